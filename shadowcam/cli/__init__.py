@@ -1,0 +1,64 @@
+"""Command line interface: ``shadowcam <step> ...``.
+
+Each step lives in its own module of this package and exposes
+``add_parser(subparsers)`` (which registers the step and its options) and
+``run(args)``. Snakemake rules call exactly one step each.
+"""
+
+import argparse
+import importlib
+import logging
+import sys
+
+from shadowcam import __version__
+
+#: step name -> module (inside ``shadowcam.cli``) that implements it
+STEPS = {
+    "render": "render",
+    "checksum": "checksum",
+    "decode": "decode",
+    "shadow-time": "shadow_time",
+    "dual-coords": "dual_coords",
+    "dual-view": "dual_view",
+    "accuracy": "accuracy",
+    "report-figures": "report_figures",
+}
+
+
+def build_parser():
+    """Return the top-level argument parser with every available step."""
+    parser = argparse.ArgumentParser(prog="shadowcam", description=__doc__)
+    parser.add_argument("--version", action="version", version=__version__)
+    parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    subparsers = parser.add_subparsers(dest="step", required=True, metavar="STEP")
+    for name, module_name in STEPS.items():
+        try:
+            module = importlib.import_module(f"shadowcam.cli.{module_name}")
+        except ModuleNotFoundError as exc:
+            if exc.name == f"shadowcam.cli.{module_name}":
+                continue  # step not part of this installation
+            raise
+        sub = module.add_parser(subparsers, name)
+        sub.set_defaults(run=module.run)
+    return parser
+
+
+def main(argv=None):
+    """Entry point of the ``shadowcam`` command."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    logging.basicConfig(
+        level=logging.DEBUG if args.verbose else logging.INFO,
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+    )
+    try:
+        args.run(args)
+    except (ValueError, FileNotFoundError) as exc:
+        # user-facing errors: say what is wrong, no traceback
+        print(f"shadowcam {args.step}: error: {exc}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
