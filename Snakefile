@@ -1,0 +1,35 @@
+# shadowcam workflow: shadow cameras from moving shadows.
+# Run:    snakemake --profile profiles/local [--config datasets=[NAME]]
+# Report: snakemake --report results/report.html
+# Stages live in workflow/rules/*.smk, helpers in workflow/rules/common.smk.
+from snakemake.utils import min_version, validate
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+validate(config, "workflow/schemas/config.schema.yaml")
+
+
+report: "workflow/report/workflow.rst"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/render.smk"
+include: "workflow/rules/decode.smk"
+include: "workflow/rules/shadow_time.smk"
+include: "workflow/rules/dual.smk"
+include: "workflow/rules/accuracy.smk"
+include: "workflow/rules/report.smk"
+
+
+localrules:
+    all,
+
+
+rule all:
+    input:
+        get_final_targets,
+    default_target: True

@@ -1,0 +1,31 @@
+# Stage: accuracy against ground truth (only datasets that have it: synthetic ones,
+# or user data with a `ground_truth:` entry).
+
+
+rule accuracy:
+    input:
+        capture=get_capture_input,
+        shadow_time="results/{ds}/shadow_time.nc",
+        dual_coords="results/{ds}/dual_coords.nc",
+        dual_view="results/{ds}/dual_view.nc",
+    output:
+        json="results/{ds}/accuracy.json",
+        csv=report(
+            "results/{ds}/accuracy.csv",
+            caption="../report/accuracy.rst",
+            category="{ds}",
+            subcategory="accuracy",
+            labels={"dataset": "{ds}", "table": "accuracy (CSV)"},
+        ),
+    params:
+        manifest=get_capture_manifest,
+    log:
+        "logs/{ds}/accuracy.log",
+    benchmark:
+        "benchmarks/{ds}/accuracy.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    shell:
+        "shadowcam accuracy --manifest {params.manifest} --shadow-time {input.shadow_time}"
+        " --dual-coords {input.dual_coords} --dual-view {input.dual_view}"
+        " --out-json {output.json} --out-csv {output.csv} > {log} 2>&1"

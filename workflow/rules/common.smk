@@ -1,0 +1,218 @@
+# Helpers of the shadowcam workflow: dataset manifests, which stages and sweeps
+# each dataset needs, and the input functions (get_*) used by the stage files.
+#
+# Offers
+# ------
+# load_dataset_manifest(ds)   parsed data_manifest/<ds>.yaml (cached), with a clear error
+# is_synthetic(ds)            manifest has a `synthetic:` block (rendered by the workflow)
+# has_ground_truth(ds)        synthetic, or a `ground_truth:` entry -> accuracy is run
+# has_reference(ds)           capture has an unshadowed reference frame
+# uses_calibration(ds)        calibration sweeps exist and the configured model may use them
+# scene_sweeps(ds)            names of the scene sweeps (u, v)
+# get_*                       input / params functions of the rules
+import glob
+import json
+from pathlib import Path
+
+import yaml
+
+SCENE_SWEEPS = ("u", "v")
+CALIBRATION_SWEEPS = ("cal_u", "cal_v")
+_MANIFEST_CACHE = {}
+
+
+wildcard_constraints:
+    ds=r"[A-Za-z0-9][A-Za-z0-9_.-]*",
+    sweep=r"[A-Za-z0-9_]+",
+
+
+def as_json(mapping):
+    """Return `mapping` as a compact, key-sorted JSON string (for params)."""
+    return json.dumps(mapping, sort_keys=True, separators=(",", ":"))
+
+
+def manifest_path(ds):
+    """Return the path of the data manifest of dataset `ds`."""
+    return f"data_manifest/{ds}.yaml"
+
+
+def load_dataset_manifest(ds):
+    """Return the parsed data manifest of dataset `ds` (a dict); raise ValueError if unusable."""
+    if ds not in _MANIFEST_CACHE:
+        path = Path(manifest_path(ds))
+        if not path.is_file():
+            raise ValueError(
+                f"dataset {ds!r} (config key 'datasets'): {path} does not exist; "
+                f"write it (see README.md) or choose an existing dataset with "
+                f"--config datasets=[NAME]"
+            )
+        with open(path) as handle:
+            manifest = yaml.safe_load(handle)
+        if not isinstance(manifest, dict):
+            raise ValueError(f"{path}: expected a YAML mapping at top level")
+        if manifest.get("name", ds) != ds:
+            raise ValueError(
+                f"{path}: key 'name' is {manifest['name']!r} but must equal the file stem {ds!r}"
+            )
+        _MANIFEST_CACHE[ds] = manifest
+    return _MANIFEST_CACHE[ds]
+
+
+def is_synthetic(ds):
+    """Return True if dataset `ds` is rendered by the workflow (`synthetic:` block)."""
+    return "synthetic" in load_dataset_manifest(ds)
+
+
+def has_ground_truth(ds):
+    """Return True if dataset `ds` has ground truth (synthetic, or a `ground_truth:` entry)."""
+    return is_synthetic(ds) or "ground_truth" in load_dataset_manifest(ds)
+
+
+def has_reference(ds):
+    """Return True if the capture of `ds` has an unshadowed reference frame.
+
+    Rendered captures always include one (``shadowcam render`` writes it).
+    """
+    return is_synthetic(ds) or bool(load_dataset_manifest(ds).get("reference"))
+
+
+def has_calibration_sweeps(ds):
+    """Return True if `ds` has both calibration-plane sweeps and their plane description."""
+    manifest = load_dataset_manifest(ds)
+    if is_synthetic(ds):
+        return bool(manifest["synthetic"].get("calibration", False))
+    sweeps = manifest.get("sweeps") or {}
+    return all(s in sweeps for s in CALIBRATION_SWEEPS) and "calibration_plane" in manifest
+
+
+def scene_sweeps(ds):
+    """Return the scene sweep names of `ds` (tuple of str); raise ValueError if u or v is missing."""
+    manifest = load_dataset_manifest(ds)
+    if is_synthetic(ds):
+        return SCENE_SWEEPS
+    sweeps = manifest.get("sweeps") or {}
+    missing = [s for s in SCENE_SWEEPS if s not in sweeps]
+    if missing:
+        raise ValueError(
+            f"{manifest_path(ds)}: key 'sweeps' lacks {', '.join(missing)}; "
+            f"the lab dual view needs the two perpendicular sweeps u and v"
+        )
+    return SCENE_SWEEPS
+
+
+def dual_model(ds):
+    """Return the dual-coordinate model to run for `ds` (config `dual_coords.model`)."""
+    model = config["dual_coords"]["model"]
+    if model == "calibration" and not has_calibration_sweeps(ds):
+        raise ValueError(
+            f"config dual_coords.model is 'calibration' but {manifest_path(ds)} has no "
+            f"calibration sweeps (cal_u, cal_v and calibration_plane); use model 'auto' or 'uniform'"
+        )
+    return model
+
+
+def uses_calibration(ds):
+    """Return True if the calibration sweeps of `ds` are decoded and timed."""
+    return has_calibration_sweeps(ds) and dual_model(ds) in ("auto", "calibration")
+
+
+def dataset_targets(ds):
+    """Return the final output files of dataset `ds` (list of str)."""
+    targets = [
+        f"results/{ds}/shadow_time.nc",
+        f"results/{ds}/dual_coords.nc",
+        f"results/{ds}/dual_view.nc",
+        f"results/{ds}/figures",
+    ]
+    if has_ground_truth(ds):
+        targets += [f"results/{ds}/accuracy.json", f"results/{ds}/accuracy.csv"]
+    return targets
+
+
+def get_final_targets(wildcards):
+    """Input function of `all`: the outputs of every configured dataset."""
+    return [t for ds in config["datasets"] for t in dataset_targets(ds)]
+
+
+def get_capture_input(wildcards):
+    """Input that describes the capture: the manifest (user data) or the rendered capture directory."""
+    if is_synthetic(wildcards.ds):
+        return f"results/{wildcards.ds}/capture"
+    return manifest_path(wildcards.ds)
+
+
+def get_capture_manifest(wildcards):
+    """Path given to ``--manifest``: data_manifest/<ds>.yaml, or capture.json of a rendered capture."""
+    if is_synthetic(wildcards.ds):
+        return f"results/{wildcards.ds}/capture/capture.json"
+    return manifest_path(wildcards.ds)
+
+
+def get_raw_files(wildcards):
+    """Files that `decode` reads for one sweep: the capture directory, or the manifest plus its frames."""
+    ds = wildcards.ds
+    if is_synthetic(ds):
+        return [f"results/{ds}/capture"]
+    manifest = load_dataset_manifest(ds)
+    root = Path(manifest_path(ds)).parent / manifest.get("root", ".")
+    if wildcards.sweep == "reference":
+        pattern = manifest.get("reference")
+    else:
+        pattern = (manifest.get("sweeps") or {}).get(wildcards.sweep, {}).get("files")
+    if not pattern:
+        raise ValueError(f"{manifest_path(ds)}: no files declared for sweep {wildcards.sweep!r}")
+    files = sorted(glob.glob(str(root / pattern)))
+    if not files:
+        raise ValueError(
+            f"{manifest_path(ds)}: pattern {pattern!r} of sweep {wildcards.sweep!r} matches no "
+            f"file under {root}; check 'root' and the pattern"
+        )
+    return [manifest_path(ds)] + files
+
+
+def get_sweeps(wildcards):
+    """Sweeps whose shadow times are estimated: u, v, and cal_u, cal_v when used."""
+    sweeps = list(scene_sweeps(wildcards.ds))
+    if uses_calibration(wildcards.ds):
+        sweeps += list(CALIBRATION_SWEEPS)
+    return sweeps
+
+
+def get_frames(wildcards):
+    """Decoded frame stores of the sweeps of `get_sweeps`, in the same order."""
+    return [f"results/{wildcards.ds}/frames/{s}.zarr" for s in get_sweeps(wildcards)]
+
+
+def get_reference(wildcards):
+    """Decoded reference frame store, or an empty list if the capture has none."""
+    if has_reference(wildcards.ds):
+        return [f"results/{wildcards.ds}/frames/reference.zarr"]
+    return []
+
+
+def get_reference_option(wildcards, input):
+    """``--reference PATH`` if the dual view has a reference frame, else an empty string."""
+    return f"--reference {input.reference}" if input.reference else ""
+
+
+def get_dual_model(wildcards):
+    """Model name passed to ``shadowcam dual-coords --model``."""
+    return dual_model(wildcards.ds)
+
+
+def get_accuracy(wildcards):
+    """Accuracy table of the dataset, or an empty list if it has no ground truth."""
+    if has_ground_truth(wildcards.ds):
+        return [f"results/{wildcards.ds}/accuracy.csv"]
+    return []
+
+
+def get_accuracy_option(wildcards, input):
+    """``--accuracy PATH`` for report figures when accuracy was computed, else empty."""
+    return f"--accuracy {input.accuracy}" if input.accuracy else ""
+
+
+def get_dual_view_params(wildcards):
+    """JSON options of ``shadowcam dual-view``: grid size and method options."""
+    section = config["dual_view"]
+    return as_json({"width": section["width"], "height": section["height"], **section["params"]})

@@ -1,0 +1,31 @@
+# Stage: report figures (primal image, shadow-time maps, dual view vs reciprocal,
+# error histogram, accuracy table) shown by `snakemake --report results/report.html`.
+
+
+rule report_figures:
+    input:
+        capture=get_capture_input,
+        shadow_time="results/{ds}/shadow_time.nc",
+        dual_view="results/{ds}/dual_view.nc",
+        accuracy=get_accuracy,
+    output:
+        report(
+            directory("results/{ds}/figures"),
+            patterns=["{figure}.png", "{figure}.html"],
+            caption="../report/figures.rst",
+            category="{ds}",
+            subcategory="figures",
+            labels={"dataset": "{ds}", "figure": "{figure}"},
+        ),
+    params:
+        manifest=get_capture_manifest,
+        accuracy=get_accuracy_option,
+    log:
+        "logs/{ds}/report_figures.log",
+    benchmark:
+        "benchmarks/{ds}/report_figures.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    shell:
+        "shadowcam report-figures --manifest {params.manifest} --shadow-time {input.shadow_time}"
+        " --dual-view {input.dual_view} {params.accuracy} --outdir {output} > {log} 2>&1"
