@@ -1,0 +1,431 @@
+"""Per-pixel shadow time of a sweep: when the mask's shadow passes each pixel.
+
+The frames of one sweep stream through a :class:`~shadowcam.dip_tracker.DipTracker`
+(memory independent of the frame count); each pixel's dip is then classified
+(is there a reliable shadow at all?) and timed to a fraction of a frame by one
+of the methods of :data:`SHADOW_TIME_METHODS`. The default, ``edge_fit``, adds
+the spatial structure of the shadow edge (:mod:`shadowcam.edge_refine`): a
+pixel's own samples are nearly on/off when the shadow crosses it within a
+frame, so its neighbours' times sharpen it (paper II-A: the shadow camera's
+resolution depends on the edge detector, not on the shadow width).
+
+Offers
+------
+SHADOW_TIME_METHODS : name -> timing function ``f(summary) -> (time, entry, exit, time_std)``.
+REASONS : flag code -> meaning, for pixels without a reliable time.
+classify_dips : reason code, contrast and confidence per pixel.
+shadow_times : timing + classification of one sweep's :class:`DipSummary`.
+track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
+"""
+
+import numpy as np
+from scipy.special import ndtri
+
+from shadowcam.dip_tracker import DipTracker
+from shadowcam.edge_refine import refine_times
+
+#: flag code -> meaning (0 = a reliable time)
+REASONS = {
+    0: "ok",
+    1: "never_shadowed",
+    2: "low_contrast",
+    3: "saturated",
+    4: "several_minima",
+    5: "invalid_input",
+}
+OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT = range(6)
+
+#: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
+_SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
+
+
+def _window_times(summary):
+    """Frame index of each window slot, ``(K, H, W)`` float64."""
+    k = summary.window.shape[0]
+    return summary.window_start[None] + np.arange(k)[:, None, None]
+
+
+def _coverage(summary):
+    """Fraction of light removed in each window frame, ``(K, H, W)``; NaN outside."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        level = summary.lit_level[None]
+        return np.clip(1.0 - summary.window / level, 0.0, 1.0)
+
+
+def _centroid(summary, coverage):
+    """Coverage-weighted mean time and its noise standard deviation."""
+    times = _window_times(summary)
+    weight = np.where(np.isfinite(coverage), coverage, 0.0)
+    total = weight.sum(axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        centre = (weight * times).sum(axis=0) / total
+        # each coverage sample carries noise sigma / level; propagate it
+        spread = np.where(np.isfinite(coverage), (times - centre) ** 2, 0.0).sum(axis=0)
+        std = summary.noise / summary.lit_level * np.sqrt(spread) / total
+    return centre, std
+
+
+def _crossings(summary, threshold):
+    """Entry and exit times where the signal crosses `threshold` (linear interpolation).
+
+    The crossings nearest to the minimum on each side are used; NaN where the
+    dip does not come back above `threshold` inside the window.
+    """
+    win = summary.window
+    k = win.shape[0]
+    h = summary.half_window
+    above = win >= threshold[None]
+    idx = np.arange(k)[:, None, None]
+    # entry: last slot before the centre that is above the threshold
+    left = np.where(above & (idx < h), idx, -1).max(axis=0)
+    # exit: first slot after the centre that is above the threshold
+    right = np.where(above & (idx > h), idx, k).min(axis=0)
+    rows, cols = np.indices(threshold.shape)
+
+    def interpolate(a, b):
+        ok = (a >= 0) & (a < k) & (b >= 0) & (b < k)
+        a_c, b_c = np.clip(a, 0, k - 1), np.clip(b, 0, k - 1)
+        va, vb = win[a_c, rows, cols], win[b_c, rows, cols]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            frac = (va - threshold) / (va - vb)
+        return np.where(ok & np.isfinite(frac), summary.window_start + a_c + frac * (b_c - a_c), np.nan)
+
+    entry = interpolate(left, left + 1)
+    exit_ = interpolate(right, right - 1)
+    centre_below = win[h] < threshold
+    entry = np.where(centre_below, entry, np.nan)
+    exit_ = np.where(centre_below, exit_, np.nan)
+    return entry, exit_
+
+
+def _noise_time_std(summary, depth):
+    """Rough time uncertainty of a crossing: noise / slope of a one-frame edge."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return summary.noise / depth
+
+
+def time_midpoint_crossing_BouguetPerona1998(summary):
+    """Midpoint of the entry and exit crossings of (Imax + Imin) / 2.
+
+    Bouguet & Perona, "3D photography on your desk", ICCV 1998: the shadow
+    time is where the temporal profile crosses the mean of its extremes, with
+    linear interpolation between frames; entry and exit are both kept.
+    """
+    minimum = np.nanmin(np.where(np.isfinite(summary.window), summary.window, np.inf), axis=0)
+    threshold = 0.5 * (summary.lit_level + minimum)
+    entry, exit_ = _crossings(summary, threshold)
+    depth = summary.lit_level - minimum
+    return 0.5 * (entry + exit_), entry, exit_, _noise_time_std(summary, depth)
+
+
+def time_argmin_parabolic(summary):
+    """Deepest frame of the [1, 2, 1]-smoothed profile, refined by a parabola.
+
+    The vertex of the parabola through the smoothed samples at the minimum
+    and its two neighbours gives the sub-frame offset (clipped to +-0.5).
+    """
+    win = summary.window.astype(np.float64)
+    h = summary.half_window
+    padded = np.concatenate([win[:1], win, win[-1:]])
+    padded = np.where(np.isfinite(padded), padded, np.nan)
+    smooth = 0.25 * padded[:-2] + 0.5 * padded[1:-1] + 0.25 * padded[2:]
+    s_m, s_0, s_p = smooth[h - 1], smooth[h], smooth[h + 1]
+    curvature = s_m - 2 * s_0 + s_p
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.clip(0.5 * (s_m - s_p) / curvature, -0.5, 0.5)
+    offset = np.where(np.isfinite(offset), offset, 0.0)
+    time = summary.minimum_frame + offset
+    depth = summary.lit_level - summary.minimum_value
+    with np.errstate(invalid="ignore", divide="ignore"):
+        std = summary.noise * _SMOOTHED_NOISE / np.abs(curvature)
+    entry, exit_ = _crossings(summary, 0.5 * (summary.lit_level + summary.minimum_value))
+    return time, entry, exit_, np.minimum(std, 0.5) + 0 * depth
+
+
+def time_dip_centroid(summary):
+    """Centroid of the removed-light fraction over the window around the minimum.
+
+    With the dip fully inside the window, the centroid of ``1 - I / I_lit``
+    is the time the shadow's centre line crosses the pixel, using the partial
+    coverage of the frames at the dip's edges.
+    """
+    coverage = _coverage(summary)
+    time, std = _centroid(summary, coverage)
+    threshold = summary.lit_level * 0.5 + 0.5 * summary.minimum_value
+    entry, exit_ = _crossings(summary, threshold)
+    return time, entry, exit_, std
+
+
+def time_edge_fit(summary, *, radius=3, range_sigma=1.5, floor_std=0.15):
+    """Dip centroid refined by an edge-aware local plane fit of neighbours' times.
+
+    See :func:`shadowcam.edge_refine.refine_times`; `floor_std` is the
+    per-pixel error, in frames, that remains without noise (the on/off
+    staircase of a shadow that crosses a pixel within one frame).
+    """
+    time, entry, exit_, std = time_dip_centroid(summary)
+    refined, refined_std = refine_times(
+        time, np.hypot(std, floor_std), radius=radius, range_sigma=range_sigma
+    )
+    shift = refined - time
+    return refined, entry + shift, exit_ + shift, refined_std
+
+
+#: shadow-time methods: name -> function(summary) -> (time, entry, exit, time_std)
+SHADOW_TIME_METHODS = {
+    "argmin_parabolic": time_argmin_parabolic,
+    "midpoint_crossing_BouguetPerona1998": time_midpoint_crossing_BouguetPerona1998,
+    "dip_centroid": time_dip_centroid,
+    "edge_fit": time_edge_fit,
+}
+
+
+def detection_threshold(n_frames, *, false_alarm=1e-3):
+    """Dip depth, in units of the smoothed-sample noise, that pure noise rarely reaches.
+
+    The deepest of `n_frames` smoothed noise samples exceeds ``z`` standard
+    deviations with probability about ``n_frames * Q(z)``; ``z`` is chosen so
+    that this is `false_alarm`.
+    """
+    if not 0 < false_alarm < 1:
+        raise ValueError(f"false_alarm must be in (0, 1), got {false_alarm!r}")
+    return float(-ndtri(false_alarm / max(int(n_frames), 1)))
+
+
+def _shifts(radius):
+    """Neighbour offsets ``(dr, dc)`` within `radius`, excluding ``(0, 0)``."""
+    return [(dr, dc) for dr in range(-radius, radius + 1) for dc in range(-radius, radius + 1)
+            if (dr, dc) != (0, 0)]
+
+
+def _neighbour(array, dr, dc, fill):
+    """``out[r, c] = array[r + dr, c + dc]``, `fill` outside the image."""
+    out = np.full_like(array, fill)
+    h, w = array.shape
+    rs, re = max(0, -dr), min(h, h - dr)
+    cs, ce = max(0, -dc), min(w, w - dc)
+    out[rs:re, cs:ce] = array[rs + dr:re + dr, cs + dc:ce + dc]
+    return out
+
+
+def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, frames_per_pixel=1.5,
+                             min_support=3):
+    """Weak dips whose timing agrees with enough strong neighbours.
+
+    A real but faint shadow dip occurs when the neighbours' dips occur (the
+    edge sweeps across them); a dip of pure noise falls at a random frame. A
+    candidate is supported when at least `min_support` strong neighbours, and
+    at least half of the strong neighbours, have their minimum within
+    ``1 + frames_per_pixel * distance`` frames of the candidate's.
+    """
+    agree = np.zeros(candidate.shape, np.int32)
+    total = np.zeros(candidate.shape, np.int32)
+    frame = minimum_frame.astype(np.float64)
+    for dr, dc in _shifts(radius):
+        n_strong = _neighbour(strong, dr, dc, False)
+        n_frame = _neighbour(frame, dr, dc, np.nan)
+        tolerance = 1.0 + frames_per_pixel * np.hypot(dr, dc)
+        total += n_strong
+        agree += n_strong & (np.abs(n_frame - frame) <= tolerance)
+    return candidate & (agree >= min_support) & (2 * agree >= total)
+
+
+def _partially_lit(detected, level, *, min_lit_fraction=0.5):
+    """Detected pixels at a shadow boundary whose lit part is under `min_lit_fraction`.
+
+    A pixel straddling the boundary of a cast (scene) shadow dips when the
+    mask passes, although its centre is in shadow. Its lit fraction is
+    estimated as its level over the brightest detected 8-neighbour; only
+    pixels next to an undetected, darker pixel (the shadow side) are tested.
+    """
+    lit_level = np.where(detected, level, 0.0)
+    brightest = np.zeros_like(lit_level)
+    shadow_side = np.zeros(detected.shape, bool)
+    for dr, dc in _shifts(1):
+        brightest = np.maximum(brightest, _neighbour(lit_level, dr, dc, 0.0))
+        n_detected = _neighbour(detected, dr, dc, True)
+        n_level = _neighbour(level, dr, dc, np.inf)
+        shadow_side |= ~n_detected & (n_level < level)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fraction = level / brightest
+    return detected & shadow_side & (fraction < min_lit_fraction)
+
+
+def classify_dips(summary, *, saturated=None, false_alarm=1e-3, weak_false_alarm=0.5,
+                  min_relative_depth=0.1, min_lit_fraction=0.5, noise_floor=1e-4,
+                  second_dip_ratio=0.5):
+    """Decide per pixel whether its dip is a reliable shadow, and why not.
+
+    A dip is detected when it is deeper than pure noise gets within the
+    sweep (threshold from the measured per-pixel noise and `false_alarm`),
+    or when it passes the looser `weak_false_alarm` threshold and its timing
+    agrees with detected neighbours. Detected pixels at a cast-shadow
+    boundary whose lit fraction is below `min_lit_fraction` (centre in
+    shadow) are then rejected.
+
+    Parameters
+    ----------
+    summary : DipSummary
+        One sweep.
+    saturated : (H, W) bool ndarray, optional
+        Pixels that reached the white level in any channel.
+    false_alarm : float, optional
+        Wanted probability that a pixel of pure noise is given a time on its own.
+    weak_false_alarm : float, optional
+        The same for a dip that neighbours must confirm.
+    min_relative_depth : float, optional
+        Smallest dip depth, as a fraction of the lit level, taken as a shadow.
+    min_lit_fraction : float, optional
+        Smallest lit fraction of a boundary pixel's footprint.
+    noise_floor : float, optional
+        Lower bound of the noise (signal units), for noise-free data.
+    second_dip_ratio : float, optional
+        A second dip a window away at least this deep (relative to the first)
+        marks the pixel ``several_minima``.
+
+    Returns
+    -------
+    reason : (H, W) uint8 ndarray
+        Codes of :data:`REASONS`.
+    contrast : (H, W) float32 ndarray
+        Dip depth over its noise standard deviation.
+    """
+    z = detection_threshold(summary.n_frames, false_alarm=false_alarm)
+    z_weak = detection_threshold(summary.n_frames, false_alarm=weak_false_alarm)
+    noise = np.maximum(np.nan_to_num(summary.noise, nan=np.inf), noise_floor)
+    level = summary.lit_level
+    depth = level - summary.minimum_value
+    with np.errstate(invalid="ignore", divide="ignore"):
+        contrast = depth / (noise * _SMOOTHED_NOISE)
+        second_depth = level - summary.second_value
+    deep_enough = depth > min_relative_depth * level
+    strong = (contrast > z) & deep_enough
+    weak = (contrast > z_weak) & deep_enough & ~strong
+    detected = strong | _supported_by_neighbours(weak, strong, summary.minimum_frame)
+    significant_level = level > z * noise / np.sqrt(np.maximum(summary.lit_count, 1))
+
+    reason = np.zeros(level.shape, np.uint8)
+    reason[~detected] = NEVER_SHADOWED
+    reason[~significant_level] = LOW_CONTRAST
+    reason[_partially_lit(detected, level, min_lit_fraction=min_lit_fraction)] = LOW_CONTRAST
+    several = detected & (second_depth >= second_dip_ratio * depth) & (
+        second_depth / (noise * _SMOOTHED_NOISE) > z
+    )
+    reason[(reason == OK) & several] = SEVERAL_MINIMA
+    if saturated is not None:
+        reason[(reason == OK) & saturated] = SATURATED
+    window_invalid = ~np.isfinite(summary.window).all(axis=0)
+    inside = (summary.window_start >= 0) & (
+        summary.window_start + summary.window.shape[0] <= summary.n_frames
+    )
+    broken = (summary.invalid_count > 0) & (window_invalid & inside)
+    broken |= summary.lit_count < 3
+    broken |= summary.minimum_frame < 0
+    reason[broken] = INVALID_INPUT
+    return reason, np.nan_to_num(contrast, nan=0.0, posinf=0.0).astype(np.float32)
+
+
+def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=None,
+                 **classify_params):
+    """Time and classify the dips of one sweep.
+
+    Parameters
+    ----------
+    summary : DipSummary
+    method : str, optional
+        Key of :data:`SHADOW_TIME_METHODS`.
+    saturated : (H, W) bool ndarray, optional
+    method_params : dict, optional
+        Keyword options of the timing method.
+    **classify_params
+        Options of :func:`classify_dips`.
+
+    Returns
+    -------
+    dict of (H, W) ndarrays
+        ``shadow_time``, ``entry_time``, ``exit_time`` (frames, NaN where
+        unreliable), ``time_std`` (frames), ``confidence`` (0..1),
+        ``contrast``, ``reason`` (uint8), ``lit_level``, ``noise``.
+    """
+    if method not in SHADOW_TIME_METHODS:
+        raise ValueError(
+            f"method must be one of {sorted(SHADOW_TIME_METHODS)}, got {method!r}"
+        )
+    reason, contrast = classify_dips(summary, saturated=saturated, **classify_params)
+    masked = _masked_summary(summary, reason == OK)
+    time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
+    last = summary.n_frames - 1
+    outside = ~((time >= 0) & (time <= last))
+    reason = reason.copy()
+    reason[(reason == OK) & outside] = NEVER_SHADOWED
+    good = reason == OK
+    std = np.where(good, std, np.nan)
+    confidence = np.where(good, np.exp(-0.5 * (std / 0.25) ** 2), 0.0)
+    nan = np.float32(np.nan)
+    return {
+        "shadow_time": np.where(good, time, nan).astype(np.float32),
+        "entry_time": np.where(good, np.clip(entry, 0, last), nan).astype(np.float32),
+        "exit_time": np.where(good, np.clip(exit_, 0, last), nan).astype(np.float32),
+        "time_std": std.astype(np.float32),
+        "confidence": np.nan_to_num(confidence, nan=0.0).astype(np.float32),
+        "contrast": contrast,
+        "reason": reason,
+        "lit_level": summary.lit_level.astype(np.float32),
+        "noise": summary.noise.astype(np.float32),
+    }
+
+
+def _masked_summary(summary, keep):
+    """Copy of `summary` whose window is NaN outside `keep` (so methods ignore them)."""
+    from dataclasses import replace
+
+    return replace(summary, window=np.where(keep[None], summary.window, np.nan))
+
+
+def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progress=None):
+    """Stream one sweep's frames through a :class:`DipTracker`.
+
+    Parameters
+    ----------
+    blocks : iterable of (T, H, W, C) float ndarray
+        Frames in time order (any block sizes).
+    shape : tuple of int
+        ``(H, W)``.
+    half_window : int, optional
+    saturation_level : float, optional
+        Linear value (white = 1) at or above which a channel is saturated.
+    progress : callable, optional
+        Called with the number of frames done after each block.
+
+    Returns
+    -------
+    summary : DipSummary
+        Of the channel-summed signal.
+    lit_image : (H, W, C) float32 ndarray
+        Unshadowed colour per pixel: the channel means scaled by the ratio of
+        the lit level to the mean level (the mask removes light from all
+        channels alike).
+    saturated : (H, W) bool ndarray
+    """
+    tracker = DipTracker(shape, half_window=half_window)
+    colour_sum = None
+    saturated = np.zeros(shape, bool)
+    for block in blocks:
+        block = np.asarray(block, np.float32)
+        if block.ndim != 4 or block.shape[1:3] != tuple(shape):
+            raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C), got {block.shape}")
+        with np.errstate(invalid="ignore"):
+            saturated |= (block >= saturation_level).any(axis=(0, 3))
+        finite = np.where(np.isfinite(block), block, 0.0)
+        sums = finite.sum(axis=0, dtype=np.float64)
+        colour_sum = sums if colour_sum is None else colour_sum + sums
+        tracker.update(block.sum(axis=3))
+        if progress is not None:
+            progress(tracker.n_frames)
+    summary = tracker.result()
+    if colour_sum is None:
+        raise ValueError("blocks is empty: the sweep has no frames")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = summary.lit_level / summary.mean_level
+        lit_image = colour_sum / summary.n_frames * scale[..., None]
+    return summary, np.nan_to_num(lit_image, nan=0.0).astype(np.float32), saturated
