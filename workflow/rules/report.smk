@@ -7,6 +7,7 @@ rule report_figures:
         capture=get_capture_input,
         shadow_time="results/{ds}/shadow_time.nc",
         dual_view="results/{ds}/dual_view.nc",
+        reference=get_reference,
         accuracy=get_accuracy,
     output:
         report(
@@ -19,6 +20,7 @@ rule report_figures:
         ),
     params:
         manifest=get_capture_manifest,
+        reference=get_reference_option,
         accuracy=get_accuracy_option,
     log:
         "logs/{ds}/report_figures.log",
@@ -28,4 +30,4 @@ rule report_figures:
         "../envs/shadowcam.yaml"
     shell:
         "shadowcam report-figures --manifest {params.manifest} --shadow-time {input.shadow_time}"
-        " --dual-view {input.dual_view} {params.accuracy} --outdir {output} > {log} 2>&1"
+        " --dual-view {input.dual_view} {params.reference} {params.accuracy} --outdir {output} > {log} 2>&1"

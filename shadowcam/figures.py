@@ -1,0 +1,238 @@
+"""Report figures: matplotlib (Agg, no pyplot state) renderings of shadowcam products.
+
+Every function takes arrays and returns a :class:`matplotlib.figure.Figure` of a fixed
+pixel size (``size`` inches x :data:`FIGURE_DPI`); :func:`save_png` writes one. Linear
+radiance is shown with a percentile white point and a display gamma; pixels without a
+value (NaN) are drawn in :data:`NAN_GREY`.
+
+Offers
+------
+FIGURE_DPI : dots per inch of every figure (image size = size x FIGURE_DPI pixels).
+NAN_GREY : RGB colour of pixels without a value.
+display_rgb : linear image -> displayable RGB in [0, 1], NaN -> grey.
+primal_figure : the camera (primal) image.
+time_map_figure : a shadow-time map with colour bar.
+dual_view_figure : the dual view, next to the ground-truth reciprocal view if given.
+error_histogram_figure : histogram of shadow-time errors per sweep.
+save_png : write a figure as PNG (exact pixel size).
+"""
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib import colormaps
+from matplotlib.figure import Figure
+
+FIGURE_DPI = 100
+NAN_GREY = (0.5, 0.5, 0.5)
+
+
+def _new_figure(size):
+    width, height = size
+    if not (width > 0 and height > 0):
+        raise ValueError(f"size must be two positive numbers (inches), got {size!r}")
+    figure = Figure(figsize=(width, height), dpi=FIGURE_DPI)
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _as_image(image, name):
+    image = np.asarray(image)
+    if image.ndim == 2:
+        image = image[..., np.newaxis]
+    if image.ndim != 3 or image.shape[2] not in (1, 3) or min(image.shape[:2]) < 1:
+        raise ValueError(
+            f"{name} must be a (rows, cols) or (rows, cols, 1|3) array, got shape {image.shape}"
+        )
+    if not np.issubdtype(image.dtype, np.number):
+        raise ValueError(f"{name} must be numeric, got dtype {image.dtype}")
+    if image.shape[2] == 1:
+        image = np.repeat(image, 3, axis=2)
+    return image
+
+
+def display_rgb(image, *, percentile=99.5, gamma=1 / 2.2):
+    """Map a linear image to displayable RGB.
+
+    Parameters
+    ----------
+    image : (rows, cols) or (rows, cols, 1|3) ndarray
+        Linear radiance; NaN where there is no value.
+    percentile : float, optional
+        Percentile of the finite values mapped to white (0 < percentile <= 100).
+    gamma : float, optional
+        Display exponent applied after scaling.
+
+    Returns
+    -------
+    rgb : (rows, cols, 3) float32 ndarray
+        Values in [0, 1]; pixels with a NaN channel are :data:`NAN_GREY`.
+    """
+    image = _as_image(image, "image").astype(np.float32, copy=False)
+    if not 0 < percentile <= 100:
+        raise ValueError(f"percentile must be in (0, 100], got {percentile!r}")
+    if not gamma > 0:
+        raise ValueError(f"gamma must be positive, got {gamma!r}")
+    missing = ~np.all(np.isfinite(image), axis=2)
+    finite = image[~missing]
+    white = np.percentile(finite, percentile) if finite.size else 1.0
+    white = white if white > 0 else 1.0
+    rgb = np.clip(np.nan_to_num(image / np.float32(white)), 0, 1) ** np.float32(gamma)
+    rgb[missing] = NAN_GREY
+    return rgb.astype(np.float32)
+
+
+def _show_image(axes, rgb, title, *, xlabel="col", ylabel="row"):
+    axes.imshow(rgb, interpolation="nearest", origin="upper")
+    axes.set_title(title)
+    axes.set_xlabel(xlabel)
+    axes.set_ylabel(ylabel)
+
+
+def primal_figure(image, *, title="primal (camera) image", size=(5.0, 5.0)):
+    """Figure of the camera image.
+
+    Parameters
+    ----------
+    image : (rows, cols) or (rows, cols, 1|3) ndarray
+        Linear camera image (e.g. the unshadowed reference frame).
+    title : str, optional
+    size : (float, float), optional
+        Figure width, height in inches (pixels = inches x :data:`FIGURE_DPI`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    rgb = display_rgb(image)
+    figure = _new_figure(size)
+    _show_image(figure.add_subplot(), rgb, title)
+    figure.tight_layout()
+    return figure
+
+
+def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
+                    vmin=None, vmax=None, cmap="viridis", size=(6.0, 5.0)):
+    """Figure of a per-pixel time map with a colour bar; NaN drawn grey.
+
+    Parameters
+    ----------
+    times : (rows, cols) ndarray
+        Times (e.g. frames); NaN where there is no reliable time.
+    title, label : str, optional
+        Axes title and colour-bar label.
+    vmin, vmax : float, optional
+        Colour range; default the range of the finite values.
+    cmap : str, optional
+        Matplotlib colour map name.
+    size : (float, float), optional
+        Figure width, height in inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    times = np.asarray(times)
+    if times.ndim != 2 or min(times.shape) < 1:
+        raise ValueError(f"times must be a (rows, cols) array, got shape {times.shape}")
+    if not np.issubdtype(times.dtype, np.number):
+        raise ValueError(f"times must be numeric, got dtype {times.dtype}")
+    colours = colormaps[cmap].with_extremes(bad=NAN_GREY)
+    finite = times[np.isfinite(times)]
+    if vmin is None:
+        vmin = float(finite.min()) if finite.size else 0.0
+    if vmax is None:
+        vmax = float(finite.max()) if finite.size else 1.0
+    figure = _new_figure(size)
+    axes = figure.add_subplot()
+    shown = axes.imshow(np.ma.masked_invalid(times), cmap=colours, vmin=vmin, vmax=vmax,
+                        interpolation="nearest", origin="upper")
+    axes.set_title(title)
+    axes.set_xlabel("col")
+    axes.set_ylabel("row")
+    figure.colorbar(shown, ax=axes, label=label)
+    figure.tight_layout()
+    return figure
+
+
+def dual_view_figure(dual_view, *, reciprocal=None, size=None):
+    """Figure of the dual view, next to the ground-truth reciprocal view if given.
+
+    Each panel is scaled to its own white point: the two views differ photometrically
+    (the camera and light fall-off terms swap), so only geometry is compared.
+
+    Parameters
+    ----------
+    dual_view : (v, u) or (v, u, 1|3) ndarray
+        Linear dual view; NaN = hole (drawn grey).
+    reciprocal : (v, u) or (v, u, 1|3) ndarray, optional
+        Ground-truth reciprocal view (rendered from the light).
+    size : (float, float), optional
+        Figure width, height in inches; default (5, 5) for one panel, (10, 5) for two.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    panels = [("dual view (shadow camera)", display_rgb(dual_view))]
+    if reciprocal is not None:
+        panels.append(("ground-truth reciprocal view", display_rgb(reciprocal)))
+    figure = _new_figure(size or (5.0 * len(panels), 5.0))
+    for index, (title, rgb) in enumerate(panels, start=1):
+        _show_image(figure.add_subplot(1, len(panels), index), rgb, title,
+                    xlabel="u (dual col)", ylabel="v (dual row)")
+    figure.tight_layout()
+    return figure
+
+
+def error_histogram_figure(errors, *, limit=3.0, bins=60, unit="frame", size=(6.0, 4.0)):
+    """Histogram of errors (estimate - ground truth), one outline per series.
+
+    Parameters
+    ----------
+    errors : mapping of str to (N,) ndarray
+        Series name (e.g. sweep) -> errors; non-finite values are ignored.
+    limit : float, optional
+        Histogram range is [-limit, limit]; values outside are counted in the legend.
+    bins : int, optional
+    unit : str, optional
+        Unit of the errors, for the axis label.
+    size : (float, float), optional
+        Figure width, height in inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if not hasattr(errors, "items") or not errors:
+        raise ValueError("errors must be a non-empty mapping of name -> 1-D array")
+    if not limit > 0:
+        raise ValueError(f"limit must be positive, got {limit!r}")
+    if int(bins) < 1:
+        raise ValueError(f"bins must be a positive integer, got {bins!r}")
+    figure = _new_figure(size)
+    axes = figure.add_subplot()
+    edges = np.linspace(-limit, limit, int(bins) + 1)
+    for name, values in errors.items():
+        values = np.asarray(values, dtype=np.float64).ravel()
+        values = values[np.isfinite(values)]
+        if values.size == 0:
+            axes.plot([], [], label=f"{name}: no pixels")
+            continue
+        outside = np.count_nonzero(np.abs(values) > limit)
+        label = (f"{name}: n={values.size}, median |e|={np.median(np.abs(values)):.3f}, "
+                 f"|e|>{limit:g}: {outside}")
+        axes.hist(values, bins=edges, histtype="step", linewidth=1.5, label=label)
+    axes.set_xlabel(f"error ({unit})")
+    axes.set_ylabel("pixels")
+    axes.legend(fontsize="small")
+    figure.tight_layout()
+    return figure
+
+
+def save_png(figure, path):
+    """Write `figure` to `path` as PNG (size = figure inches x FIGURE_DPI); return the Path."""
+    path = Path(path)
+    figure.savefig(path, format="png", dpi=FIGURE_DPI)
+    return path
