@@ -1,0 +1,297 @@
+"""Dual view: resample camera colours onto the ``(v, u)`` dual grid.
+
+By Helmholtz reciprocity (paper section II-A) the dual image at ``(u, v)`` is
+the camera colour of the pixel whose dual coordinates are ``(u, v)``. The
+camera pixels give scattered samples in the dual grid; two resamplers turn
+them into an image, neither of them last-write-wins splatting:
+
+* ``mesh``: forward mesh warp. The camera pixel grid is split into triangles
+  (two per 2x2 pixel quad), their vertices moved to ``(u, v)`` and each
+  triangle rasterised at the dual pixel centres it covers with barycentric
+  colour interpolation. Triangles with a vertex without valid coordinates or
+  an edge longer than ``max_edge`` dual pixels (they span a depth or shadow
+  discontinuity) are dropped. Where several triangles cover a dual pixel their
+  colours are averaged. Fully vectorised (triangles are expanded to candidate
+  pixels of their bounding boxes, in bounded-memory chunks).
+* ``idw``: inverse-distance weighting of the ``k`` nearest camera samples
+  within ``radius`` dual pixels (``scipy.spatial.cKDTree``).
+
+Dual pixels without a sample stay NaN and ``coverage`` is False there.
+
+Offers
+------
+DUAL_VIEW_METHODS : name -> resampler, ``mesh`` and ``idw``.
+dual_view_mesh : forward mesh warp.
+dual_view_idw : k-nearest inverse-distance weighting.
+resample_dual_view : dispatch through `DUAL_VIEW_METHODS` with input checks.
+camera_colours : the camera colours to resample (reference frame or mean lit image).
+dual_view_dataset : assemble the ``dual_view`` xarray Dataset.
+"""
+
+import json
+
+import numpy as np
+import xarray as xr
+from scipy.spatial import cKDTree
+
+#: candidate (triangle, dual pixel) pairs processed at once by the mesh warp
+_CHUNK_CANDIDATES = 1 << 21
+
+
+def _grid_triangles(rows, cols):
+    """Vertex indices ``(n, 3)`` of the two triangles of every 2x2 pixel quad."""
+    r, c = np.mgrid[0 : rows - 1, 0 : cols - 1]
+    tl = (r * cols + c).ravel()
+    tr, bl, br = tl + 1, tl + cols, tl + cols + 1
+    return np.concatenate([np.stack([tl, tr, bl], 1), np.stack([br, bl, tr], 1)])
+
+
+def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, eps=1e-9):
+    """Forward mesh warp of camera colours into the dual grid.
+
+    Parameters
+    ----------
+    colours : (rows, cols, channel) ndarray
+        Linear camera colours.
+    u, v : (rows, cols) ndarray
+        Dual coordinates of the camera pixel centres (dual pixels).
+    valid : (rows, cols) bool ndarray, keyword-only
+        Pixels with usable coordinates and colours.
+    shape : (int, int)
+        ``(height, width)`` of the dual grid.
+    max_edge : float
+        Triangles with an edge longer than this (dual pixels) are dropped as
+        spanning a discontinuity.
+    eps : float
+        Barycentric tolerance for pixel centres on triangle edges.
+
+    Returns
+    -------
+    image : (height, width, channel) float32 ndarray
+        NaN where no triangle covers the dual pixel centre.
+    coverage : (height, width) bool ndarray
+    """
+    rows, cols, n_ch = colours.shape
+    height, width = shape
+    tri = _grid_triangles(rows, cols)
+    uf, vf = u.ravel().astype(np.float64), v.ravel().astype(np.float64)
+    ok_vertex = valid.ravel() & np.isfinite(uf) & np.isfinite(vf)
+    keep = ok_vertex[tri].all(axis=1)
+    tri = tri[keep]
+    pu, pv = uf[tri], vf[tri]  # (n, 3)
+    edge2 = np.stack([
+        (pu[:, 1] - pu[:, 0]) ** 2 + (pv[:, 1] - pv[:, 0]) ** 2,
+        (pu[:, 2] - pu[:, 1]) ** 2 + (pv[:, 2] - pv[:, 1]) ** 2,
+        (pu[:, 0] - pu[:, 2]) ** 2 + (pv[:, 0] - pv[:, 2]) ** 2,
+    ], 1)
+    e1u, e1v = pu[:, 1] - pu[:, 0], pv[:, 1] - pv[:, 0]
+    e2u, e2v = pu[:, 2] - pu[:, 0], pv[:, 2] - pv[:, 0]
+    det = e1u * e2v - e1v * e2u
+    keep = (edge2.max(axis=1) <= max_edge**2) & (np.abs(det) > 1e-12)
+    i0 = np.maximum(np.ceil(pu.min(axis=1) - eps), 0).astype(np.int64)
+    i1 = np.minimum(np.floor(pu.max(axis=1) + eps), width - 1).astype(np.int64)
+    j0 = np.maximum(np.ceil(pv.min(axis=1) - eps), 0).astype(np.int64)
+    j1 = np.minimum(np.floor(pv.max(axis=1) + eps), height - 1).astype(np.int64)
+    bw, bh = i1 - i0 + 1, j1 - j0 + 1
+    keep &= (bw > 0) & (bh > 0)
+    sel = np.nonzero(keep)[0]
+    flat_col = colours.reshape(-1, n_ch).astype(np.float64)
+    sums = np.zeros((height * width, n_ch))
+    counts = np.zeros(height * width)
+    cum = np.cumsum((bw * bh)[sel])
+    start = 0
+    while start < len(sel):  # chunks of about _CHUNK_CANDIDATES candidate pixels
+        done = cum[start - 1] if start else 0
+        stop = max(int(np.searchsorted(cum, done + _CHUNK_CANDIDATES, side="right")), start + 1)
+        part, start = sel[start:stop], stop
+        nb = bw[part] * bh[part]
+        t = np.repeat(np.arange(len(part)), nb)
+        local = np.arange(nb.sum()) - np.repeat(np.cumsum(nb) - nb, nb)
+        k = part[t]
+        i = i0[k] + local % bw[k]
+        j = j0[k] + local // bw[k]
+        du, dv = i - pu[k, 0], j - pv[k, 0]
+        l1 = (du * e2v[k] - dv * e2u[k]) / det[k]
+        l2 = (e1u[k] * dv - e1v[k] * du) / det[k]
+        l0 = 1.0 - l1 - l2
+        inside = (l0 >= -eps) & (l1 >= -eps) & (l2 >= -eps)
+        k, l0, l1, l2 = k[inside], l0[inside], l1[inside], l2[inside]
+        pix = j[inside] * width + i[inside]
+        vert = tri[k]
+        col = (l0[:, None] * flat_col[vert[:, 0]] + l1[:, None] * flat_col[vert[:, 1]]
+               + l2[:, None] * flat_col[vert[:, 2]])
+        counts += np.bincount(pix, minlength=height * width)
+        for ch in range(n_ch):
+            sums[:, ch] += np.bincount(pix, weights=col[:, ch], minlength=height * width)
+    coverage = counts > 0
+    image = np.full((height * width, n_ch), np.nan, dtype=np.float32)
+    image[coverage] = sums[coverage] / counts[coverage, None]
+    return image.reshape(height, width, n_ch), coverage.reshape(height, width)
+
+
+def dual_view_idw(colours, u, v, *, valid, shape, k=8, radius=1.0, power=2.0):
+    """Inverse-distance weighting of the nearest camera samples.
+
+    Parameters
+    ----------
+    colours : (rows, cols, channel) ndarray
+    u, v : (rows, cols) ndarray
+        Dual coordinates of the camera pixel centres (dual pixels).
+    valid : (rows, cols) bool ndarray, keyword-only
+    shape : (int, int)
+        ``(height, width)`` of the dual grid.
+    k : int
+        Nearest samples considered per dual pixel.
+    radius : float
+        Only samples within this distance (dual pixels) contribute.
+    power : float
+        Weight ``1 / distance ** power`` (a sample exactly at the centre wins).
+
+    Returns
+    -------
+    image : (height, width, channel) float32 ndarray
+    coverage : (height, width) bool ndarray
+    """
+    height, width = shape
+    n_ch = colours.shape[2]
+    ok = valid & np.isfinite(u) & np.isfinite(v)
+    points = np.column_stack([u[ok], v[ok]]).astype(np.float64)
+    samples = colours[ok].astype(np.float64)
+    image = np.full((height * width, n_ch), np.nan, dtype=np.float32)
+    coverage = np.zeros(height * width, dtype=bool)
+    if len(points):
+        jj, ii = np.mgrid[0:height, 0:width]
+        centres = np.column_stack([ii.ravel(), jj.ravel()]).astype(np.float64)
+        dist, idx = cKDTree(points).query(centres, k=k, distance_upper_bound=radius)
+        dist, idx = dist.reshape(len(centres), -1), idx.reshape(len(centres), -1)
+        found = np.isfinite(dist)
+        weight = np.where(found, 1.0 / np.maximum(dist, 1e-9) ** power, 0.0)
+        wsum = weight.sum(axis=1)
+        coverage = wsum > 0
+        safe_idx = np.where(found, idx, 0)
+        acc = np.einsum("pk,pkc->pc", weight, samples[safe_idx])
+        image[coverage] = acc[coverage] / wsum[coverage, None]
+    return image.reshape(height, width, n_ch), coverage.reshape(height, width)
+
+
+#: dual-view resamplers, name -> function(colours, u, v, *, valid, shape, **params)
+DUAL_VIEW_METHODS = {
+    "mesh": dual_view_mesh,
+    "idw": dual_view_idw,
+}
+
+
+def resample_dual_view(colours, u, v, *, shape, valid=None, method="mesh", **params):
+    """Resample camera colours into the dual grid with a method of `DUAL_VIEW_METHODS`.
+
+    Parameters
+    ----------
+    colours : (rows, cols, channel) ndarray
+        Linear camera colours; non-finite colours count as invalid.
+    u, v : (rows, cols) ndarray
+        Dual coordinates (dual pixels; centre of dual column ``i`` is ``u = i``).
+    shape : (int, int), keyword-only
+        ``(height, width)`` of the dual grid.
+    valid : (rows, cols) bool ndarray, optional
+        Default: finite ``u``, ``v``.
+    method : str
+        Key of `DUAL_VIEW_METHODS`.
+    **params
+        Method options (``max_edge`` for mesh; ``k``, ``radius``, ``power`` for idw).
+
+    Returns
+    -------
+    image : (height, width, channel) float32 ndarray
+        NaN = hole.
+    coverage : (height, width) bool ndarray
+    """
+    colours = np.asarray(colours)
+    if colours.ndim != 3:
+        raise ValueError(f"colours: expected (rows, cols, channel), got shape {colours.shape}")
+    u, v = np.asarray(u), np.asarray(v)
+    if u.shape != colours.shape[:2] or v.shape != colours.shape[:2]:
+        raise ValueError(f"u/v: shapes {u.shape}, {v.shape} differ from colours {colours.shape[:2]}")
+    if method not in DUAL_VIEW_METHODS:
+        raise ValueError(f"method: unknown {method!r}; choose from {sorted(DUAL_VIEW_METHODS)}")
+    height, width = (int(s) for s in shape)
+    if height < 1 or width < 1:
+        raise ValueError(f"shape: must be positive, got {shape}")
+    ok = np.isfinite(u) & np.isfinite(v) & np.all(np.isfinite(colours), axis=2)
+    if valid is not None:
+        valid = np.asarray(valid, dtype=bool)
+        if valid.shape != u.shape:
+            raise ValueError(f"valid: shape {valid.shape} differs from u {u.shape}")
+        ok &= valid
+    return DUAL_VIEW_METHODS[method](colours, u, v, valid=ok, shape=(height, width), **params)
+
+
+def camera_colours(shadow_time, *, reference=None, sweeps=("u", "v")):
+    """Camera colours to resample: the reference frame, else the mean lit image.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        The ``shadow_time`` dataset; its ``lit_image (sweep, row, col, channel)``
+        is used when `reference` is None.
+    reference : (rows, cols, channel) array_like, optional
+        Unshadowed reference frame (linear).
+    sweeps : sequence of str
+        Scene sweeps whose lit images are averaged (NaN-aware).
+
+    Returns
+    -------
+    (rows, cols, channel) float32 ndarray
+    """
+    if reference is not None:
+        ref = np.asarray(reference, dtype=np.float32)
+        if ref.ndim != 3:
+            raise ValueError(f"reference: expected (rows, cols, channel), got shape {ref.shape}")
+        return ref
+    if "lit_image" not in shadow_time:
+        raise ValueError("shadow_time: no 'lit_image' variable and no reference frame given")
+    present = [s for s in sweeps if s in shadow_time["sweep"].values]
+    if not present:
+        raise ValueError(f"shadow_time: none of the sweeps {list(sweeps)} is present")
+    lit = shadow_time["lit_image"].sel(sweep=present).transpose("sweep", "row", "col", "channel")
+    with np.errstate(invalid="ignore"):
+        stack = np.asarray(lit.values, dtype=np.float32)
+        counts = np.sum(np.isfinite(stack), axis=0)
+        mean = np.where(counts > 0, np.nansum(stack, axis=0) / np.maximum(counts, 1), np.nan)
+    return mean.astype(np.float32)
+
+
+def dual_view_dataset(image, coverage, *, method, params=None, channels=("R", "G", "B")):
+    """Assemble the ``dual_view`` Dataset of docs/architecture.md.
+
+    Parameters
+    ----------
+    image : (height, width, channel) ndarray
+    coverage : (height, width) bool ndarray
+    method : str, keyword-only
+        Resampling method (stored as attr ``resampling``).
+    params : mapping, optional
+        Method options (stored as JSON attr ``resampling_params``).
+    channels : sequence of str
+
+    Returns
+    -------
+    xarray.Dataset
+        ``dual_view (v, u, channel)`` float32 and ``coverage (v, u)`` bool.
+    """
+    height, width, n_ch = image.shape
+    channels = list(channels)[:n_ch] if len(channels) >= n_ch else [str(c) for c in range(n_ch)]
+    ds = xr.Dataset(
+        {
+            "dual_view": (("v", "u", "channel"), np.asarray(image, dtype=np.float32), {
+                "units": "1", "long_name": "dual (shadow-camera) view, linear camera units"}),
+            "coverage": (("v", "u"), np.asarray(coverage, dtype=bool), {
+                "long_name": "dual pixel received camera samples"}),
+        },
+        coords={
+            "v": ("v", np.arange(height), {"units": "dual_pixel", "long_name": "dual row"}),
+            "u": ("u", np.arange(width), {"units": "dual_pixel", "long_name": "dual column"}),
+            "channel": channels,
+        },
+    )
+    ds.attrs.update(resampling=method, resampling_params=json.dumps(dict(params or {})))
+    return ds
