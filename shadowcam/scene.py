@@ -1,0 +1,756 @@
+"""Scene description for synthetic lab captures: geometry, materials, lights, cameras, wire sweeps.
+
+Conventions are those of the shared development data (``/work/shared/data/README.md`` 1.3):
+right-handed world, +y up; camera ``X_cam = R (X_world - centre)`` with camera axes x right,
+y down, z forward; pinhole projection in *pixel-edge* coordinates, so pixel (row r, col c)
+has its centre at ``(x, y) = (c + 0.5, r + 0.5)``.
+
+Offers
+------
+Texture, Material : procedural albedo (checker, discs, bricks) and a Blinn-Phong specular term.
+Sphere, Box, GroundPlane, BackPlane : scene objects (box yawed about +y; ground infinite;
+    the finite back plane carries 2-D plane coordinates (x, y) and is the calibration plane).
+PointLight, DistantLight, AreaLight : lights; ``light_samples`` gives their stratified samples.
+PinholeCamera, OrthographicCamera : cameras; ``look_at_camera`` builds a pinhole.
+camera_rays, project : pixel-edge coordinates <-> world rays / points.
+MaskPlane, WireSweep : the mask plane and the wire sweeps u, v (README 1.3).
+make_mask_plane, make_wire_sweeps, dual_camera : build them from a light and an aim point.
+wire_shadow_time : analytic time at which a sweep's wire centre line shadows points.
+Scene, make_scene, calibration_scene, SCENES : a whole scene; presets by name.
+texture_albedo : evaluate a texture at 2-D texture coordinates.
+"""
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+UP = (0.0, 1.0, 0.0)
+
+
+def _vec(value, name, size=3):
+    arr = np.asarray(value, dtype=np.float64)
+    if arr.shape != (size,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}: expected {size} finite numbers, got {value!r}")
+    return arr
+
+
+def _unit(value, name):
+    arr = _vec(value, name)
+    norm = np.linalg.norm(arr)
+    if norm == 0:
+        raise ValueError(f"{name}: must not be the zero vector")
+    return arr / norm
+
+
+def _positive(value, name):
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(f"{name}: must be a positive number, got {value!r}")
+    return float(value)
+
+
+def _set(obj, **values):
+    for key, value in values.items():
+        object.__setattr__(obj, key, value)
+
+
+def yaw_matrix(yaw_deg):
+    """Return the (3, 3) rotation about +y by `yaw_deg` degrees (local -> world)."""
+    a = math.radians(yaw_deg)
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+# --------------------------------------------------------------------------- materials
+
+TEXTURE_KINDS = ("checker", "discs", "bricks")
+
+
+@dataclass(frozen=True, eq=False)
+class Texture:
+    """Procedural albedo on 2-D texture coordinates (scene units).
+
+    Parameters
+    ----------
+    kind : {"checker", "discs", "bricks"}
+    colors : (K, 3) array_like
+        Linear albedos: checker uses 2, discs uses background + K-1 disc colours,
+        bricks uses brick colour(s) then mortar as the last entry.
+    scale : float
+        Checker square / disc spacing / brick height, in scene units.
+    seed : int
+        Seeds disc placement and per-brick colour variation.
+    """
+
+    kind: str
+    colors: np.ndarray
+    scale: float
+    seed: int = 0
+
+    def __post_init__(self):
+        if self.kind not in TEXTURE_KINDS:
+            raise ValueError(f"kind: must be one of {TEXTURE_KINDS}, got {self.kind!r}")
+        colors = np.asarray(self.colors, dtype=np.float64)
+        if colors.ndim != 2 or colors.shape[1] != 3 or colors.shape[0] < 2:
+            raise ValueError(f"colors: expected (K>=2, 3) albedos, got shape {colors.shape}")
+        _set(self, colors=colors, scale=_positive(self.scale, "scale"))
+
+
+def texture_albedo(texture, coords):
+    """Evaluate `texture` at texture coordinates.
+
+    Parameters
+    ----------
+    texture : Texture
+    coords : (N, 2) ndarray
+        Texture coordinates in scene units.
+
+    Returns
+    -------
+    (N, 3) float64 ndarray
+        Linear albedo.
+    """
+    coords = np.asarray(coords, dtype=np.float64)
+    if coords.ndim != 2 or coords.shape[1] != 2:
+        raise ValueError(f"coords: expected (N, 2), got {coords.shape}")
+    colors = texture.colors
+    s = coords / texture.scale
+    if texture.kind == "checker":
+        parity = (np.floor(s[:, 0]).astype(np.int64) + np.floor(s[:, 1]).astype(np.int64)) & 1
+        return colors[parity]
+    if texture.kind == "bricks":
+        row = np.floor(s[:, 1]).astype(np.int64)
+        x = s[:, 0] / 2.0 + 0.5 * (row & 1)  # bricks twice as long as high, offset rows
+        col = np.floor(x).astype(np.int64)
+        mortar = (s[:, 1] - row < 0.08) | (x - col < 0.04)
+        n_brick = len(colors) - 1
+        rng = np.random.default_rng(texture.seed)
+        shade = rng.uniform(0.85, 1.15, size=(64, 64))
+        pick = ((row * 7 + col * 13) % n_brick + n_brick) % n_brick
+        out = colors[pick] * shade[row % 64, col % 64][:, None]
+        out[mortar] = colors[-1]
+        return np.clip(out, 0.0, 1.0)
+    # discs: one disc (radius 0.3 scale) jittered in every cell of a 1-scale grid
+    cell = np.floor(s).astype(np.int64)
+    rng = np.random.default_rng(texture.seed)
+    jitter = rng.uniform(-0.15, 0.15, size=(32, 32, 2))
+    radius = rng.uniform(0.2, 0.38, size=(32, 32))
+    pick = rng.integers(1, len(colors), size=(32, 32))
+    ci, cj = cell[:, 0] % 32, cell[:, 1] % 32
+    centre = cell + 0.5 + jitter[ci, cj]
+    inside = np.sum((s - centre) ** 2, axis=1) < radius[ci, cj] ** 2
+    out = np.repeat(colors[:1], len(s), axis=0)
+    out[inside] = colors[pick[ci, cj][inside]]
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Material:
+    """Surface reflectance: Lambertian albedo (or texture) plus a Blinn-Phong lobe.
+
+    The BRDF is ``albedo/pi + specular * (shininess + 8) / (8 pi) * (n.h)**shininess``;
+    it is symmetric in light and view directions (reciprocal).
+
+    Parameters
+    ----------
+    albedo : (3,) array_like
+        Linear diffuse albedo, used when `texture` is None.
+    texture : Texture, optional
+    specular : float
+        Weight of the Blinn-Phong lobe (0 = matte).
+    shininess : float
+        Blinn-Phong exponent.
+    """
+
+    albedo: np.ndarray = (0.5, 0.5, 0.5)
+    texture: Texture = None
+    specular: float = 0.0
+    shininess: float = 40.0
+
+    def __post_init__(self):
+        albedo = _vec(self.albedo, "albedo")
+        if np.any(albedo < 0) or np.any(albedo > 1):
+            raise ValueError(f"albedo: must lie in [0, 1], got {albedo}")
+        if not 0 <= self.specular < 1:
+            raise ValueError(f"specular: must be in [0, 1), got {self.specular}")
+        _set(self, albedo=albedo, shininess=_positive(self.shininess, "shininess"))
+
+
+# --------------------------------------------------------------------------- objects
+
+
+@dataclass(frozen=True, eq=False)
+class Sphere:
+    """Sphere; texture coordinates are (azimuth, polar angle) times the radius."""
+
+    center: np.ndarray
+    radius: float
+    material: Material = field(default_factory=Material)
+
+    def __post_init__(self):
+        _set(self, center=_vec(self.center, "center"), radius=_positive(self.radius, "radius"))
+
+
+@dataclass(frozen=True, eq=False)
+class Box:
+    """Box of `half_extents` (x, y, z) about `center`, yawed by `yaw_deg` about +y.
+
+    Texture coordinates are (local x + local z, local y).
+    """
+
+    center: np.ndarray
+    half_extents: np.ndarray
+    yaw_deg: float = 0.0
+    material: Material = field(default_factory=Material)
+
+    def __post_init__(self):
+        half = _vec(self.half_extents, "half_extents")
+        if np.any(half <= 0):
+            raise ValueError(f"half_extents: must be positive, got {half}")
+        _set(self, center=_vec(self.center, "center"), half_extents=half,
+             yaw_deg=float(self.yaw_deg))
+
+    @property
+    def rotation(self):
+        """(3, 3) local -> world rotation."""
+        return yaw_matrix(self.yaw_deg)
+
+
+@dataclass(frozen=True, eq=False)
+class GroundPlane:
+    """Infinite horizontal plane ``y = height`` facing +y; texture coordinates (x, z)."""
+
+    height: float
+    material: Material = field(default_factory=Material)
+
+    def __post_init__(self):
+        if not np.isfinite(self.height):
+            raise ValueError(f"height: must be finite, got {self.height}")
+        _set(self, height=float(self.height))
+
+
+@dataclass(frozen=True, eq=False)
+class BackPlane:
+    """Finite vertical rectangle, yawed about +y, facing ``normal = yaw(+z)``.
+
+    Its plane coordinates are ``x = (X - center).axis_x``, ``y = (X - center).axis_y``
+    with ``axis_x = yaw(+x)``, ``axis_y = +y`` (scene units); it is the calibration plane.
+    """
+
+    center: np.ndarray
+    width: float
+    height: float
+    yaw_deg: float = 0.0
+    material: Material = field(default_factory=Material)
+
+    def __post_init__(self):
+        _set(self, center=_vec(self.center, "center"), width=_positive(self.width, "width"),
+             height=_positive(self.height, "height"), yaw_deg=float(self.yaw_deg))
+
+    @property
+    def axis_x(self):
+        return yaw_matrix(self.yaw_deg)[:, 0]
+
+    @property
+    def axis_y(self):
+        return np.array(UP)
+
+    @property
+    def normal(self):
+        return yaw_matrix(self.yaw_deg)[:, 2]
+
+    def plane_coords(self, points):
+        """Return (N, 2) plane coordinates (x, y) of (N, 3) world `points`."""
+        rel = np.asarray(points, dtype=np.float64) - self.center
+        return np.stack([rel @ self.axis_x, rel @ self.axis_y], axis=-1)
+
+
+# --------------------------------------------------------------------------- lights
+
+
+@dataclass(frozen=True, eq=False)
+class PointLight:
+    """Isotropic point light; `intensity` (3,) is radiant intensity per RGB channel (W/sr)."""
+
+    position: np.ndarray
+    intensity: np.ndarray = (0.02, 0.02, 0.02)
+
+    def __post_init__(self):
+        _set(self, position=_vec(self.position, "position"),
+             intensity=_vec(self.intensity, "intensity"))
+
+    @property
+    def center(self):
+        return self.position
+
+
+@dataclass(frozen=True, eq=False)
+class DistantLight:
+    """Directional light; `direction` points from the scene *toward* the light,
+    `irradiance` (3,) is the irradiance on a surface facing it."""
+
+    direction: np.ndarray
+    irradiance: np.ndarray = (1.0, 1.0, 1.0)
+
+    def __post_init__(self):
+        _set(self, direction=_unit(self.direction, "direction"),
+             irradiance=_vec(self.irradiance, "irradiance"))
+
+
+@dataclass(frozen=True, eq=False)
+class AreaLight:
+    """Small isotropic area light (disc or square) perpendicular to `normal`.
+
+    Sampled with a fixed stratified pattern of ``samples_per_side**2`` point lights that
+    share `intensity` (3,) (total radiant intensity, W/sr).
+    """
+
+    position: np.ndarray
+    normal: np.ndarray
+    size: float
+    shape: str = "disc"
+    intensity: np.ndarray = (0.02, 0.02, 0.02)
+    samples_per_side: int = 4
+
+    def __post_init__(self):
+        if self.shape not in ("disc", "square"):
+            raise ValueError(f"shape: must be 'disc' or 'square', got {self.shape!r}")
+        if int(self.samples_per_side) < 1:
+            raise ValueError(f"samples_per_side: must be >= 1, got {self.samples_per_side}")
+        _set(self, position=_vec(self.position, "position"),
+             normal=_unit(self.normal, "normal"), size=_positive(self.size, "size"),
+             intensity=_vec(self.intensity, "intensity"),
+             samples_per_side=int(self.samples_per_side))
+
+    @property
+    def center(self):
+        return self.position
+
+
+def _frame(normal, up=UP):
+    """Return unit (e_u, e_v) with e_u = normalize(n x up), e_v = n x e_u."""
+    e_u = np.cross(normal, np.asarray(up, dtype=np.float64))
+    norm = np.linalg.norm(e_u)
+    if norm < 1e-9:
+        raise ValueError("up: must not be parallel to the aim direction")
+    e_u = e_u / norm
+    return e_u, np.cross(normal, e_u)
+
+
+def light_samples(light):
+    """Return the light's samples.
+
+    Parameters
+    ----------
+    light : PointLight, DistantLight or AreaLight
+
+    Returns
+    -------
+    positions : (S, 3) ndarray or None
+        Sample positions (None for a distant light).
+    directions : (S, 3) ndarray or None
+        Unit directions toward the light (distant light only, else None).
+    weights : (S, 3) ndarray
+        Intensity (point/area, W/sr) or irradiance (distant) of each sample.
+    """
+    if isinstance(light, PointLight):
+        return light.position[None], None, light.intensity[None]
+    if isinstance(light, DistantLight):
+        return None, light.direction[None], light.irradiance[None]
+    if isinstance(light, AreaLight):
+        k = light.samples_per_side
+        a, b = np.meshgrid((np.arange(k) + 0.5) / k, (np.arange(k) + 0.5) / k, indexing="ij")
+        a, b = a.ravel(), b.ravel()
+        e1, e2 = _frame(light.normal, UP if abs(light.normal[1]) < 0.99 else (1, 0, 0))
+        if light.shape == "disc":  # equal-area stratified polar mapping
+            r = 0.5 * light.size * np.sqrt(a)
+            phi = 2 * np.pi * b
+            x, y = r * np.cos(phi), r * np.sin(phi)
+        else:
+            x, y = (a - 0.5) * light.size, (b - 0.5) * light.size
+        pos = light.position + x[:, None] * e1 + y[:, None] * e2
+        weights = np.repeat(light.intensity[None] / len(pos), len(pos), axis=0)
+        return pos, None, weights
+    raise ValueError(f"light: unsupported light type {type(light).__name__}")
+
+
+# --------------------------------------------------------------------------- cameras
+
+
+@dataclass(frozen=True, eq=False)
+class PinholeCamera:
+    """Pinhole: ``X_cam = R (X - center)``, ``x = K[0,0] X/Z + K[0,2]`` (pixel-edge coords)."""
+
+    K: np.ndarray
+    R: np.ndarray
+    center: np.ndarray
+    width: int
+    height: int
+
+    def __post_init__(self):
+        K = np.asarray(self.K, dtype=np.float64)
+        R = np.asarray(self.R, dtype=np.float64)
+        if K.shape != (3, 3) or R.shape != (3, 3):
+            raise ValueError("K, R: expected (3, 3) matrices")
+        if not np.allclose(R @ R.T, np.eye(3), atol=1e-9):
+            raise ValueError("R: must be a rotation matrix")
+        if int(self.width) < 1 or int(self.height) < 1:
+            raise ValueError(f"width, height: must be positive, got {self.width}, {self.height}")
+        _set(self, K=K, R=R, center=_vec(self.center, "center"),
+             width=int(self.width), height=int(self.height))
+
+
+@dataclass(frozen=True, eq=False)
+class OrthographicCamera:
+    """Orthographic camera looking along ``R[2]``; pixel-edge coords (x, y) map to the
+    ray origin ``center + (x - width/2) pixel_size R[0] + (y - height/2) pixel_size R[1]``."""
+
+    R: np.ndarray
+    center: np.ndarray
+    pixel_size: float
+    width: int
+    height: int
+
+    def __post_init__(self):
+        R = np.asarray(self.R, dtype=np.float64)
+        if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-9):
+            raise ValueError("R: must be a (3, 3) rotation matrix")
+        _set(self, R=R, center=_vec(self.center, "center"),
+             pixel_size=_positive(self.pixel_size, "pixel_size"),
+             width=int(self.width), height=int(self.height))
+
+
+def look_at_camera(center, target, *, fov_x_deg, width, height, up=UP):
+    """Return a PinholeCamera at `center` looking at `target` (principal point at the centre)."""
+    center = _vec(center, "center")
+    forward = _unit(_vec(target, "target") - center, "target - center")
+    right = np.cross(forward, np.asarray(up, dtype=np.float64))
+    if np.linalg.norm(right) < 1e-9:
+        raise ValueError("up: must not be parallel to the viewing direction")
+    right /= np.linalg.norm(right)
+    down = np.cross(forward, right)
+    if not 0 < fov_x_deg < 180:
+        raise ValueError(f"fov_x_deg: must be in (0, 180), got {fov_x_deg}")
+    focal = width / 2.0 / math.tan(math.radians(fov_x_deg) / 2.0)
+    K = np.array([[focal, 0.0, width / 2.0], [0.0, focal, height / 2.0], [0.0, 0.0, 1.0]])
+    return PinholeCamera(K=K, R=np.stack([right, down, forward]), center=center,
+                         width=width, height=height)
+
+
+def camera_rays(camera, x, y):
+    """Rays through pixel-edge image coordinates.
+
+    Parameters
+    ----------
+    camera : PinholeCamera or OrthographicCamera
+    x, y : (N,) ndarray
+        Pixel-edge coordinates (column, row): pixel (row r, col c) centre is (c + 0.5, r + 0.5).
+
+    Returns
+    -------
+    origins, directions : (N, 3) ndarray
+        Ray origins and unit directions in world coordinates.
+    """
+    x = np.asarray(x, dtype=np.float64).ravel()
+    y = np.asarray(y, dtype=np.float64).ravel()
+    if x.shape != y.shape:
+        raise ValueError(f"x, y: shapes differ ({x.shape} vs {y.shape})")
+    if isinstance(camera, PinholeCamera):
+        pix = np.stack([x, y, np.ones_like(x)], axis=-1)
+        d = pix @ np.linalg.inv(camera.K).T @ camera.R  # R^T K^-1 pix, row-wise
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        return np.broadcast_to(camera.center, d.shape).copy(), d
+    if isinstance(camera, OrthographicCamera):
+        s = camera.pixel_size
+        o = (camera.center + ((x - camera.width / 2.0) * s)[:, None] * camera.R[0]
+             + ((y - camera.height / 2.0) * s)[:, None] * camera.R[1])
+        return o, np.broadcast_to(camera.R[2], o.shape).copy()
+    raise ValueError(f"camera: unsupported camera type {type(camera).__name__}")
+
+
+def project(camera, points):
+    """Project (N, 3) world `points`; return (N, 2) pixel-edge (x, y) and (N,) depth z_cam."""
+    points = np.asarray(points, dtype=np.float64)
+    if isinstance(camera, PinholeCamera):
+        cam = (points - camera.center) @ camera.R.T
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xy = cam[:, :2] / cam[:, 2:3]
+        xy = xy * np.diag(camera.K)[:2] + camera.K[:2, 2]
+        return xy, cam[:, 2]
+    if isinstance(camera, OrthographicCamera):
+        cam = (points - camera.center) @ camera.R.T
+        xy = cam[:, :2] / camera.pixel_size + np.array([camera.width, camera.height]) / 2.0
+        return xy, cam[:, 2]
+    raise ValueError(f"camera: unsupported camera type {type(camera).__name__}")
+
+
+# --------------------------------------------------------------------------- mask plane, wire
+
+
+@dataclass(frozen=True, eq=False)
+class MaskPlane:
+    """The plane the wire moves in (README 1.3).
+
+    Attributes
+    ----------
+    origin : (3,) M0 = L + f n (point light) or a point on the light side of the scene (distant).
+    normal : (3,) n, the light's aim direction (from the light toward the scene).
+    e_u, e_v : (3,) e_u = normalize(n x up), e_v = n x e_u.
+    delta : frame step in the plane (scene units) = one dual pixel.
+    n_u, n_v : dual grid size (frames per sweep).
+    focal : f, light-to-plane distance (point light); None for a distant light.
+    """
+
+    origin: np.ndarray
+    normal: np.ndarray
+    e_u: np.ndarray
+    e_v: np.ndarray
+    delta: float
+    n_u: int
+    n_v: int
+    focal: float = None
+
+
+@dataclass(frozen=True, eq=False)
+class WireSweep:
+    """One wire sweep: centre line ``p(t) = p0 + t velocity``, axis `direction`, t = 0..frames-1."""
+
+    axis: str
+    p0: np.ndarray
+    velocity: np.ndarray
+    direction: np.ndarray
+    frames: int
+    radius: float
+    length: float
+
+
+def make_mask_plane(light, *, target, frames, f=0.045, fov_deg=44.0, extent=None, up=UP):
+    """Mask plane of a light aimed at `target`.
+
+    Parameters
+    ----------
+    light : PointLight, AreaLight or DistantLight
+    target : (3,) array_like
+        Point the light is aimed at (point/area) or the centre of the swept region (distant).
+    frames : int
+        Frames per sweep = dual grid size N_u = N_v.
+    f : float
+        Light-to-mask-plane distance (point/area light) or target-to-plane distance
+        toward the light (distant light).
+    fov_deg : float
+        Dual field of view (point/area light): ``frames delta = 2 f tan(fov/2)``.
+    extent : float, optional
+        Width ``frames delta`` of the swept region (distant light; required there).
+    up : (3,) array_like
+
+    Returns
+    -------
+    MaskPlane
+    """
+    frames = int(frames)
+    if frames < 2:
+        raise ValueError(f"frames: must be >= 2, got {frames}")
+    f = _positive(f, "f")
+    target = _vec(target, "target")
+    if isinstance(light, DistantLight):
+        if extent is None:
+            raise ValueError("extent: required for a distant light")
+        n = -light.direction
+        delta = _positive(extent, "extent") / frames
+        origin = target - f * n
+        focal = None
+    else:
+        n = _unit(target - light.center, "target - light position")
+        if not 0 < fov_deg < 180:
+            raise ValueError(f"fov_deg: must be in (0, 180), got {fov_deg}")
+        delta = 2 * f * math.tan(math.radians(fov_deg) / 2) / frames
+        origin = light.center + f * n
+        focal = f
+    e_u, e_v = _frame(n, up)
+    return MaskPlane(origin=origin, normal=n, e_u=e_u, e_v=e_v, delta=delta,
+                     n_u=frames, n_v=frames, focal=focal)
+
+
+def make_wire_sweeps(mask, *, radius=None, length=None):
+    """The two perpendicular sweeps of README 1.3.
+
+    Sweep u: wire parallel to e_v, moving ``delta e_u`` per frame; sweep v: parallel to e_u,
+    moving ``delta e_v``; frame (N-1)/2 passes through M0.
+
+    Parameters
+    ----------
+    mask : MaskPlane
+    radius : float, optional
+        Wire radius; default `delta` (a dip about two frames wide).
+    length : float, optional
+        Wire length; default 1.5 x the dual field diagonal (covers the whole field).
+
+    Returns
+    -------
+    dict of str to WireSweep
+        Keys ``"u"`` and ``"v"``.
+    """
+    radius = mask.delta if radius is None else _positive(radius, "radius")
+    if length is None:
+        length = 1.5 * math.hypot(mask.n_u, mask.n_v) * mask.delta
+    length = _positive(length, "length")
+    sweeps = {}
+    for axis, e_move, e_wire, n in (("u", mask.e_u, mask.e_v, mask.n_u),
+                                    ("v", mask.e_v, mask.e_u, mask.n_v)):
+        velocity = mask.delta * e_move
+        sweeps[axis] = WireSweep(axis=axis, p0=mask.origin - (n - 1) / 2.0 * velocity,
+                                 velocity=velocity, direction=e_wire.copy(), frames=n,
+                                 radius=radius, length=length)
+    return sweeps
+
+
+def dual_camera(mask, light):
+    """The dual (shadow) camera: dual pixel (row j, col i) centre <-> u = i, v = j.
+
+    A pinhole at the light centre with ``R`` rows (e_u, e_v, n) and
+    ``K = [[f/delta, 0, N_u/2], [0, f/delta, N_v/2], [0, 0, 1]]`` for a point or area light;
+    an orthographic camera on the mask plane looking along n for a distant light.
+    """
+    R = np.stack([mask.e_u, mask.e_v, mask.normal])
+    if isinstance(light, DistantLight):
+        return OrthographicCamera(R=R, center=mask.origin, pixel_size=mask.delta,
+                                  width=mask.n_u, height=mask.n_v)
+    k = mask.focal / mask.delta
+    K = np.array([[k, 0.0, mask.n_u / 2.0], [0.0, k, mask.n_v / 2.0], [0.0, 0.0, 1.0]])
+    return PinholeCamera(K=K, R=R, center=light.center, width=mask.n_u, height=mask.n_v)
+
+
+def wire_shadow_time(points, sweep, light):
+    """Analytic time at which the wire centre line shadows each point (README 1.3).
+
+    ``t = -(P - L).(d x (p0 - L)) / ((P - L).(d x v))`` for a light centre L; for a
+    distant light (toward-light direction l) ``t = (P - p0).(d x l) / (v.(d x l))``.
+
+    Parameters
+    ----------
+    points : (N, 3) ndarray
+    sweep : WireSweep
+    light : PointLight, AreaLight or DistantLight
+        Area lights use their centre.
+
+    Returns
+    -------
+    (N,) float64 ndarray
+        Fractional frame (not restricted to [0, frames-1]; NaN where undefined).
+    """
+    points = np.asarray(points, dtype=np.float64)
+    d, v = sweep.direction, sweep.velocity
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if isinstance(light, DistantLight):
+            w = np.cross(d, light.direction)
+            return (points - sweep.p0) @ w / (v @ w)
+        rel = points - light.center
+        return -(rel @ np.cross(d, sweep.p0 - light.center)) / (rel @ np.cross(d, v))
+
+
+# --------------------------------------------------------------------------- scenes
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A renderable lab scene: objects, one light, a camera, the mask plane and sweeps."""
+
+    name: str
+    objects: tuple
+    light: object
+    camera: PinholeCamera
+    mask: MaskPlane
+    sweeps: dict
+    seed: int = 0
+
+    @property
+    def back_plane(self):
+        """The scene's calibration plane (first BackPlane), or None."""
+        return next((o for o in self.objects if isinstance(o, BackPlane)), None)
+
+
+def calibration_scene(scene):
+    """Return `scene` holding only its back plane (same light, camera and sweeps)."""
+    plane = scene.back_plane
+    if plane is None:
+        raise ValueError("scene: has no BackPlane to calibrate with")
+    return replace(scene, name=f"{scene.name}_calibration", objects=(plane,))
+
+
+def _tabletop(*, seed, height, width, frames, light_kind):
+    rng = np.random.default_rng([seed, 1234])
+    jit = lambda s: rng.uniform(-s, s)  # noqa: E731
+    ground_y = -0.05
+    tex_sphere = Texture("checker", [[0.15, 0.25, 0.6], [0.85, 0.8, 0.65]], 0.012, seed)
+    tex_ground = Texture("bricks", [[0.55, 0.3, 0.22], [0.5, 0.35, 0.25], [0.62, 0.6, 0.55]],
+                         0.012, seed)
+    tex_back = Texture("discs", [[0.75, 0.75, 0.72], [0.8, 0.2, 0.2], [0.2, 0.55, 0.25],
+                                 [0.2, 0.3, 0.75], [0.85, 0.7, 0.15]], 0.05, seed)
+    shade = lambda c: np.clip(np.asarray(c) * rng.uniform(0.9, 1.1, 3), 0, 1)  # noqa: E731
+    radii = (0.034, 0.022, 0.013)
+    xz = ((-0.06, -0.04), (0.015, 0.04), (0.075, 0.0))
+    mats = (Material(texture=tex_sphere, specular=0.04),
+            Material(albedo=shade([0.8, 0.5, 0.25]), specular=0.04),
+            Material(albedo=shade([0.35, 0.7, 0.4]), specular=0.04))
+    objects = [Sphere((x + jit(0.006), ground_y + r, z + jit(0.006)), r, m)
+               for r, (x, z), m in zip(radii, xz, mats)]
+    objects.append(Box((0.02 + jit(0.005), ground_y + 0.03, -0.085 + jit(0.005)),
+                       (0.018, 0.03, 0.015), 35.0 + jit(5.0),
+                       Material(albedo=shade([0.55, 0.58, 0.7]))))
+    objects.append(GroundPlane(ground_y, Material(texture=tex_ground)))
+    objects.append(BackPlane((0.0, 0.23, -0.13), 1.0, 0.56, 12.0 + jit(2.0),
+                             Material(texture=tex_back)))
+    camera = look_at_camera((0.03, 0.085, 0.3), (0.0, -0.02, -0.03), fov_x_deg=42.0,
+                            width=width, height=height)
+    aim = np.array([-0.005, -0.02, -0.02])
+    light_pos = camera.center + np.array([-0.09, -0.045, 0.035])
+    intensity = (0.02, 0.02, 0.02)
+    if light_kind == "point":
+        light = PointLight(light_pos, intensity)
+    elif light_kind == "area":
+        light = AreaLight(light_pos, aim - light_pos, 0.006, "disc", intensity, 4)
+    elif light_kind == "distant":
+        light = DistantLight(light_pos - aim, (2.0, 2.0, 2.0))
+    else:
+        raise ValueError(f"light_kind: must be 'point', 'area' or 'distant', got {light_kind!r}")
+    if light_kind == "distant":  # plane between the scene and the light, clear of objects
+        mask = make_mask_plane(light, target=aim, frames=frames, f=0.2, extent=0.26)
+    else:
+        mask = make_mask_plane(light, target=aim, frames=frames, f=0.045, fov_deg=44.0)
+    return objects, light, camera, mask
+
+
+#: preset scene name -> builder(seed, height, width, frames, light_kind)
+SCENES = {"tabletop": _tabletop}
+
+
+def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="point"):
+    """Build a preset scene.
+
+    Parameters
+    ----------
+    name : str
+        Preset name, a key of ``SCENES`` (``"tabletop"``: three spheres and a yawed box on a
+        brick-textured ground in front of a disc-textured back plane, light beside the camera).
+    seed : int
+        Varies texture layout, colours and object placement slightly.
+    height, width : int
+        Camera image size (rows, cols).
+    frames : int
+        Frames per sweep (= dual grid size).
+    light_kind : {"point", "area", "distant"}
+
+    Returns
+    -------
+    Scene
+    """
+    if name not in SCENES:
+        raise ValueError(f"name: unknown scene {name!r}; choose one of {sorted(SCENES)}")
+    for key, value in (("height", height), ("width", width)):
+        if int(value) < 2 or int(value) % 2:
+            raise ValueError(f"{key}: must be an even number >= 2, got {value}")
+    objects, light, camera, mask = SCENES[name](seed=int(seed), height=int(height),
+                                                width=int(width), frames=int(frames),
+                                                light_kind=light_kind)
+    return Scene(name=name, objects=tuple(objects), light=light, camera=camera, mask=mask,
+                 sweeps=make_wire_sweeps(mask), seed=int(seed))
