@@ -1,0 +1,187 @@
+"""Ground truth of synthetic captures in the standard form (docs/architecture.md).
+
+Standard form (an ``xarray.Dataset``):
+
+* ``(row, col)``: ``t_u``, ``t_v`` (shadow time in frames, NaN where not lit
+  or not swept), ``lit`` (bool);
+* ``(v, u, channel)``: ``reciprocal`` (linear render from the light = the dual view);
+* ``(v, u)``: ``dual_cam_visible`` (bool);
+
+plus whatever else the source has (``P``, ``reference_linear``, ...). Camera
+arrays are indexed at pixel centres; dual pixel (row j, col i) is ``u = i, v = j``.
+
+Supported formats (the manifest's ``ground_truth.format``):
+
+* ``shadowcam_nc`` -- the netCDF written by ``shadowcam render`` (already standard);
+* ``mitsuba_lab_npz`` -- ``gt.npz`` of the shared lab development data
+  (``shared/data/README.md`` section 1.5).
+
+Offers
+------
+GT_FORMATS : format name -> loader(path) -> Dataset.
+REQUIRED : standard variables and their dims.
+load_ground_truth : the standard GT Dataset of a manifest.
+mitsuba_lab_npz_to_dataset : convert the arrays of a lab ``gt.npz``.
+check_ground_truth : raise ValueError unless a Dataset is in standard form.
+"""
+
+import logging
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+log = logging.getLogger(__name__)
+
+#: standard variables and their dims
+REQUIRED = {
+    "t_u": ("row", "col"),
+    "t_v": ("row", "col"),
+    "lit": ("row", "col"),
+    "reciprocal": ("v", "u", "channel"),
+    "dual_cam_visible": ("v", "u"),
+}
+
+_CAM = ("row", "col")
+_DUAL = ("v", "u")
+# gt.npz key -> (dims, attrs); keys not listed here are skipped
+_LAB_NPZ_VARS = {
+    "t_u": (_CAM, {"units": "frame", "long_name": "analytic shadow time, sweep u (= dual u)"}),
+    "t_v": (_CAM, {"units": "frame", "long_name": "analytic shadow time, sweep v (= dual v)"}),
+    "t_u_all": (_CAM, {"units": "frame", "long_name": "t_u without lit / range restriction"}),
+    "t_v_all": (_CAM, {"units": "frame", "long_name": "t_v without lit / range restriction"}),
+    "valid_u": (_CAM, {"long_name": "isfinite(t_u)"}),
+    "valid_v": (_CAM, {"long_name": "isfinite(t_v)"}),
+    "xprime": (_CAM, {"units": "dual pixel", "long_name": "true dual coordinate u (= t_u)"}),
+    "yprime": (_CAM, {"units": "dual pixel", "long_name": "true dual coordinate v (= t_v)"}),
+    "lit": (_CAM, {"long_name": "faces light and camera, unoccluded from the light"}),
+    "hit": (_CAM, {"long_name": "pixel-centre ray hits geometry"}),
+    "depth": (_CAM, {"units": "scene unit", "long_name": "camera z of P"}),
+    "cos_L": (_CAM, {"units": "1", "long_name": "cosine normal / direction to light"}),
+    "cos_C": (_CAM, {"units": "1", "long_name": "cosine normal / direction to camera"}),
+    "dist_L": (_CAM, {"units": "scene unit", "long_name": "distance P to light"}),
+    "dist_C": (_CAM, {"units": "scene unit", "long_name": "distance P to camera centre"}),
+    "P": (_CAM + ("xyz",), {"units": "scene unit", "long_name": "world point at pixel centre"}),
+    "N": (_CAM + ("xyz",), {"long_name": "geometric normal"}),
+    "N_shading": (_CAM + ("xyz",), {"long_name": "shading normal"}),
+    "reference_linear": (_CAM + ("channel",), {"units": "radiance", "long_name": "linear render without the wire"}),
+    "reciprocal": (_DUAL + ("channel",), {"units": "radiance", "long_name": "reciprocal render (dual view)"}),
+    "dual_P": (_DUAL + ("xyz",), {"units": "scene unit", "long_name": "world point at dual pixel centre"}),
+    "dual_hit": (_DUAL, {"long_name": "dual pixel ray hits geometry"}),
+    "dual_cam_visible": (_DUAL, {"long_name": "dual point directly visible from the camera"}),
+    "dual_cam_xy": (_DUAL + ("cam_axis",), {"units": "camera pixel", "long_name": "camera (col, row) of dual point"}),
+}
+
+
+def check_ground_truth(dataset):
+    """Raise ValueError unless `dataset` has the standard variables with their dims."""
+    problems = [
+        f"{name} {dims}" for name, dims in REQUIRED.items()
+        if name not in dataset or tuple(dataset[name].dims) != dims
+    ]
+    if problems:
+        raise ValueError(f"ground truth lacks (or has wrong dims for): {', '.join(problems)}")
+    return dataset
+
+
+def mitsuba_lab_npz_to_dataset(arrays):
+    """Convert the arrays of a lab ``gt.npz`` into the standard GT Dataset.
+
+    Parameters
+    ----------
+    arrays : mapping of str to ndarray
+        E.g. ``numpy.load("gt.npz")``: camera arrays ``(H, W[, 3])`` indexed
+        ``[row, col]``, dual arrays ``(N_v, N_u[, k])`` indexed ``[v, u]``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Standard variables plus every known key (see ``_LAB_NPZ_VARS``), with
+        integer coords ``row``, ``col``, ``u``, ``v``, ``channel`` (R, G, B),
+        ``xyz`` and ``cam_axis`` (col, row).
+    """
+    missing = [k for k in REQUIRED if k not in arrays]
+    if missing:
+        raise ValueError(f"gt.npz arrays lack required keys {missing}")
+    data_vars = {}
+    for key, (dims, attrs) in _LAB_NPZ_VARS.items():
+        if key in arrays:
+            value = np.asarray(arrays[key])
+            if value.ndim != len(dims):
+                raise ValueError(f"gt.npz key {key!r} has shape {value.shape}, expected dims {dims}")
+            data_vars[key] = (dims, value, attrs)
+    skipped = sorted(set(arrays) - set(_LAB_NPZ_VARS))
+    if skipped:
+        log.debug("gt.npz keys not converted: %s", skipped)
+    height, width = np.shape(arrays["t_u"])
+    n_v, n_u = np.shape(arrays["dual_cam_visible"])
+    coords = {
+        "row": np.arange(height),
+        "col": np.arange(width),
+        "v": ("v", np.arange(n_v), {"long_name": "dual row (pixel-centre index)"}),
+        "u": ("u", np.arange(n_u), {"long_name": "dual column (pixel-centre index)"}),
+        "channel": np.array(["R", "G", "B"], dtype=object),
+        "xyz": np.array(["x", "y", "z"], dtype=object),
+        "cam_axis": np.array(["col", "row"], dtype=object),
+    }
+    dataset = xr.Dataset(data_vars, coords=coords)
+    for name in ("lit", "dual_cam_visible", "hit", "dual_hit", "valid_u", "valid_v"):
+        if name in dataset:
+            dataset[name] = dataset[name].astype(bool)
+    return check_ground_truth(dataset)
+
+
+def _load_shadowcam_nc(path):
+    with xr.open_dataset(path, engine="h5netcdf") as source:
+        dataset = source.load()
+    return dataset
+
+
+def _load_mitsuba_lab_npz(path):
+    with np.load(path) as arrays:
+        return mitsuba_lab_npz_to_dataset({k: arrays[k] for k in arrays.files})
+
+
+#: ground_truth.format -> loader(path) -> Dataset
+GT_FORMATS = {"shadowcam_nc": _load_shadowcam_nc, "mitsuba_lab_npz": _load_mitsuba_lab_npz}
+
+
+def load_ground_truth(manifest):
+    """Return a manifest's ground truth as the standard GT Dataset.
+
+    Parameters
+    ----------
+    manifest : dict or str or Path
+        From :func:`shadowcam.manifest.load_manifest`, or a manifest path. Its
+        ``ground_truth`` entry names the format and the file (relative to root).
+
+    Returns
+    -------
+    xarray.Dataset
+        In memory; attrs ``source_format``, ``source_file`` and ``source_sha256``.
+    """
+    from shadowcam.manifest import load_manifest, verify_checksums
+
+    if isinstance(manifest, (str, Path)):
+        manifest = load_manifest(manifest)
+    spec = manifest.get("ground_truth")
+    if not spec:
+        raise ValueError(f"manifest {manifest.get('manifest_path')} has no ground_truth entry (real captures have none)")
+    if spec["format"] not in GT_FORMATS:
+        raise ValueError(f"ground_truth.format {spec['format']!r} is not one of {sorted(GT_FORMATS)}")
+    root = Path(manifest.get("root") or Path(manifest["manifest_path"]).parent)
+    path = root / spec["file"]
+    if not path.is_file():
+        raise ValueError(f"ground truth file {path} (manifest {manifest.get('manifest_path')}) does not exist")
+    checksums = verify_checksums(manifest, ["ground_truth"]) if "ground_truth" in manifest.get("files", {}) else {}
+    try:
+        dataset = GT_FORMATS[spec["format"]](path)
+        check_ground_truth(dataset)
+    except ValueError as exc:
+        raise ValueError(f"ground truth {path} (format {spec['format']}): {exc}") from None
+    dataset.attrs.update(
+        source_format=spec["format"],
+        source_file=str(path),
+        source_sha256=next(iter(checksums.values()), ""),
+    )
+    return dataset
