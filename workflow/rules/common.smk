@@ -12,6 +12,7 @@
 # get_*                       input / params functions of the rules
 import glob
 import json
+import os
 from pathlib import Path
 
 import yaml
@@ -161,7 +162,7 @@ def get_raw_files(wildcards):
         pattern = (manifest.get("sweeps") or {}).get(wildcards.sweep, {}).get("files")
     if not pattern:
         raise ValueError(f"{manifest_path(ds)}: no files declared for sweep {wildcards.sweep!r}")
-    files = sorted(glob.glob(str(root / pattern)))
+    files = sorted(os.path.normpath(f) for f in glob.glob(str(root / pattern)))
     if not files:
         raise ValueError(
             f"{manifest_path(ds)}: pattern {pattern!r} of sweep {wildcards.sweep!r} matches no "
