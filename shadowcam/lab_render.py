@@ -483,7 +483,7 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
                         "analytic shadow time of calibration sweep cal_u"),
             "t_cal_v": (rc, cgt["t_v"].astype(f32), "frame",
                         "analytic shadow time of calibration sweep cal_v"),
-            "plane_xy": (rc + ("plane_xy",), xy.astype(f32), "scene_unit",
+            "plane_xy": (rc + ("plane_axis",), xy.astype(f32), "scene_unit",
                          "back-plane coordinates (x, y) at pixel centre (calibration scene)"),
             "calibration_homography": (("h_row", "h_col"), homography, "1",
                                        "camera (col, row) pixel-centre index -> plane (x, y)"),
