@@ -113,7 +113,7 @@ def test_accuracy_and_figures_written(run):
     names = {p.name for p in (out / "figures").iterdir()}
     assert {"primal.png", "shadow_time_u.png", "shadow_time_v.png", "dual_view.png",
             "error_histogram.png", "accuracy.html"} <= names
-    for rule in ("render", "decode_u", "shadow_time", "dual_view", "report_figures"):
+    for rule in ("render", "decode_u", "decode_reference", "shadow_time", "dual_view", "report_figures"):
         assert (workdir / "benchmarks" / DS / f"{rule}.tsv").is_file()
         assert (workdir / "logs" / DS / f"{rule}.log").is_file()
 
@@ -140,7 +140,7 @@ def test_nothing_to_do_after_a_run(run):
         ("shadow_time", {"method": "argmin_parabolic"},
          {"shadow_time", "dual_coords", "dual_view", "accuracy", "report_figures"}),
         ("dual_view", {"method": "idw"}, {"dual_view", "accuracy", "report_figures"}),
-        ("decode", {"chunk_frames": 8},
+        ("decode", {"chunk_frames": 8},  # not the reference frame: it is one image
          {"decode", "shadow_time", "dual_coords", "dual_view", "accuracy", "report_figures"}),
     ],
 )

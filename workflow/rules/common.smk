@@ -149,26 +149,36 @@ def get_capture_manifest(wildcards):
     return manifest_path(wildcards.ds)
 
 
-def get_raw_files(wildcards):
-    """Files that `decode` reads for one sweep: the capture directory, or the manifest plus its frames."""
-    ds = wildcards.ds
+def capture_files(ds, group):
+    """Files `decode` reads for `group` (a sweep name or "reference"): the rendered capture
+    directory, or the manifest plus the frames its pattern matches."""
     if is_synthetic(ds):
         return [f"results/{ds}/capture"]
     manifest = load_dataset_manifest(ds)
     root = Path(manifest_path(ds)).parent / manifest.get("root", ".")
-    if wildcards.sweep == "reference":
+    if group == "reference":
         pattern = manifest.get("reference")
     else:
-        pattern = (manifest.get("sweeps") or {}).get(wildcards.sweep, {}).get("files")
+        pattern = (manifest.get("sweeps") or {}).get(group, {}).get("files")
     if not pattern:
-        raise ValueError(f"{manifest_path(ds)}: no files declared for sweep {wildcards.sweep!r}")
+        raise ValueError(f"{manifest_path(ds)}: no files declared for sweep {group!r}")
     files = sorted(os.path.normpath(f) for f in glob.glob(str(root / pattern)))
     if not files:
         raise ValueError(
-            f"{manifest_path(ds)}: pattern {pattern!r} of sweep {wildcards.sweep!r} matches no "
+            f"{manifest_path(ds)}: pattern {pattern!r} of sweep {group!r} matches no "
             f"file under {root}; check 'root' and the pattern"
         )
     return [manifest_path(ds)] + files
+
+
+def get_raw_files(wildcards):
+    """Input files of decoding one sweep (see `capture_files`)."""
+    return capture_files(wildcards.ds, wildcards.sweep)
+
+
+def get_reference_files(wildcards):
+    """Input files of decoding the reference frame (see `capture_files`)."""
+    return capture_files(wildcards.ds, "reference")
 
 
 def get_sweeps(wildcards):
