@@ -213,7 +213,7 @@ def header_metadata(path):
         spec = inp.spec()
         exposure = spec.getattribute("ExposureTime")
         if exposure is not None and float(exposure) > 0:
-            out["exposure_s"] = float(exposure)
+            out["exposure_s"] = float(f"{float(exposure):.7g}")  # OIIO holds it as float32
         stamp = _parse_exif_datetime(
             spec.getattribute("Exif:DateTimeOriginal") or spec.getattribute("DateTimeOriginal"),
             spec.getattribute("Exif:SubsecTimeOriginal"),
