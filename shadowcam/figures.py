@@ -187,7 +187,7 @@ def dual_view_figure(dual_view, *, reciprocal=None, size=None):
 
 
 def error_histogram_figure(errors, *, limit=3.0, bins=60, unit="frame", size=(6.0, 4.0)):
-    """Histogram of errors (estimate - ground truth), one outline per series.
+    """Histogram of errors (estimate - ground truth), one outline per series, log counts.
 
     Parameters
     ----------
@@ -225,6 +225,7 @@ def error_histogram_figure(errors, *, limit=3.0, bins=60, unit="frame", size=(6.
                  f"|e|>{limit:g}: {outside}")
         axes.hist(values, bins=edges, histtype="step", linewidth=1.5, label=label)
     axes.set_xlabel(f"error ({unit})")
+    axes.set_yscale("log")  # the tails (edge pixels, outliers) matter as much as the peak
     axes.set_ylabel("pixels")
     axes.legend(fontsize="small")
     figure.tight_layout()

@@ -2,7 +2,8 @@
 
 Writes into ``--outdir``:
 
-* ``primal.png`` - the camera image (``--reference`` frame, else the lit level of sweep u),
+* ``primal.png`` - the camera image (``--reference`` frame, else the lit image of the
+  first sweep from ``--shadow-time``),
 * ``shadow_time_<sweep>.png`` - one shadow-time map per sweep of ``--shadow-time``,
 * ``dual_view.png`` - the dual view, next to the ground-truth reciprocal view when the
   capture has ground truth,
@@ -49,7 +50,7 @@ def _primal_image(reference, shadow_time):
         if "time" in image.dims:
             image = image.isel(time=0)
         return image.transpose("row", "col", ...).values
-    lit = shadow_time["lit_level"]
+    lit = shadow_time["lit_image" if "lit_image" in shadow_time else "lit_level"]
     if "sweep" in lit.dims:
         lit = lit.isel(sweep=0)
     return lit.transpose("row", "col", ...).values
