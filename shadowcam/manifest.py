@@ -205,8 +205,13 @@ def _resolve(path, *, strict):
     """Load + validate; with `strict`, also require checksums and resolve times."""
     path = Path(path).resolve()
     doc = _read_document(path)
-    if not strict and "sweeps" in doc:
-        doc.setdefault("checksums", {})  # being written: the block may not exist yet
+    if "sweeps" in doc and "checksums" not in doc:
+        if strict:
+            raise ValueError(
+                f"manifest {path} has sweeps but no checksums block (files not listed in checksums); "
+                + _FIX_CHECKSUMS.format(m=path)
+            )
+        doc["checksums"] = {}  # being written: the block does not exist yet
     _validate(doc, path)
     manifest = dict(doc)
     manifest["manifest_path"] = str(path)
