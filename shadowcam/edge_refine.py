@@ -79,7 +79,7 @@ def _plane_fit(time, weight_of, radius):
     return a, b, c, m["s"]
 
 
-def refine_times(time, time_std, *, radius=3, range_sigma=1.5, iterations=3):
+def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
     """Edge-aware local plane fit of a shadow-time map.
 
     Parameters

@@ -88,7 +88,8 @@ def _crossings(summary, threshold):
         va, vb = win[a_c, rows, cols], win[b_c, rows, cols]
         with np.errstate(invalid="ignore", divide="ignore"):
             frac = (va - threshold) / (va - vb)
-        return np.where(ok & np.isfinite(frac), summary.window_start + a_c + frac * (b_c - a_c), np.nan)
+            crossing = summary.window_start + a_c + frac * (b_c - a_c)
+        return np.where(ok & np.isfinite(frac), crossing, np.nan)
 
     entry = interpolate(left, left + 1)
     exit_ = interpolate(right, right - 1)
@@ -156,7 +157,7 @@ def time_dip_centroid(summary):
     return time, entry, exit_, std
 
 
-def time_edge_fit(summary, *, radius=3, range_sigma=1.5, floor_std=0.15):
+def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15):
     """Dip centroid refined by an edge-aware local plane fit of neighbours' times.
 
     See :func:`shadowcam.edge_refine.refine_times`; `floor_std` is the
@@ -230,28 +231,37 @@ def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, fram
     return candidate & (agree >= min_support) & (2 * agree >= total)
 
 
-def _partially_lit(detected, level, *, min_lit_fraction=0.5):
+def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
     """Detected pixels at a shadow boundary whose lit part is under `min_lit_fraction`.
 
     A pixel straddling the boundary of a cast (scene) shadow dips when the
     mask passes, although its centre is in shadow. Its lit fraction is
-    estimated as its level over the brightest detected 8-neighbour; only
-    pixels next to an undetected, darker pixel (the shadow side) are tested.
+    estimated as its level over the brightest detected neighbour of the same
+    colour; only pixels next to an undetected, darker pixel (the shadow side)
+    are tested. For demosaiced RAW, `level` should be each site's own measured
+    channel and `site_colour` its CFA colour: interpolated channels carry
+    light from lit neighbours into shadowed sites.
     """
+    same_colour_radius = 1 if site_colour is None else 2
+    colour = np.zeros(level.shape, np.int8) if site_colour is None else site_colour
     lit_level = np.where(detected, level, 0.0)
     brightest = np.zeros_like(lit_level)
     shadow_side = np.zeros(detected.shape, bool)
-    for dr, dc in _shifts(1):
-        brightest = np.maximum(brightest, _neighbour(lit_level, dr, dc, 0.0))
+    for dr, dc in _shifts(same_colour_radius):
+        same = _neighbour(colour, dr, dc, -1) == colour
+        brightest = np.maximum(brightest, np.where(same, _neighbour(lit_level, dr, dc, 0.0), 0.0))
         n_detected = _neighbour(detected, dr, dc, True)
-        n_level = _neighbour(level, dr, dc, np.inf)
-        shadow_side |= ~n_detected & (n_level < level)
+        if site_colour is None:
+            shadow_side |= ~n_detected & (_neighbour(level, dr, dc, np.inf) < level)
+        else:
+            shadow_side |= ~n_detected
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
     return detected & shadow_side & (fraction < min_lit_fraction)
 
 
-def classify_dips(summary, *, saturated=None, false_alarm=1e-3, weak_false_alarm=0.5,
+def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
+                  false_alarm=1e-2, weak_false_alarm=0.5,
                   min_relative_depth=0.1, min_lit_fraction=0.5, noise_floor=1e-4,
                   second_dip_ratio=0.5):
     """Decide per pixel whether its dip is a reliable shadow, and why not.
@@ -269,6 +279,9 @@ def classify_dips(summary, *, saturated=None, false_alarm=1e-3, weak_false_alarm
         One sweep.
     saturated : (H, W) bool ndarray, optional
         Pixels that reached the white level in any channel.
+    site_level, site_colour : (H, W) ndarray, optional
+        For demosaiced RAW: each pixel's lit level in its own CFA channel and
+        that channel's index, used by the cast-shadow boundary test.
     false_alarm : float, optional
         Wanted probability that a pixel of pure noise is given a time on its own.
     weak_false_alarm : float, optional
@@ -307,7 +320,10 @@ def classify_dips(summary, *, saturated=None, false_alarm=1e-3, weak_false_alarm
     reason = np.zeros(level.shape, np.uint8)
     reason[~detected] = NEVER_SHADOWED
     reason[~significant_level] = LOW_CONTRAST
-    reason[_partially_lit(detected, level, min_lit_fraction=min_lit_fraction)] = LOW_CONTRAST
+    boundary_level = level if site_level is None else site_level
+    partial = _partially_lit(detected, boundary_level, site_colour=site_colour,
+                             min_lit_fraction=min_lit_fraction)
+    reason[partial] = LOW_CONTRAST
     several = detected & (second_depth >= second_dip_ratio * depth) & (
         second_depth / (noise * _SMOOTHED_NOISE) > z
     )
@@ -429,3 +445,120 @@ def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progres
         scale = summary.lit_level / summary.mean_level
         lit_image = colour_sum / summary.n_frames * scale[..., None]
     return summary, np.nan_to_num(lit_image, nan=0.0).astype(np.float32), saturated
+
+
+def cfa_site_colours(shape, pattern):
+    """Channel index (0 R, 1 G, 2 B) measured at each pixel of a Bayer mosaic.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)``.
+    pattern : str
+        CFA letters of the top-left 2x2 block in reading order, e.g. ``"RGGB"``.
+
+    Returns
+    -------
+    (H, W) int8 ndarray
+    """
+    if len(pattern) != 4 or set(pattern) - set("RGB"):
+        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB', got {pattern!r}")
+    tile = np.array(["RGB".index(ch) for ch in pattern], np.int8).reshape(2, 2)
+    rows = np.arange(shape[0])[:, None] % 2
+    cols = np.arange(shape[1])[None, :] % 2
+    return tile[rows, cols]
+
+
+def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_pattern=None,
+                       method_params=None, classify_params=None, progress=None):
+    """Shadow times of one sweep from its frames, streamed.
+
+    Parameters
+    ----------
+    blocks : iterable of (T, H, W, C) float ndarray
+        Linear frames in time order.
+    shape : tuple of int
+        ``(H, W)``.
+    method : str, optional
+        Key of :data:`SHADOW_TIME_METHODS`.
+    half_window : int, optional
+        Frames kept each side of the dip (see :class:`DipTracker`).
+    cfa_pattern : str, optional
+        Bayer pattern when the frames were demosaiced from RAW (e.g. ``"RGGB"``);
+        the shadow-boundary test then uses each site's measured channel.
+    method_params, classify_params : dict, optional
+        Options of the timing method and of :func:`classify_dips`.
+    progress : callable, optional
+        Called with the number of frames done.
+
+    Returns
+    -------
+    results : dict of (H, W) ndarrays
+        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
+    """
+    summary, lit_image, saturated = track_sweep(
+        blocks, shape, half_window=half_window, progress=progress
+    )
+    classify_params = dict(classify_params or {})
+    if cfa_pattern:
+        colour = cfa_site_colours(shape, cfa_pattern)
+        classify_params.update(
+            site_colour=colour,
+            site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],
+        )
+    results = shadow_times(summary, method=method, saturated=saturated,
+                           method_params=method_params, **classify_params)
+    results["lit_image"] = lit_image
+    results["n_frames"] = summary.n_frames
+    return results
+
+
+_VARIABLE_ATTRS = {
+    "shadow_time": ("frame", "time the mask shadow's centre crosses the pixel"),
+    "entry_time": ("frame", "time the shadow enters the pixel (half depth)"),
+    "exit_time": ("frame", "time the shadow leaves the pixel (half depth)"),
+    "time_std": ("frame", "standard deviation of shadow_time (noise model)"),
+    "confidence": ("1", "confidence of shadow_time, exp(-std^2 / (2 * 0.25^2))"),
+    "contrast": ("1", "dip depth over the noise of a smoothed sample"),
+    "lit_level": ("linear", "unshadowed level of the channel sum"),
+    "noise": ("linear", "temporal noise standard deviation of the channel sum"),
+    "lit_image": ("linear", "unshadowed colour per channel"),
+}
+
+
+def shadow_time_dataset(per_sweep, *, channels=("R", "G", "B")):
+    """Assemble the ``shadow_time`` dataset from per-sweep results.
+
+    Parameters
+    ----------
+    per_sweep : dict of str to dict
+        Sweep name -> the dict returned by :func:`sweep_shadow_times`.
+    channels : sequence of str, optional
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables over ``(sweep, row, col)`` (``lit_image`` over
+        ``(sweep, row, col, channel)``); ``reason`` carries CF
+        ``flag_values``/``flag_meanings``; attrs ``n_frames_<sweep>``.
+    """
+    import xarray as xr
+
+    if not per_sweep:
+        raise ValueError("per_sweep is empty: no sweep to assemble")
+    names = list(per_sweep)
+    data = {}
+    for key, (units, long_name) in _VARIABLE_ATTRS.items():
+        stacked = np.stack([per_sweep[n][key] for n in names])
+        dims = ("sweep", "row", "col", "channel") if stacked.ndim == 4 else ("sweep", "row", "col")
+        data[key] = (dims, stacked, {"units": units, "long_name": long_name})
+    data["reason"] = (("sweep", "row", "col"), np.stack([per_sweep[n]["reason"] for n in names]), {
+        "long_name": "why a pixel has no shadow time",
+        "flag_values": np.array(sorted(REASONS), np.uint8),
+        "flag_meanings": " ".join(REASONS[k] for k in sorted(REASONS)),
+    })
+    n_channels = data["lit_image"][1].shape[-1]
+    ds = xr.Dataset(data, coords={"sweep": names, "channel": list(channels)[:n_channels]})
+    for name in names:
+        ds.attrs[f"n_frames_{name}"] = int(per_sweep[name]["n_frames"])
+    return ds
