@@ -223,7 +223,15 @@ def get_accuracy_option(wildcards, input):
     return f"--accuracy {input.accuracy}" if input.accuracy else ""
 
 
-def get_dual_view_params(wildcards):
-    """JSON options of ``shadowcam dual-view``: grid size and method options."""
-    section = config["dual_view"]
-    return as_json({"width": section["width"], "height": section["height"], **section["params"]})
+def get_dual_coords_params(wildcards):
+    """JSON ``--params`` of ``shadowcam dual-coords``: model options and the dual grid size.
+
+    The dual grid size is set in config section ``dual_view`` (width, height; null = the
+    manifest's ``dual`` block, else frames per sweep) and fixed when the dual coordinates
+    are computed, so a change reruns dual_coords and everything after it.
+    """
+    options = dict(config["dual_coords"]["params"])
+    for key in ("width", "height"):
+        if config["dual_view"][key] is not None:
+            options[f"dual_{key}"] = config["dual_view"][key]
+    return as_json(options)

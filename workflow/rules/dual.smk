@@ -11,7 +11,7 @@ rule dual_coords:
     params:
         manifest=get_capture_manifest,
         model=get_dual_model,
-        options=as_json(config["dual_coords"]["params"]),
+        options=get_dual_coords_params,
     log:
         "logs/{ds}/dual_coords.log",
     benchmark:
@@ -35,7 +35,7 @@ rule dual_view:
     params:
         reference=get_reference_option,
         method=config["dual_view"]["method"],
-        options=get_dual_view_params,
+        options=as_json(config["dual_view"]["params"]),
     log:
         "logs/{ds}/dual_view.log",
     benchmark:
