@@ -182,12 +182,15 @@ def trace_light_paths(objects, camera, light, *, supersample=4):
                       distant=isinstance(light, DistantLight))
 
 
+def _pixel_sums(paths):
+    n_pix = paths.shape[0] * paths.shape[1]
+    return np.stack([np.bincount(paths.pixel, weights=paths.radiance[:, c], minlength=n_pix)
+                     for c in range(3)], axis=-1)
+
+
 def render_image(paths):
     """Return the (rows, cols, 3) float32 radiance image of `paths` (no wire)."""
-    n_pix = paths.shape[0] * paths.shape[1]
-    out = np.stack([np.bincount(paths.pixel, weights=paths.radiance[:, c], minlength=n_pix)
-                    for c in range(3)], axis=-1)
-    return out.reshape(*paths.shape, 3).astype(np.float32)
+    return _pixel_sums(paths).reshape(*paths.shape, 3).astype(np.float32)
 
 
 def sweep_frames(paths, sweep, mask):
@@ -221,7 +224,7 @@ def sweep_frames(paths, sweep, mask):
     index = np.concatenate([base + first[keep].astype(np.int64),
                             base + last[keep].astype(np.int64) + 1])
     frames = np.empty((n_frames, n_pix, 3), dtype=np.float32)
-    reference = render_image(paths).reshape(n_pix, 3)
+    reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
     for c in range(3):
         w = paths.radiance[keep, c]
         diff = np.bincount(index, weights=np.concatenate([w, -w]),
