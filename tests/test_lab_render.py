@@ -202,7 +202,7 @@ def test_render_cli_writes_a_complete_capture(tmp_path):
 
     manifest = tmp_path / "tiny.yaml"
     manifest.write_text(yaml.safe_dump({
-        "name": "tiny", "kind": "lab", "synthetic": {
+        "name": "tiny", "kind": "lab", "light": "distant", "synthetic": {
             "scene": "tabletop", "seed": 5, "height": 32, "width": 32, "frames": 12,
             "format": "dng", "bit_depth": 12, "noise": True, "calibration": True}}))
     out = tmp_path / "capture"
@@ -210,6 +210,7 @@ def test_render_cli_writes_a_complete_capture(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["capture", "tiny.yaml"]  # no temp
     cap = json.loads((out / "capture.json").read_text())
     assert cap["name"] == "tiny" and cap["kind"] == "lab" and cap["root"] == "."
+    assert cap["light"] == "distant"  # the manifest's top-level light type is rendered
     assert cap["sweeps"]["u"] == {"files": "frames_u/*.dng", "axis": "u"}
     assert cap["sweeps"]["cal_v"] == {"files": "cal_v/*.dng", "axis": "v"}
     assert cap["dual"] == {"width": 12, "height": 12}
@@ -230,6 +231,7 @@ def test_render_cli_writes_a_complete_capture(tmp_path):
                        0, sensor.white_level)
     assert np.abs(got.astype(float) - expected).max() <= 1  # float32 GT storage rounding
     assert gt.attrs["step"] == "render" and json.loads(gt.attrs["input_checksums"])
+    assert json.loads(gt.attrs["geometry"])["light"]["type"] == "DistantLight"
     gt.close()
     # explicit flags, tiff, re-render replaces the directory atomically
     assert main(["render", "--scene", "tabletop", "--height", "24", "--width", "24",

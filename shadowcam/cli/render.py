@@ -36,6 +36,7 @@ DEFAULTS = {
     "light": "point", "supersample": 4, "exposure": 0.8,
 }
 FORMATS = ("dng", "tiff")
+BIT_DEPTHS = (8, 10, 12, 14, 16)
 #: capture start time written into the DNGs; frame k of every sweep is k seconds later
 CAPTURE_START = datetime.datetime(2024, 1, 1, 0, 0, 0)
 
@@ -54,12 +55,13 @@ def add_parser(subparsers, name):
     p.add_argument("--width", type=int, help="image cols")
     p.add_argument("--frames", type=int, help="frames per sweep (= dual grid size)")
     p.add_argument("--format", choices=FORMATS, help="frame format")
-    p.add_argument("--bit-depth", type=int, choices=(12, 14), help="sensor bit depth")
+    p.add_argument("--bit-depth", type=int, choices=BIT_DEPTHS, help="sensor bit depth")
     p.add_argument("--no-noise", dest="noise", action="store_const", const=False,
                    help="noise-free frames (mean DN, rounded)")
     p.add_argument("--calibration", action=argparse.BooleanOptionalAction,
                    default=None, help="also render the calibration-plane sweeps cal_u, cal_v")
-    p.add_argument("--light", choices=("point", "area", "distant"), help="light type")
+    p.add_argument("--light", choices=("point", "area", "distant"),
+                   help="light type (default: the manifest's 'light', else point)")
     p.add_argument("--supersample", type=int, help="sub-samples per pixel side (default 4)")
     p.add_argument("--exposure", type=float,
                    help="fraction of the DN range reached by the 99.5th percentile of the "
@@ -101,15 +103,18 @@ def resolve_options(args):
     manifest = {}
     if args.manifest is not None:
         manifest, block = _read_synthetic_block(args.manifest)
+        block.pop("light", None)
         options.update(block)
+        if manifest.get("light") is not None:  # the light type is a top-level manifest key
+            options["light"] = manifest["light"]
     for key in DEFAULTS:
         value = getattr(args, key, None)
         if value is not None:
             options[key] = value
     if options["format"] not in FORMATS:
         raise ValueError(f"format: must be one of {FORMATS}, got {options['format']!r}")
-    if options["bit_depth"] not in (12, 14):
-        raise ValueError(f"bit_depth: must be 12 or 14, got {options['bit_depth']!r}")
+    if options["bit_depth"] not in BIT_DEPTHS:
+        raise ValueError(f"bit_depth: must be one of {BIT_DEPTHS}, got {options['bit_depth']!r}")
     for key in ("height", "width"):
         if options["format"] == "dng" and int(options[key]) < 22:
             raise ValueError(f"{key}: DNG frames need at least 22 pixels (LibRaw limit)")
