@@ -18,6 +18,7 @@ make_mask_plane, make_wire_sweeps, dual_camera : build them from a light and an 
 wire_shadow_time : analytic time at which a sweep's wire centre line shadows points.
 Scene, make_scene, calibration_scene, SCENES : a whole scene; presets by name.
 texture_albedo : evaluate a texture at 2-D texture coordinates.
+yaw_matrix : rotation about +y (local -> world).
 """
 
 import math

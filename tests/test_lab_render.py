@@ -4,7 +4,6 @@ Physical facts against the exact analytic ground truth of tiny tabletop captures
 """
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

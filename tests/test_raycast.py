@@ -12,7 +12,6 @@ from shadowcam.raycast import (
 )
 from shadowcam.scene import (
     BackPlane,
-    Box,
     GroundPlane,
     Material,
     PointLight,
