@@ -136,6 +136,15 @@ def demosaic_bilinear(mosaic, *, pattern, max_value):
     (M, N, 3) float32 ndarray
         R, G, B in the units of `mosaic`.
     """
+    rgb, scale = _demosaic_scaled(mosaic, pattern=pattern, max_value=max_value)
+    out = rgb.astype(np.float32)
+    if scale > 1:
+        out /= np.float32(scale)
+    return out
+
+
+def _demosaic_scaled(mosaic, *, pattern, max_value):
+    """OpenCV demosaic of ``mosaic * k``: return ((M, N, 3) uint16 view, k)."""
     mosaic = np.asarray(mosaic)
     if mosaic.ndim != 2 or min(mosaic.shape) < 3:
         raise ValueError(f"mosaic must be a 2-D array of at least 3x3; got shape {mosaic.shape}")
@@ -148,11 +157,7 @@ def demosaic_bilinear(mosaic, *, pattern, max_value):
     scale = 65535 // max_value
     scaled = mosaic.astype(np.uint16) * np.uint16(scale) if scale > 1 else mosaic.astype(np.uint16)
     padded = cv2.copyMakeBorder(scaled, 2, 2, 2, 2, cv2.BORDER_REFLECT_101)
-    rgb = cv2.cvtColor(padded, code)[2:-2, 2:-2]
-    out = rgb.astype(np.float32)
-    if scale > 1:
-        out /= np.float32(scale)
-    return out
+    return cv2.cvtColor(padded, code)[2:-2, 2:-2], scale
 
 
 def _site_map(values, shape, pattern, max_value):
@@ -253,6 +258,7 @@ def _decode_raw(path):
                 "convert it to TIFF or a Bayer DNG first"
             )
         mosaic = raw.raw_image_visible
+        shape = mosaic.shape
         colours = raw.raw_colors_visible[:2, :2]  # CFA phase at the visible origin
         pattern = bayer_pattern(colours, raw.color_desc)
         black_levels = np.asarray(raw.black_level_per_channel, dtype=np.float64)
@@ -263,19 +269,24 @@ def _decode_raw(path):
             np.asarray(white_per, dtype=np.float64)[colours] if white_per is not None else np.full((2, 2), white)
         )
         wb = _white_balance_rgb(raw.camera_whitebalance)
-        dn = demosaic_bilinear(mosaic, pattern=pattern, max_value=int(white_sites.max()))
-    black = _site_map(black_sites, mosaic.shape, pattern, int(white_sites.max()))
-    white_map = _site_map(white_sites, mosaic.shape, pattern, int(white_sites.max()))
-    if np.any(white_map <= black):
+        vmax = int(white_sites.max())
+        rgb, k = _demosaic_scaled(mosaic, pattern=pattern, max_value=vmax)
+    # (k * DN - k * black) / (k * (white - black)): exact at each CFA site's own
+    # channel (integers below 2**24), computed in place on one float32 buffer
+    black = _site_map(black_sites, shape, pattern, vmax) * np.float32(k)
+    span = _site_map(white_sites, shape, pattern, vmax) * np.float32(k) - black
+    if np.any(span <= 0):
         raise ValueError(f"{path}: white level {white_sites.tolist()} not above black {black_sites.tolist()}")
-    image = (dn - black) / (white_map - black)
+    image = rgb.astype(np.float32)
+    image -= black
+    np.divide(image, span, out=image)
     header = header_metadata(path)
     bits = header["bits_per_sample"] or int(math.ceil(math.log2(white_sites.max() + 1)))
     info = {
         "path": str(path),
         "decoder": "rawpy raw_image_visible + OpenCV bilinear demosaic (linear, no white balance)",
-        "height": int(mosaic.shape[0]),
-        "width": int(mosaic.shape[1]),
+        "height": int(shape[0]),
+        "width": int(shape[1]),
         "bit_depth": int(bits),
         "cfa_pattern": pattern,
         "black_level": [float(np.mean(black_sites[np.array(list(pattern)).reshape(2, 2) == c])) for c in _RGB],
@@ -284,7 +295,7 @@ def _decode_raw(path):
         "exposure_s": header["exposure_s"],
         "capture_time": header["capture_time"],
     }
-    return image.astype(np.float32, copy=False), info
+    return image, info
 
 
 def _oiio_info(path, spec):
