@@ -112,7 +112,16 @@ def test_memory_bounded_by_chunk_not_frame_count(tmp_path):
     assert peak_200 < 50 * frame_bytes
     # 150 more frames add (much) less than 15 frames of memory: no accumulation
     assert peak_200 - peak_50 < 15 * frame_bytes
-    assert open_frames(tmp_path / "b.zarr").sizes["time"] == 200
+    # reading back streams too: one 10-frame chunk at a time
+    ds = open_frames(tmp_path / "b.zarr")
+    tracemalloc.start()
+    try:
+        total = sum(float(block[..., 0].sum()) for _, block in iter_frame_chunks(ds))
+        peak_read = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak_read < 50 * frame_bytes
+    assert total > 0 and ds.sizes["time"] == 200
 
 
 def test_decode_cli_verifies_then_writes(tmp_path):
