@@ -4,7 +4,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import xarray as xr
 import yaml
 
 from shadowcam.ground_truth import REQUIRED, check_ground_truth, load_ground_truth, mitsuba_lab_npz_to_dataset
