@@ -588,8 +588,12 @@ def dual_coords_calibration(
     u = np.full(t_u.shape, np.nan, dtype=np.float32)
     v = np.full(t_u.shape, np.nan, dtype=np.float32)
     ok = codes == 0
-    u_vals = (xy[:, 0] - x0) / pixel[0] - 0.5
-    v_vals = (xy[:, 1] - y0) / pixel[1] - 0.5
+    # orient each dual axis along its sweep (u grows with t_u, v with t_v), as
+    # the uniform model and the reciprocal camera do, whatever the plane's axes
+    grows_x = np.cov(plane_xy[:, 0], cal_times[:, 0])[0, 1] >= 0
+    grows_y = np.cov(plane_xy[:, 1], cal_times[:, 1])[0, 1] >= 0
+    u_vals = ((xy[:, 0] - x0) if grows_x else (x1 - xy[:, 0])) / pixel[0] - 0.5
+    v_vals = ((xy[:, 1] - y0) if grows_y else (y1 - xy[:, 1])) / pixel[1] - 0.5
     u[has_time] = np.where(ok, u_vals, np.nan)
     v[has_time] = np.where(ok, v_vals, np.nan)
     info = {
@@ -597,6 +601,7 @@ def dual_coords_calibration(
         "model_residual_rms": fit.residual_rms,
         "candidates": fit.candidates,
         "plane_window": [x0, y0, x1, y1],
+        "axes_flipped": [bool(not grows_x), bool(not grows_y)],
         "dual_width": width,
         "dual_height": height,
         "n_calibration_points": int(len(cal_times)),
