@@ -250,11 +250,8 @@ def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
     for dr, dc in _shifts(same_colour_radius):
         same = _neighbour(colour, dr, dc, -1) == colour
         brightest = np.maximum(brightest, np.where(same, _neighbour(lit_level, dr, dc, 0.0), 0.0))
-        n_detected = _neighbour(detected, dr, dc, True)
-        if site_colour is None:
-            shadow_side |= ~n_detected & (_neighbour(level, dr, dc, np.inf) < level)
-        else:
-            shadow_side |= ~n_detected
+        darker = _neighbour(level, dr, dc, np.inf) < min_lit_fraction * level
+        shadow_side |= (same & darker) | ~_neighbour(detected, dr, dc, True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
     return detected & shadow_side & (fraction < min_lit_fraction)

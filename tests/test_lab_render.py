@@ -213,7 +213,8 @@ def test_render_cli_writes_a_complete_capture(tmp_path):
     assert cap["sweeps"]["u"] == {"files": "frames_u/*.dng", "axis": "u"}
     assert cap["sweeps"]["cal_v"] == {"files": "cal_v/*.dng", "axis": "v"}
     assert cap["dual"] == {"width": 12, "height": 12}
-    assert cap["ground_truth"] == {"format": "shadowcam_nc", "file": "ground_truth.nc"}
+    assert cap["ground_truth"] == {"format": "shadowcam_nc", "file": "ground_truth.nc",
+                                   "noise": "noise_free"}
     assert cap["timing"] == {"source": "rate", "rate_hz": 1.0}
     assert cap["licence"] == "CC0-1.0"
     assert np.shape(cap["calibration_plane"]["homography"]) == (3, 3)

@@ -220,5 +220,6 @@ def test_shared_dev_manifests(name, suffix):
         paths = manifest["sweeps"][sweep]["paths"]
         assert [Path(p).name for p in paths] == [f"{k:06d}{suffix}" for k in range(96)]
         assert manifest["sweeps"][sweep]["times_s"] == [float(k) for k in range(96)]  # frame t = file index
-    assert manifest["ground_truth"] == {"format": "mitsuba_lab_npz", "file": "gt.npz"}
+    noise = "raw12" if suffix == ".dng" else "noise_free"
+    assert manifest["ground_truth"] == {"format": "mitsuba_lab_npz", "file": "gt.npz", "noise": noise}
     assert len(verify_checksums(manifest)) == 2 * 96 + 2

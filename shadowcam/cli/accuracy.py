@@ -2,7 +2,8 @@
 
 Writes the nested report as JSON and a flat ``metric,value`` CSV table. The
 noise condition that selects the shadow-time target comes from ``--params
-'{"noise": "noise_free"|"raw12"}'``, else from the manifest's ``synthetic.noise``,
+'{"noise": "noise_free"|"raw12"}'``, else from the manifest's ``ground_truth.noise``
+or ``synthetic.noise``,
 else ``noise_free``.
 
 Offers
@@ -57,8 +58,11 @@ def run(args):
     manifest = load_manifest(args.manifest)
     gt = load_ground_truth(manifest)
     synthetic = manifest.get("synthetic") or {}
+    declared = (manifest.get("ground_truth") or {}).get("noise")
     if "noise" in params:
         noise, source = params["noise"], "--params"
+    elif declared:
+        noise, source = declared, "manifest ground_truth.noise"
     elif "noise" in synthetic:
         noise, source = ("raw12" if synthetic["noise"] else "noise_free"), "manifest synthetic.noise"
     else:

@@ -210,7 +210,8 @@ def render_capture_dir(options, out_dir):
             "timing": {"source": "rate", "rate_hz": 1.0},
             "checksums": checksums,
             "dual": {"width": scene.mask.n_u, "height": scene.mask.n_v},
-            "ground_truth": {"format": "shadowcam_nc", "file": "ground_truth.nc"},
+            "ground_truth": {"format": "shadowcam_nc", "file": "ground_truth.nc",
+                             "noise": "raw12" if options["noise"] else "noise_free"},
             "provenance": (f"rendered by shadowcam {__version__} 'shadowcam render' "
                            f"(scene {options['scene']}, seed {seed}, "
                            f"{options['height']}x{options['width']}, "
