@@ -14,12 +14,13 @@ stay sharp.
 Offers
 ------
 refine_times : local robust plane fit of a time map.
+shifted : an image shifted by a neighbour offset, filled outside.
 """
 
 import numpy as np
 
 
-def _shifted(array, dr, dc, fill):
+def shifted(array, dr, dc, fill):
     """`array` shifted so that ``out[r, c] = array[r + dr, c + dc]`` (fill outside)."""
     out = np.full_like(array, fill)
     h, w = array.shape
@@ -41,7 +42,7 @@ def _plane_fit(time, weight_of, radius):
                ("s", "r", "c", "rr", "rc", "cc", "t", "tr", "tc")}
     for dr in range(-radius, radius + 1):
         for dc in range(-radius, radius + 1):
-            t_n = _shifted(time, dr, dc, np.nan)
+            t_n = shifted(time, dr, dc, np.nan)
             wgt = weight_of(dr, dc, t_n)
             wgt = np.where(np.isfinite(t_n), wgt, 0.0)
             t_n = np.where(wgt > 0, t_n, 0.0)
@@ -124,7 +125,7 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         def weight_of(dr, dc, t_n, centre=centre, slope_r=slope_r, slope_c=slope_c):
             predicted = centre + slope_r * dr + slope_c * dc
             residual = (t_n - predicted) / range_sigma
-            return _shifted(inv_var, dr, dc, 0.0) * np.exp(-0.5 * residual**2)
+            return shifted(inv_var, dr, dc, 0.0) * np.exp(-0.5 * residual**2)
 
         centre, slope_r, slope_c, weight_sum = _plane_fit(t64, weight_of, radius)
         centre = np.where(valid, centre, np.nan)

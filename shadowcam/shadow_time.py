@@ -22,7 +22,7 @@ import numpy as np
 from scipy.special import ndtri
 
 from shadowcam.dip_tracker import DipTracker
-from shadowcam.edge_refine import refine_times
+from shadowcam.edge_refine import refine_times, shifted
 
 #: flag code -> meaning (0 = a reliable time)
 REASONS = {
@@ -199,16 +199,6 @@ def _shifts(radius):
             if (dr, dc) != (0, 0)]
 
 
-def _neighbour(array, dr, dc, fill):
-    """``out[r, c] = array[r + dr, c + dc]``, `fill` outside the image."""
-    out = np.full_like(array, fill)
-    h, w = array.shape
-    rs, re = max(0, -dr), min(h, h - dr)
-    cs, ce = max(0, -dc), min(w, w - dc)
-    out[rs:re, cs:ce] = array[rs + dr:re + dr, cs + dc:ce + dc]
-    return out
-
-
 def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, frames_per_pixel=1.5,
                              min_support=3):
     """Weak dips whose timing agrees with enough strong neighbours.
@@ -223,8 +213,8 @@ def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, fram
     total = np.zeros(candidate.shape, np.int32)
     frame = minimum_frame.astype(np.float64)
     for dr, dc in _shifts(radius):
-        n_strong = _neighbour(strong, dr, dc, False)
-        n_frame = _neighbour(frame, dr, dc, np.nan)
+        n_strong = shifted(strong, dr, dc, False)
+        n_frame = shifted(frame, dr, dc, np.nan)
         tolerance = 1.0 + frames_per_pixel * np.hypot(dr, dc)
         total += n_strong
         agree += n_strong & (np.abs(n_frame - frame) <= tolerance)
@@ -248,10 +238,10 @@ def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
     brightest = np.zeros_like(lit_level)
     shadow_side = np.zeros(detected.shape, bool)
     for dr, dc in _shifts(same_colour_radius):
-        same = _neighbour(colour, dr, dc, -1) == colour
-        brightest = np.maximum(brightest, np.where(same, _neighbour(lit_level, dr, dc, 0.0), 0.0))
-        darker = _neighbour(level, dr, dc, np.inf) < min_lit_fraction * level
-        shadow_side |= (same & darker) | ~_neighbour(detected, dr, dc, True)
+        same = shifted(colour, dr, dc, -1) == colour
+        brightest = np.maximum(brightest, np.where(same, shifted(lit_level, dr, dc, 0.0), 0.0))
+        darker = shifted(level, dr, dc, np.inf) < min_lit_fraction * level
+        shadow_side |= (same & darker) | ~shifted(detected, dr, dc, True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
     return detected & shadow_side & (fraction < min_lit_fraction)
