@@ -12,8 +12,9 @@ add_parser : register the step and its options.
 run : evaluate and write the report.
 """
 
-import json
 import logging
+
+from shadowcam.cli.options import parse_params
 
 log = logging.getLogger(__name__)
 
@@ -49,12 +50,7 @@ def run(args):
     from shadowcam.manifest import load_manifest
     from shadowcam.provenance import file_sha256
 
-    try:
-        params = json.loads(args.params)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"--params is not valid JSON: {exc}") from None
-    if not isinstance(params, dict) or set(params) - {"noise"}:
-        raise ValueError(f"--params: only key 'noise' is understood, got {params}")
+    params = parse_params(args.params, allowed={"noise"})
     manifest = load_manifest(args.manifest)
     gt = load_ground_truth(manifest)
     synthetic = manifest.get("synthetic") or {}

@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from shadowcam.cli.options import parse_params
 from shadowcam.dual_coords import (
     DUAL_COORD_METHODS,
     dual_coords_calibration,
@@ -63,13 +64,8 @@ def run(args):
     from shadowcam.manifest import load_manifest, verify_checksums
     from shadowcam.provenance import attach_provenance, file_sha256
 
-    try:
-        params = json.loads(args.params)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"--params is not valid JSON: {exc}") from None
-    allowed = set(_GRID_KEYS) | set(_UNIFORM_KEYS) | set(_CALIBRATION_KEYS)
-    if not isinstance(params, dict) or set(params) - allowed:
-        raise ValueError(f"--params: unknown keys {sorted(set(params) - allowed)}; allowed {sorted(allowed)}")
+    params = parse_params(args.params,
+                          allowed=set(_GRID_KEYS) | set(_UNIFORM_KEYS) | set(_CALIBRATION_KEYS))
     manifest = load_manifest(args.manifest)
     with xr.open_dataset(args.shadow_time, engine="h5netcdf") as ds:
         shadow_time = ds.load()

@@ -14,8 +14,8 @@ import json
 import logging
 import time
 
-import numpy as np
 
+from shadowcam.cli.options import parse_params
 from shadowcam.dual_view import DUAL_VIEW_METHODS
 
 log = logging.getLogger(__name__)
@@ -45,12 +45,7 @@ def run(args):
     from shadowcam.image_io import write_exr, write_netcdf, write_png_preview
     from shadowcam.provenance import attach_provenance, file_sha256
 
-    try:
-        params = json.loads(args.params)
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"--params is not valid JSON: {exc}") from None
-    if not isinstance(params, dict):
-        raise ValueError("--params must be a JSON object")
+    params = parse_params(args.params)
     with xr.open_dataset(args.dual_coords, engine="h5netcdf") as ds:
         coords = ds.load()
     with xr.open_dataset(args.shadow_time, engine="h5netcdf") as ds:

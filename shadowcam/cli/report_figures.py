@@ -20,7 +20,6 @@ import shutil
 import tempfile
 from pathlib import Path
 
-import numpy as np
 import xarray as xr
 
 from shadowcam import figures

@@ -14,6 +14,7 @@ import logging
 import os
 from pathlib import Path
 
+from shadowcam.cli.options import parse_params
 from shadowcam.frame_store import iter_frame_chunks, open_frames
 from shadowcam.provenance import attach_provenance
 from shadowcam.shadow_time import SHADOW_TIME_METHODS, shadow_time_dataset, sweep_shadow_times
@@ -37,10 +38,7 @@ def run(args):
     """Compute the shadow times of every sweep and write one dataset."""
     if len(args.frames) != len(args.sweeps):
         raise ValueError(f"--frames has {len(args.frames)} stores but --sweeps names {len(args.sweeps)}")
-    params = json.loads(args.params)
-    unknown = set(params) - {"half_window", "method_params", "classify_params"}
-    if unknown:
-        raise ValueError(f"--params has unknown keys {sorted(unknown)}")
+    params = parse_params(args.params, allowed={"half_window", "method_params", "classify_params"})
     per_sweep, checksums = {}, {}
     for path, sweep in zip(args.frames, args.sweeps):
         frames = open_frames(path)
