@@ -221,16 +221,21 @@ def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, fram
     return candidate & (agree >= min_support) & (2 * agree >= total)
 
 
-def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
+def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5,
+                   shadow_ratio=0.1):
     """Detected pixels at a shadow boundary whose lit part is under `min_lit_fraction`.
 
     A pixel straddling the boundary of a cast (scene) shadow dips when the
     mask passes, although its centre is in shadow. Its lit fraction is
     estimated as its level over the brightest detected neighbour of the same
-    colour; only pixels next to an undetected, darker pixel (the shadow side)
-    are tested. For demosaiced RAW, `level` should be each site's own measured
-    channel and `site_colour` its CFA colour: interpolated channels carry
-    light from lit neighbours into shadowed sites.
+    colour; only pixels beside the shadow side are tested: an undetected
+    neighbour, or a same-colour neighbour darker than `shadow_ratio` times
+    the pixel's level (a cast shadow keeps only ambient light, an order of
+    magnitude below direct light, while neighbouring albedos of a texture
+    rarely differ that much). For demosaiced RAW, `level` should be each
+    site's own measured channel and `site_colour` its CFA colour:
+    interpolated channels carry light from lit neighbours into shadowed
+    sites, so those are detected too and only the darkness test finds them.
     """
     same_colour_radius = 1 if site_colour is None else 2
     colour = np.zeros(level.shape, np.int8) if site_colour is None else site_colour
@@ -240,7 +245,7 @@ def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
     for dr, dc in _shifts(same_colour_radius):
         same = shifted(colour, dr, dc, -1) == colour
         brightest = np.maximum(brightest, np.where(same, shifted(lit_level, dr, dc, 0.0), 0.0))
-        darker = shifted(level, dr, dc, np.inf) < min_lit_fraction * level
+        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * level
         shadow_side |= (same & darker) | ~shifted(detected, dr, dc, True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
@@ -249,8 +254,8 @@ def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
 
 def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
                   false_alarm=1e-2, weak_false_alarm=0.5,
-                  min_relative_depth=0.1, min_lit_fraction=0.5, noise_floor=1e-4,
-                  second_dip_ratio=0.5):
+                  min_relative_depth=0.1, min_lit_fraction=0.5, shadow_ratio=0.1,
+                  noise_floor=1e-4, second_dip_ratio=0.5):
     """Decide per pixel whether its dip is a reliable shadow, and why not.
 
     A dip is detected when it is deeper than pure noise gets within the
@@ -277,6 +282,9 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
         Smallest dip depth, as a fraction of the lit level, taken as a shadow.
     min_lit_fraction : float, optional
         Smallest lit fraction of a boundary pixel's footprint.
+    shadow_ratio : float, optional
+        A same-colour neighbour darker than this fraction of a pixel's level
+        is taken as the shadowed side of a cast-shadow boundary.
     noise_floor : float, optional
         Lower bound of the noise (signal units), for noise-free data.
     second_dip_ratio : float, optional
@@ -309,7 +317,7 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     reason[~significant_level] = LOW_CONTRAST
     boundary_level = level if site_level is None else site_level
     partial = _partially_lit(detected, boundary_level, site_colour=site_colour,
-                             min_lit_fraction=min_lit_fraction)
+                             min_lit_fraction=min_lit_fraction, shadow_ratio=shadow_ratio)
     reason[partial] = LOW_CONTRAST
     several = detected & (second_depth >= second_dip_ratio * depth) & (
         second_depth / (noise * _SMOOTHED_NOISE) > z
@@ -429,7 +437,8 @@ def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progres
     if colour_sum is None:
         raise ValueError("blocks is empty: the sweep has no frames")
     with np.errstate(invalid="ignore", divide="ignore"):
-        scale = summary.lit_level / summary.mean_level
+        # a pixel with no light at all (mean 0) has no colour, not an infinite one
+        scale = np.where(summary.mean_level > 0, summary.lit_level / summary.mean_level, 0.0)
         lit_image = colour_sum / summary.n_frames * scale[..., None]
     return summary, np.nan_to_num(lit_image, nan=0.0).astype(np.float32), saturated
 
