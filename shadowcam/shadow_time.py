@@ -16,6 +16,7 @@ REASONS : flag code -> meaning, for pixels without a reliable time.
 classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
+lit_colour : unshadowed colour per pixel from a summary with channel sums.
 """
 
 import numpy as np
@@ -413,34 +414,36 @@ def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progres
     summary : DipSummary
         Of the channel-summed signal.
     lit_image : (H, W, C) float32 ndarray
-        Unshadowed colour per pixel: the channel means scaled by the ratio of
-        the lit level to the mean level (the mask removes light from all
-        channels alike).
+        Unshadowed colour per pixel (see :func:`lit_colour`).
     saturated : (H, W) bool ndarray
     """
-    tracker = DipTracker(shape, half_window=half_window)
-    colour_sum = None
-    saturated = np.zeros(shape, bool)
+    tracker = DipTracker(shape, half_window=half_window, saturation_level=saturation_level)
     for block in blocks:
         block = np.asarray(block, np.float32)
         if block.ndim != 4 or block.shape[1:3] != tuple(shape):
             raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C), got {block.shape}")
-        with np.errstate(invalid="ignore"):
-            saturated |= (block >= saturation_level).any(axis=(0, 3))
-        finite = np.where(np.isfinite(block), block, 0.0)
-        sums = finite.sum(axis=0, dtype=np.float64)
-        colour_sum = sums if colour_sum is None else colour_sum + sums
-        tracker.update(block.sum(axis=3))
+        tracker.update(block)
         if progress is not None:
             progress(tracker.n_frames)
-    summary = tracker.result()
-    if colour_sum is None:
+    if tracker.n_frames == 0:
         raise ValueError("blocks is empty: the sweep has no frames")
+    summary = tracker.result()
+    return summary, lit_colour(summary), summary.saturated
+
+
+def lit_colour(summary):
+    """Unshadowed colour per pixel, ``(H, W, C)`` float32.
+
+    The channel means scaled by the ratio of the lit level to the mean level
+    (the mask removes light from all channels alike).
+    """
+    if summary.channel_sum is None:
+        raise ValueError("summary has no channel sums: feed the tracker (T, H, W, C) blocks")
     with np.errstate(invalid="ignore", divide="ignore"):
         # a pixel with no light at all (mean 0) has no colour, not an infinite one
         scale = np.where(summary.mean_level > 0, summary.lit_level / summary.mean_level, 0.0)
-        lit_image = colour_sum / summary.n_frames * scale[..., None]
-    return summary, np.nan_to_num(lit_image, nan=0.0).astype(np.float32), saturated
+        lit_image = summary.channel_sum / summary.n_frames * scale[..., None]
+    return np.nan_to_num(lit_image, nan=0.0).astype(np.float32)
 
 
 def cfa_site_colours(shape, pattern):
