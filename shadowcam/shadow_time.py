@@ -330,11 +330,12 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
     if saturated is not None:
         reason[(reason == OK) & saturated] = SATURATED
-    window_invalid = ~np.isfinite(summary.window).all(axis=0)
-    inside = (summary.window_start >= 0) & (
-        summary.window_start + summary.window.shape[0] <= summary.n_frames
-    )
-    broken = (summary.invalid_count > 0) & (window_invalid & inside)
+    # a non-finite sample in the window at a frame inside the sweep (slots outside the
+    # sweep are NaN padding)
+    frame = _window_times(summary)
+    in_sweep = (frame >= 0) & (frame < summary.n_frames)
+    window_invalid = (in_sweep & ~np.isfinite(summary.window)).any(axis=0)
+    broken = (summary.invalid_count > 0) & window_invalid
     broken |= summary.lit_count < 3
     broken |= summary.minimum_frame < 0
     reason[broken] = INVALID_INPUT
@@ -431,7 +432,7 @@ def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progres
         if block.ndim != 4 or block.shape[1:3] != tuple(shape):
             raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C), got {block.shape}")
         with np.errstate(invalid="ignore"):
-            saturated |= (block >= saturation_level).any(axis=(0, 3))
+            saturated |= (np.isfinite(block) & (block >= saturation_level)).any(axis=(0, 3))
         finite = np.where(np.isfinite(block), block, 0.0)
         sums = finite.sum(axis=0, dtype=np.float64)
         colour_sum = sums if colour_sum is None else colour_sum + sums
