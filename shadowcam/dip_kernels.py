@@ -137,8 +137,9 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
                     v = block[t, p, c]
                     if np.isfinite(v):
                         channel_sum[p, c] += np.int64(np.rint(np.float64(v) * SUM_SCALE))
-                    if v >= saturation_level:
-                        saturated[p] = True
+                        # +inf is corrupt input (counted above), not a clipped channel
+                        if v >= saturation_level:
+                            saturated[p] = True
             centre = j - half_window - 1
             if centre >= start and centre >= 0 and centre < stop:
                 _consider(ring_p, centre, j + 1, half_window, top_value[p], top_frame[p], window[p])

@@ -33,8 +33,9 @@ REASONS = {
     3: "saturated",
     4: "several_minima",
     5: "invalid_input",
+    6: "wide_dip",
 }
-OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT = range(6)
+OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP = range(7)
 
 #: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
 _SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
@@ -253,6 +254,17 @@ def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5,
     return detected & shadow_side & (fraction < min_lit_fraction)
 
 
+def _wider_than_window(summary, depth, significant):
+    """The window's first or last sample (when inside the sweep) is still shadowed by more
+    than 3/4 of the dip's depth (and by more than `significant`, capped at 0.9 `depth`):
+    the dip goes on beyond the window (thick wire, area source) and its time would be
+    biased toward the window."""
+    need = np.maximum(0.75 * depth, np.minimum(significant, 0.9 * depth))
+    with np.errstate(invalid="ignore"):
+        return ((summary.lit_level - summary.window[0] > need)
+                | (summary.lit_level - summary.window[-1] > need))
+
+
 def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
                   false_alarm=1e-2, weak_false_alarm=0.5,
                   min_relative_depth=0.1, min_lit_fraction=0.5, shadow_ratio=0.1,
@@ -324,13 +336,15 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
         second_depth / (noise * _SMOOTHED_NOISE) > z
     )
     reason[(reason == OK) & several] = SEVERAL_MINIMA
+    reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
     if saturated is not None:
         reason[(reason == OK) & saturated] = SATURATED
-    window_invalid = ~np.isfinite(summary.window).all(axis=0)
-    inside = (summary.window_start >= 0) & (
-        summary.window_start + summary.window.shape[0] <= summary.n_frames
-    )
-    broken = (summary.invalid_count > 0) & (window_invalid & inside)
+    # a non-finite sample in the window at a frame inside the sweep (slots outside the
+    # sweep are NaN padding)
+    frame = _window_times(summary)
+    in_sweep = (frame >= 0) & (frame < summary.n_frames)
+    window_invalid = (in_sweep & ~np.isfinite(summary.window)).any(axis=0)
+    broken = (summary.invalid_count > 0) & window_invalid
     broken |= summary.lit_count < 3
     broken |= summary.minimum_frame < 0
     reason[broken] = INVALID_INPUT

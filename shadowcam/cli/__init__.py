@@ -22,6 +22,8 @@ STEPS = {
     "dual-view": "dual_view",
     "accuracy": "accuracy",
     "report-figures": "report_figures",
+    "evaluate": "evaluate",
+    "plan": "plan",
 }
 
 

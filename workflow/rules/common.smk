@@ -235,3 +235,8 @@ def get_dual_coords_params(wildcards):
         if config["dual_view"][key] is not None:
             options[f"dual_{key}"] = config["dual_view"][key]
     return as_json(options)
+
+
+def get_evaluate_params(wildcards):
+    """JSON ``--params`` of ``shadowcam evaluate``: config section ``evaluate``."""
+    return as_json(config["evaluate"])
