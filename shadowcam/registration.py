@@ -49,7 +49,7 @@ def bandpass_log(luma, *, inner_sigma=0.7, outer_sigma=3.0):
     return smooth - cv2.GaussianBlur(logl, (0, 0), outer_sigma)
 
 
-def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, margin=3):
+def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, margin=6):
     """Weights of the pixels whose illumination state did not change since the reference.
 
     Parameters
@@ -64,7 +64,9 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, m
         A pixel lit in the reference whose ``luma / reference`` fell below
         ``max_ratio * gain`` has been reached by the shadow.
     margin : int, optional
-        Changed pixels are dilated by this many pixels; the image border too.
+        Changed pixels are dilated by this many pixels (about twice the outer
+        scale of :func:`bandpass_log`, whose response to the moved edge
+        spreads that far); the image border too.
 
     Returns
     -------
