@@ -13,8 +13,8 @@ known, and provenance. Its structure is fixed by
 * ``sweeps[name]["times_s"]`` -- frame times in seconds (float list, one per file);
 * ``reference_paths`` -- absolute paths of the reference frame(s) (empty if none);
 * ``files`` -- group -> list of paths relative to root of every referenced file;
-  groups are the sweep names, ``reference``, ``timing`` (sidecar), ``ground_truth``
-  and ``calibration_plane`` (mask).
+  groups are the sweep names, ``reference``, ``timing`` (sidecar), ``ground_truth``,
+  ``calibration_plane`` (mask) and ``sky_mask`` (outdoor mask image).
 
 Offers
 ------
@@ -245,6 +245,9 @@ def _resolve(path, *, strict):
         gt = _existing(gt_root, manifest["ground_truth"]["file"], what="ground_truth.file", manifest_path=path)
         if root is not None:
             files["ground_truth"] = [_rel(root, gt)]
+    if "image" in manifest.get("sky_mask", {}):
+        sky = _existing(root, manifest["sky_mask"]["image"], what="sky_mask.image", manifest_path=path)
+        files["sky_mask"] = [_rel(root, sky)]
     if "mask" in manifest.get("calibration_plane", {}):
         mask = _existing(root, manifest["calibration_plane"]["mask"], what="calibration_plane.mask", manifest_path=path)
         files["calibration_plane"] = [_rel(root, mask)]

@@ -22,6 +22,12 @@ STEPS = {
     "dual-view": "dual_view",
     "accuracy": "accuracy",
     "report-figures": "report_figures",
+    "outdoor-normalise": "outdoor_normalise",
+    "track-edges": "track_edges",
+    "arrival": "arrival",
+    "pushbroom": "pushbroom",
+    "outdoor-accuracy": "outdoor_accuracy",
+    "outdoor-figures": "outdoor_figures",
 }
 
 
