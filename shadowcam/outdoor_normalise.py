@@ -80,7 +80,8 @@ class SequenceNormaliser:
             raw = luminance(frame)
             rough, _ = estimate_gain(raw, self.reference_luma, pixels=self.lit_at_start,
                                      prior=self._prior(self.gain_lit[-1], k))
-            weight = static_weight(raw, self.reference_luma, lit_reference=self.lit_at_start, gain=rough)
+            weight = static_weight(raw, self.reference_luma, lit_reference=self.lit_at_start, gain=rough,
+                                   valid=~self._sky)
             shift, _ = shift_lucas_kanade_LucasKanade1981(raw, self.reference_luma, weight=weight,
                                                           initial=self.shifts[-1])
             luma = apply_shift(raw, shift)

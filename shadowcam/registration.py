@@ -49,7 +49,7 @@ def bandpass_log(luma, *, inner_sigma=0.7, outer_sigma=3.0):
     return smooth - cv2.GaussianBlur(logl, (0, 0), outer_sigma)
 
 
-def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, margin=6):
+def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_ratio=0.5, margin=6):
     """Weights of the pixels whose illumination state did not change since the reference.
 
     Parameters
@@ -60,6 +60,10 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, m
     gain : float
         Lit gain of the frame relative to the reference
         (:func:`shadowcam.photometric.estimate_gain`; shift-insensitive).
+    valid : (H, W) bool ndarray, optional
+        Pixels that may be used; the others (the sky, whose brightness
+        relative to the terrain changes at sunset, so that the skyline's
+        band-pass response changes) are excluded with the same margin.
     max_ratio : float, optional
         A pixel lit in the reference whose ``luma / reference`` fell below
         ``max_ratio * gain`` has been reached by the shadow.
@@ -71,8 +75,9 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, m
     Returns
     -------
     (H, W) float32 ndarray of 0 / 1
-        Zero on changed pixels (the moving shadow edge) and the border; the
-        sky, the static shadows and the static lit parts are kept.
+        Zero on changed pixels (the moving shadow edge), on the reference's
+        lit / shadow boundary, on invalid pixels and the border, each widened
+        by `margin`; static shadows and static lit parts are kept.
     """
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
@@ -83,6 +88,10 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, max_ratio=0.5, m
     if not gain > 0:
         raise ValueError(f"gain must be positive; got {gain}")
     changed = lit & (luma < max_ratio * gain * ref)
+    # the reference's own shadow edge: a small move of it changes pixels less than max_ratio
+    changed |= lit & (cv2.dilate((~lit).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
+    if valid is not None:
+        changed |= ~np.asarray(valid, dtype=bool)
     size = 2 * int(margin) + 1
     changed = cv2.dilate(changed.astype(np.uint8), np.ones((size, size), np.uint8)) > 0
     weight = (~changed).astype(np.float32)
@@ -118,7 +127,7 @@ def apply_shift(image, shift, *, interpolation=cv2.INTER_CUBIC):
 
 
 def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, initial=(0.0, 0.0),
-                                       max_iter=10, tol=1e-3):
+                                       max_iter=10, tol=1e-3, min_weight=200.0, max_shift=5.0):
     """Estimate the translation of a frame relative to the reference.
 
     Lucas & Kanade (1981), "An iterative image registration technique",
@@ -135,13 +144,20 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     max_iter : int, optional
     tol : float, optional
         Stop when the update is below `tol` pixels.
+    min_weight : float, optional
+        With less total weight (about: usable pixels) the problem is
+        ill-posed and `initial` is returned unchanged.
+    max_shift : float, optional
+        A solution further than this from `initial` (pixels) is rejected
+        (divergence) and `initial` is returned.
 
     Returns
     -------
     shift : (2,) float64 ndarray
-        ``(shift_row, shift_col)``.
+        ``(shift_row, shift_col)``; `initial` when the estimate failed.
     residual : float
-        Weighted RMS of the band-passed difference after alignment.
+        Weighted RMS of the band-passed difference after alignment; NaN when
+        the estimate failed.
     """
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
@@ -155,15 +171,18 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     grad_row, grad_col = np.gradient(target)
     normal = np.array([[np.sum(weight * grad_row**2), np.sum(weight * grad_row * grad_col)],
                        [np.sum(weight * grad_row * grad_col), np.sum(weight * grad_col**2)]])
-    shift = np.asarray(initial, dtype=np.float64).copy()
-    if np.linalg.cond(normal) > 1e8:
-        return shift, float("nan")
+    start = np.asarray(initial, dtype=np.float64).copy()
+    shift = start.copy()
+    if weight.sum() < min_weight or np.linalg.cond(normal) > 1e8:
+        return start, float("nan")
     error = None
     for _ in range(max_iter):
         error = bandpass_log(apply_shift(luma, shift)).astype(np.float64) - target
         rhs = -np.array([np.sum(weight * grad_row * error), np.sum(weight * grad_col * error)])
         step = np.linalg.solve(normal, rhs)
         shift += step
+        if np.max(np.abs(shift - start)) > max_shift:
+            return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
     error = bandpass_log(apply_shift(luma, shift)).astype(np.float64) - target

@@ -17,7 +17,7 @@ import numpy as np
 from shadowcam.registration import apply_shift
 
 
-def make_timelapse(*, height=40, width=48, n_frames=30, interval=60.0, speed=0.6, slope=0.15, y0=30.0,
+def make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.5, slope=0.15, y0=50.0,
                    sky_rows=6, seed=0, shake=0.0, noise=False, gain_steps=False, jitter=0.0, drop=(),
                    sun_fade=0.0, ss=8):
     """Return a dict with ``frames (T, H, W, 3)`` float32, ``time_s``, ``arrival_s (H, W)``
