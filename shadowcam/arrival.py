@@ -96,37 +96,53 @@ class CoverageCrossing:
     level : float, optional
         The coverage level whose crossing is the arrival (0.5 = half the
         footprint shadowed).
+    confirm : bool, optional
+        A crossing counts only if the next frame is still below `level`
+        (a cloud or a noisy frame darkening a pixel for one frame is not an
+        arrival); a crossing in the last interval is kept.
 
     Notes
     -----
-    State is two ``(H, W)`` arrays (previous coverage and arrival), so memory
-    does not depend on the number of frames. Feed frames in time order with
-    :meth:`update`; read :attr:`arrival_s`.
+    State is a few ``(H, W)`` arrays (previous coverage, pending and final
+    arrival), so memory does not depend on the number of frames. Feed frames
+    in time order with :meth:`update`; read :attr:`arrival_s`.
     """
 
-    def __init__(self, shape, *, eligible, level=0.5):
+    def __init__(self, shape, *, eligible, level=0.5, confirm=True):
         self.eligible = np.asarray(eligible, dtype=bool)
         if self.eligible.shape != tuple(shape):
             raise ValueError(f"eligible {self.eligible.shape} must have shape {tuple(shape)}")
         self.level = float(level)
-        self.arrival_s = np.full(tuple(shape), np.nan)
+        self.confirm = bool(confirm)
+        self._arrival = np.full(tuple(shape), np.nan)
+        self._pending = np.full(tuple(shape), np.nan)
         self._previous = None
         self._time = None
+
+    @property
+    def arrival_s(self):
+        """(H, W) float64 ndarray: arrival seconds so far (NaN = none)."""
+        return np.where(np.isnan(self._arrival), self._pending, self._arrival)
 
     def update(self, cover, time_s):
         """Add the coverage ``(H, W)`` of the next frame, taken at `time_s` seconds."""
         cover = np.asarray(cover, dtype=np.float64)
-        if cover.shape != self.arrival_s.shape:
-            raise ValueError(f"cover {cover.shape} must have shape {self.arrival_s.shape}")
+        if cover.shape != self._arrival.shape:
+            raise ValueError(f"cover {cover.shape} must have shape {self._arrival.shape}")
         if self._previous is not None:
             if time_s <= self._time:
                 raise ValueError(f"time_s must increase: got {time_s} after {self._time}")
-            prev = self._previous
             with np.errstate(invalid="ignore"):
-                cross = (prev >= self.level) & (cover < self.level) & self.eligible & np.isnan(self.arrival_s)
+                below = cover < self.level
+                pending = np.isfinite(self._pending)
+                confirmed = pending & below
+                self._arrival[confirmed] = self._pending[confirmed]
+                self._pending[pending] = np.nan
+                prev = self._previous
+                cross = (prev >= self.level) & below & self.eligible & np.isnan(self._arrival)
             frac = (prev - self.level) / np.where(prev > cover, prev - cover, 1.0)
             value = self._time + np.clip(frac, 0.0, 1.0) * (time_s - self._time)
-            self.arrival_s[cross] = value[cross]
+            (self._pending if self.confirm else self._arrival)[cross] = value[cross]
         self._previous = cover
         self._time = float(time_s)
 

@@ -5,7 +5,8 @@ With the shifts, gains and per-pixel levels of the first pass
 (lit fraction, :func:`shadowcam.photometric.coverage`); frame differencing
 against the previous coverage gives the band where the edge moved
 (:mod:`shadowcam.frame_difference`); the edge of every column is located with
-sub-pixel precision (:mod:`shadowcam.edge_tracking`) and the per-pixel
+sub-pixel precision (:mod:`shadowcam.edge_tracking`), preferring transitions
+in the band or near the column's most recent edge (tracking) and the per-pixel
 coverage crossing is accumulated (:class:`shadowcam.arrival.CoverageCrossing`).
 The lit level of each pixel follows slow shading changes (the sun moves) while
 the pixel is fully lit and well above the edge. Memory is a few ``(H, W)``
@@ -77,6 +78,7 @@ class EdgeTracker:
         self.band_fraction = np.zeros(n_frames, dtype=np.float32)
         self.crossing = CoverageCrossing((height, width), eligible=self.lit_at_start & self.valid)
         self._previous = None
+        self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
         self._k = 0
         self._centre = np.arange(height, dtype=np.float32)[:, None] + 0.5
 
@@ -92,9 +94,10 @@ class EdgeTracker:
         if self._previous is not None:
             band = difference_band(self._previous, cover, valid=self.valid, **self.band_options)
             self.band_fraction[k] = band[self.valid].mean() if self.valid.any() else 0.0
-        previous_edge = self.edge_row[k - 1] if k else None
         self.edge_row[k], self.confidence[k], self.n_transitions[k] = column_edges(
-            cover, valid=self.valid, band=band, previous=previous_edge, **self.options)
+            cover, valid=self.valid, band=band, previous=self._last_edge if k else None, **self.options)
+        found = np.isfinite(self.edge_row[k])
+        self._last_edge[found] = self.edge_row[k][found]
         self.crossing.update(cover, self.time_s[k])
         if self.lit_update > 0:
             with np.errstate(invalid="ignore"):

@@ -117,7 +117,9 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
     pixels : (H, W) bool ndarray
         Candidate pixels (e.g. sunlit in the reference).
     prior : float, optional
-        Expected gain (previous frame's, or from exposure metadata).
+        Expected gain (previous frame's, or from exposure metadata). If too
+        few pixels lie near it (a global change: cloud, missed exposure
+        step), the search restarts from the 90th percentile of the ratios.
     min_ratio : float, optional
         Pixels whose ratio is below ``min_ratio`` times the current estimate
         are taken as having changed state (newly shadowed) and are ignored.
@@ -140,14 +142,20 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
         raise ValueError(f"prior must be positive; got {prior}")
     use = pixels & (ref > 0)
     ratio = luma[use] / ref[use]
-    gain, kept = float(prior), 0
-    for _ in range(iterations):
-        keep = (ratio > min_ratio * gain) & (ratio < gain / min_ratio)
-        kept = int(keep.sum())
-        if kept < 10:
-            return float(prior), kept
-        gain = float(np.median(ratio[keep]))
-    return gain, kept
+    if ratio.size < 10:
+        return float(prior), int(ratio.size)
+    starts = (float(prior), float(np.percentile(ratio, 90)))
+    for start in starts:
+        gain, kept = start, 0
+        for _ in range(iterations):
+            keep = (ratio > min_ratio * gain) & (ratio < gain / min_ratio)
+            kept = int(keep.sum())
+            if kept < 10:
+                break
+            gain = float(np.median(ratio[keep]))
+        if kept >= max(10, 0.05 * ratio.size):
+            return gain, kept
+    return float(prior), kept
 
 
 def coverage(luma, *, lit_level, shadow_level):

@@ -18,11 +18,15 @@ def test_edge_crossing_is_exact_for_a_linearly_moving_edge_with_irregular_times(
 
 
 def test_coverage_crossing_interpolates_linearly_and_keeps_the_first():
-    crossing = CoverageCrossing((1, 2), eligible=np.ones((1, 2), bool))
+    crossing = CoverageCrossing((1, 2), eligible=np.ones((1, 2), bool), confirm=False)
+    confirmed = CoverageCrossing((1, 2), eligible=np.ones((1, 2), bool))
     for t, c in [(0.0, [1.0, 1.0]), (10.0, [0.7, 0.2]), (30.0, [0.3, 0.9]), (40.0, [0.0, 0.0])]:
         crossing.update(np.array([c]), t)
+        confirmed.update(np.array([c]), t)
     # pixel 0: 0.7 -> 0.3 between 10 s and 30 s crosses 0.5 at 20 s; pixel 1: first drop, 1.0 -> 0.2
     np.testing.assert_allclose(crossing.arrival_s, [[20.0, 10.0 * 0.5 / 0.8]])
+    # confirmed: pixel 1's one-frame dip is ignored; its crossing 0.9 -> 0.0 in the last interval is kept
+    np.testing.assert_allclose(confirmed.arrival_s, [[20.0, 30.0 + 10.0 * 0.4 / 0.9]])
     with pytest.raises(ValueError, match="increase"):
         crossing.update(np.zeros((1, 2)), 40.0)
 
