@@ -9,11 +9,10 @@ add_parser : register the step and its options.
 run : compute and write the arrival map.
 """
 
-import numpy as np
-
 from shadowcam.arrival import arrival_from_edges, combine_arrivals, time_to_frame
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
+from shadowcam.frame_times import median_interval
 from shadowcam.outdoor_datasets import arrival_dataset
 
 
@@ -35,7 +34,7 @@ def run(args):
     photometry = open_dataset(args.photometry)
     edges = open_dataset(args.edges)
     time_s = edges["time_s"].values
-    interval = float(np.median(np.diff(time_s)))
+    interval = median_interval(time_s)
     sky = photometry["sky"].values.astype(bool)
     lit = photometry["lit_at_start"].values.astype(bool)
     edge_s = arrival_from_edges(edges["edge_row"].values, time_s, eligible=lit & ~sky)

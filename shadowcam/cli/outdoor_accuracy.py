@@ -22,6 +22,7 @@ import numpy as np
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import iter_frames, open_dataset
 from shadowcam.frame_store import open_frames
+from shadowcam.frame_times import median_interval
 from shadowcam.ground_truth import load_ground_truth
 from shadowcam.image_io import atomic_path
 from shadowcam.manifest import load_manifest
@@ -84,7 +85,7 @@ def run(args):
         "coverage_crossing": arrival["coverage_arrival_s"].values,
         "naive_baseline": baseline.arrival_s,
     }
-    interval = float(np.median(np.diff(time_s)))
+    interval = median_interval(time_s)
     report = evaluate_arrivals(estimates, truth, interval_s=interval, condition=_condition(params, manifest))
     report["false_arrivals"] = {name: false_arrivals(est, truth) for name, est in estimates.items()}
     if "pb_edge_y" in truth and truth["pb_edge_y"].shape == edges["edge_row"].shape:

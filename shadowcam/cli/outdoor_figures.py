@@ -20,6 +20,7 @@ from shadowcam.arrival import ARRIVAL_REASONS
 from shadowcam.cli.outdoor_io import open_dataset
 from shadowcam.figures import save_png
 from shadowcam.frame_store import open_frames
+from shadowcam.frame_times import median_interval
 from shadowcam.image_io import atomic_path
 from shadowcam.outdoor_figures import arrival_map_figure, edge_over_time_figure, keyframes_figure, pushbroom_figure
 from shadowcam.pushbroom import resample_uniform_time
@@ -83,7 +84,7 @@ def run(args):
              outdir / "edge_over_time.png")
     save_png(arrival_map_figure(arrival["arrival_time_s"].values, sky=sky), outdir / "arrival_map.png")
     uniform_t, uniform = resample_uniform_time(pushbroom["pushbroom"].values, time_s,
-                                               step_s=float(np.median(np.diff(time_s))))
+                                               step_s=median_interval(time_s))
     save_png(pushbroom_figure(reference, uniform, uniform_t, sky=sky), outdir / "pushbroom.png")
     reasons = arrival["reason"].values
     counts = {name: int((reasons == code).sum()) for code, name in ARRIVAL_REASONS.items()}

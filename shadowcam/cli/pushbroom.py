@@ -10,9 +10,8 @@ add_parser : register the step and its options.
 run : assemble and write the pushbroom.
 """
 
-import numpy as np
-
 from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
+from shadowcam.frame_times import median_interval
 from shadowcam.image_io import atomic_path, write_png_preview
 from shadowcam.outdoor_datasets import pushbroom_dataset
 from shadowcam.pushbroom import assemble_pushbroom, resample_uniform_time
@@ -38,6 +37,6 @@ def run(args):
     write_dataset(pushbroom_dataset(image, edges["edge_row"].values, time_s), args.out,
                   config={"colour": "registered first frame"}, checksums=input_checksums(photometry, edges),
                   step="pushbroom")
-    _, uniform = resample_uniform_time(image, time_s, step_s=float(np.median(np.diff(time_s))))
+    _, uniform = resample_uniform_time(image, time_s, step_s=median_interval(time_s))
     with atomic_path(args.png) as tmp:
         write_png_preview(tmp, uniform[::-1])

@@ -12,9 +12,12 @@ add_parser : register the step and its options.
 run : track and write the dataset.
 """
 
+import json
+
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import input_checksums, iter_frames, open_dataset, write_dataset
 from shadowcam.frame_store import open_frames
+from shadowcam.frame_times import find_gaps, median_interval
 from shadowcam.keyframes import interpolate_edges, select_keyframes
 from shadowcam.outdoor_datasets import edges_dataset, photometry_arrays
 from shadowcam.outdoor_tracking import track_frames
@@ -51,5 +54,6 @@ def run(args):
         min_confidence=key_options.get("min_confidence", 0.6))
     dataset = edges_dataset(tracked, arrays, time_s, edge_row=edge_row, is_keyframe=is_keyframe,
                             interpolated=interpolated)
+    dataset.attrs.update(median_interval_s=median_interval(time_s), gaps=json.dumps(find_gaps(time_s)))
     write_dataset(dataset, args.out, config=params, checksums=input_checksums(frames, photometry),
                   step="track-edges")
