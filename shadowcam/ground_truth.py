@@ -124,12 +124,38 @@ _OUTDOOR_NPZ_VARS = {
 }
 
 
+def _wrong_dims(dataset, required):
+    """Names (with dims) of `required` variables missing from `dataset` or with other dims."""
+    return [f"{name} {dims}" for name, dims in required.items()
+            if name not in dataset or tuple(dataset[name].dims) != dims]
+
+
+def _npz_data_vars(arrays, table):
+    """``{key: (dims, array, attrs)}`` for the keys of `table` present in `arrays`, ndim checked."""
+    data_vars = {}
+    for key, (dims, attrs) in table.items():
+        if key in arrays:
+            value = np.asarray(arrays[key])
+            if value.ndim != len(dims):
+                raise ValueError(f"gt.npz key {key!r} has shape {value.shape}, expected dims {dims}")
+            data_vars[key] = (dims, value, attrs)
+    return data_vars
+
+
+def _as_bool(dataset, names):
+    """`dataset` with the variables `names` (those present) cast to bool."""
+    for name in names:
+        if name in dataset:
+            dataset[name] = dataset[name].astype(bool)
+    return dataset
+
+
+_OUTDOOR_MASKS = ("sky_mask", "never_shadowed", "shadowed_at_start", "always_shadowed", "relit_after_arrival")
+
+
 def check_outdoor_ground_truth(dataset):
     """Raise ValueError unless `dataset` has the standard outdoor variables with their dims."""
-    problems = [
-        f"{name} {dims}" for name, dims in OUTDOOR_REQUIRED.items()
-        if name not in dataset or tuple(dataset[name].dims) != dims
-    ]
+    problems = _wrong_dims(dataset, OUTDOOR_REQUIRED)
     if problems:
         raise ValueError(f"outdoor ground truth lacks (or has wrong dims for): {', '.join(problems)}")
     return dataset
@@ -154,13 +180,7 @@ def mitsuba_outdoor_npz_to_dataset(arrays):
     missing = [k for k in OUTDOOR_REQUIRED if k not in arrays]
     if missing:
         raise ValueError(f"outdoor gt.npz arrays lack required keys {missing}")
-    data_vars = {}
-    for key, (dims, attrs) in _OUTDOOR_NPZ_VARS.items():
-        if key in arrays:
-            value = np.asarray(arrays[key])
-            if value.ndim != len(dims):
-                raise ValueError(f"gt.npz key {key!r} has shape {value.shape}, expected dims {dims}")
-            data_vars[key] = (dims, value, attrs)
+    data_vars = _npz_data_vars(arrays, _OUTDOOR_NPZ_VARS)
     height, width = np.shape(arrays["shadow_class"])
     coords = {
         "row": np.arange(height),
@@ -168,10 +188,7 @@ def mitsuba_outdoor_npz_to_dataset(arrays):
         "time": ("time", np.arange(np.size(arrays["times_s"])), {"units": "frame"}),
         "channel": np.array(["R", "G", "B"], dtype=object),
     }
-    dataset = xr.Dataset(data_vars, coords=coords)
-    for name in ("sky_mask", "never_shadowed", "shadowed_at_start", "always_shadowed", "relit_after_arrival"):
-        if name in dataset:
-            dataset[name] = dataset[name].astype(bool)
+    dataset = _as_bool(xr.Dataset(data_vars, coords=coords), _OUTDOOR_MASKS)
     if "definitions" in arrays:
         dataset.attrs["definitions"] = str(np.asarray(arrays["definitions"]))
     return check_outdoor_ground_truth(dataset)
@@ -179,10 +196,7 @@ def mitsuba_outdoor_npz_to_dataset(arrays):
 
 def check_ground_truth(dataset):
     """Raise ValueError unless `dataset` has the standard variables with their dims."""
-    problems = [
-        f"{name} {dims}" for name, dims in REQUIRED.items()
-        if name not in dataset or tuple(dataset[name].dims) != dims
-    ]
+    problems = _wrong_dims(dataset, REQUIRED)
     if problems:
         raise ValueError(f"ground truth lacks (or has wrong dims for): {', '.join(problems)}")
     return dataset
@@ -207,13 +221,7 @@ def mitsuba_lab_npz_to_dataset(arrays):
     missing = [k for k in REQUIRED if k not in arrays]
     if missing:
         raise ValueError(f"gt.npz arrays lack required keys {missing}")
-    data_vars = {}
-    for key, (dims, attrs) in _LAB_NPZ_VARS.items():
-        if key in arrays:
-            value = np.asarray(arrays[key])
-            if value.ndim != len(dims):
-                raise ValueError(f"gt.npz key {key!r} has shape {value.shape}, expected dims {dims}")
-            data_vars[key] = (dims, value, attrs)
+    data_vars = _npz_data_vars(arrays, _LAB_NPZ_VARS)
     skipped = sorted(set(arrays) - set(_LAB_NPZ_VARS))
     if skipped:
         log.debug("gt.npz keys not converted: %s", skipped)
@@ -228,10 +236,8 @@ def mitsuba_lab_npz_to_dataset(arrays):
         "xyz": np.array(["x", "y", "z"], dtype=object),
         "cam_axis": np.array(["col", "row"], dtype=object),
     }
-    dataset = xr.Dataset(data_vars, coords=coords)
-    for name in ("lit", "dual_cam_visible", "hit", "dual_hit", "valid_u", "valid_v"):
-        if name in dataset:
-            dataset[name] = dataset[name].astype(bool)
+    dataset = _as_bool(xr.Dataset(data_vars, coords=coords),
+                       ("lit", "dual_cam_visible", "hit", "dual_hit", "valid_u", "valid_v"))
     return check_ground_truth(dataset)
 
 
@@ -252,11 +258,7 @@ def _load_mitsuba_outdoor_npz(path):
 
 
 def _load_shadowcam_outdoor_nc(path):
-    dataset = _load_shadowcam_nc(path)
-    for name in ("sky_mask", "relit_after_arrival", "never_shadowed", "shadowed_at_start", "always_shadowed"):
-        if name in dataset:
-            dataset[name] = dataset[name].astype(bool)
-    return dataset
+    return _as_bool(_load_shadowcam_nc(path), _OUTDOOR_MASKS)
 
 
 #: ground_truth.format -> loader(path) -> Dataset

@@ -119,12 +119,20 @@ GT_DEFINITIONS = {
 PRIMARY_DEFINITION = "pixel_centre"
 
 
-def check_targets(stats, *, condition):
-    """Return a list of ``{name, value, bound, pass}`` for the targets of `condition`."""
+def check_targets(stats, *, condition, estimator="combined"):
+    """Return the target checks of `condition` on `stats` (:func:`arrival_errors`).
+
+    Returns
+    -------
+    list of dict
+        ``{target, sweep, value, threshold, comparison, pass}`` (the layout of
+        :func:`shadowcam.accuracy.check_targets`; ``sweep`` names the estimator).
+    """
     if condition not in TARGETS:
         raise ValueError(f"condition must be one of {sorted(TARGETS)}; got {condition!r}")
     return [
-        {"name": name, "value": stats[name], "bound": bound, "pass": bool(stats[name] <= bound)}
+        {"target": name, "sweep": estimator, "value": stats[name], "threshold": bound, "comparison": "<=",
+         "pass": bool(stats[name] <= bound)}
         for name, bound in TARGETS[condition].items()
     ]
 
@@ -160,7 +168,7 @@ def evaluate_arrivals(estimates, truth, *, interval_s, condition, primary="combi
             definition: arrival_errors(estimate, truth[variable].values, evaluate=evaluate, interval_s=interval_s)
             for definition, variable in GT_DEFINITIONS.items() if variable in truth
         }
-    targets = check_targets(errors[primary][PRIMARY_DEFINITION], condition=condition)
+    targets = check_targets(errors[primary][PRIMARY_DEFINITION], condition=condition, estimator=primary)
     return {
         "errors": errors,
         "targets": targets,

@@ -13,12 +13,11 @@ add_parser : register the step and its options.
 run : evaluate and write the report.
 """
 
-import csv
-import json
 import logging
 
 import numpy as np
 
+from shadowcam.accuracy import report_to_csv, report_to_json
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import iter_frames, open_dataset
 from shadowcam.frame_store import open_frames
@@ -52,17 +51,6 @@ def _condition(params, manifest):
         return params["condition"]
     noise = manifest.get("ground_truth", {}).get("noise")
     return noise if noise in TARGETS else "nuisances"
-
-
-def _flatten(prefix, value, rows):
-    if isinstance(value, dict):
-        for key, item in value.items():
-            _flatten(f"{prefix}.{key}" if prefix else str(key), item, rows)
-    elif isinstance(value, list):
-        for item in value:
-            _flatten(f"{prefix}.{item.get('name', '')}", {k: v for k, v in item.items() if k != "name"}, rows)
-    else:
-        rows.append((prefix, value))
 
 
 def run(args):
@@ -107,13 +95,9 @@ def run(args):
                                   "max_abs_px": float(np.max(np.abs(np.r_[d_row, d_col])))}
     report["dataset"] = manifest["name"]
     with atomic_path(args.out_json) as tmp:
-        tmp.write_text(json.dumps(report, indent=2, default=float))
-    rows = []
-    _flatten("", report, rows)
-    with atomic_path(args.out_csv) as tmp, open(tmp, "w", newline="") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(["metric", "value"])
-        writer.writerows(rows)
+        tmp.write_text(report_to_json(report))
+    with atomic_path(args.out_csv) as tmp:
+        tmp.write_text(report_to_csv(report))
     primary = report["errors"]["combined"][report["primary_definition"]]
     log.info("combined vs %s: median %.3f p95 %.3f >5: %.2f%% coverage %.2f%% (targets %s)",
              report["primary_definition"], primary["median_abs"], primary["p95_abs"], 100 * primary["frac_over_5"],

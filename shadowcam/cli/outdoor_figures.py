@@ -51,7 +51,7 @@ def _accuracy_html(report):
                 f"<td>{100 * stats['frac_over_5']:.2f}%</td><td>{100 * stats['frac_within_1']:.2f}%</td>"
                 f"<td>{100 * stats['coverage']:.2f}%</td></tr>")
     targets = "".join(
-        f"<li>{html.escape(t['name'])} = {t['value']:.4f} (bound {t['bound']}): {'pass' if t['pass'] else 'FAIL'}</li>"
+        f"<li>{html.escape(t['target'])} = {t['value']:.4f} (&lt;= {t['threshold']}): {'pass' if t['pass'] else 'FAIL'}</li>"
         for t in report["targets"])
     return (
         "<html><body><h2>Outdoor arrival-time accuracy</h2>"
