@@ -24,6 +24,7 @@ include: "workflow/rules/dual.smk"
 include: "workflow/rules/accuracy.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/evaluate.smk"
+include: "workflow/rules/outdoor.smk"
 
 
 localrules:

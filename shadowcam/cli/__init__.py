@@ -24,6 +24,12 @@ STEPS = {
     "report-figures": "report_figures",
     "evaluate": "evaluate",
     "plan": "plan",
+    "outdoor-normalise": "outdoor_normalise",
+    "track-edges": "track_edges",
+    "arrival": "arrival",
+    "pushbroom": "pushbroom",
+    "outdoor-accuracy": "outdoor_accuracy",
+    "outdoor-figures": "outdoor_figures",
 }
 
 

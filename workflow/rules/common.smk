@@ -9,6 +9,8 @@
 # has_reference(ds)           capture has an unshadowed reference frame
 # uses_calibration(ds)        calibration sweeps exist and the configured model may use them
 # scene_sweeps(ds)            names of the scene sweeps (u, v)
+# is_outdoor(ds)              manifest kind is outdoor (time-lapse pipeline, workflow/rules/outdoor.smk)
+# outdoor_sweep(ds)           name of the time-lapse sweep of an outdoor dataset
 # get_*                       input / params functions of the rules
 import glob
 import json
@@ -117,8 +119,40 @@ def uses_calibration(ds):
     return has_calibration_sweeps(ds) and dual_model(ds) in ("auto", "calibration")
 
 
+def is_outdoor(ds):
+    """Return True if dataset `ds` is an outdoor time-lapse (manifest ``kind: outdoor``)."""
+    return load_dataset_manifest(ds).get("kind") == "outdoor"
+
+
+def outdoor_sweep(ds):
+    """Return the time-lapse sweep of outdoor dataset `ds`: ``timelapse``, or its only sweep."""
+    if is_synthetic(ds):
+        return "timelapse"
+    sweeps = list(load_dataset_manifest(ds).get("sweeps") or {})
+    if "timelapse" in sweeps or len(sweeps) == 1:
+        return "timelapse" if "timelapse" in sweeps else sweeps[0]
+    raise ValueError(
+        f"{manifest_path(ds)}: an outdoor dataset needs one sweep (preferably named 'timelapse'); "
+        f"found {sweeps or 'none'}"
+    )
+
+
+def outdoor_targets(ds):
+    """Return the final output files of outdoor dataset `ds` (list of str)."""
+    targets = [
+        f"results/{ds}/outdoor/arrival.nc",
+        f"results/{ds}/outdoor/pushbroom.nc",
+        f"results/{ds}/outdoor/figures",
+    ]
+    if has_ground_truth(ds):
+        targets += [f"results/{ds}/outdoor/accuracy.json", f"results/{ds}/outdoor/accuracy.csv"]
+    return targets
+
+
 def dataset_targets(ds):
     """Return the final output files of dataset `ds` (list of str)."""
+    if is_outdoor(ds):
+        return outdoor_targets(ds)
     targets = [
         f"results/{ds}/shadow_time.nc",
         f"results/{ds}/dual_coords.nc",
@@ -240,3 +274,19 @@ def get_dual_coords_params(wildcards):
 def get_evaluate_params(wildcards):
     """JSON ``--params`` of ``shadowcam evaluate``: config section ``evaluate``."""
     return as_json(config["evaluate"])
+
+def get_outdoor_frames(wildcards):
+    """Decoded frame store of the time-lapse sweep of an outdoor dataset."""
+    return f"results/{wildcards.ds}/frames/{outdoor_sweep(wildcards.ds)}.zarr"
+
+
+def get_outdoor_accuracy(wildcards):
+    """Outdoor accuracy report of the dataset, or an empty list if it has no ground truth."""
+    if has_ground_truth(wildcards.ds):
+        return [f"results/{wildcards.ds}/outdoor/accuracy.json"]
+    return []
+
+
+def get_outdoor_accuracy_option(wildcards, input):
+    """``--accuracy PATH`` for the outdoor figures when accuracy was computed, else empty."""
+    return f"--accuracy {input.accuracy}" if input.accuracy else ""
