@@ -42,7 +42,7 @@ from shadowcam.sun import SunPath, sun_colour
 from shadowcam.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
 
 #: azimuth spacing (deg) of the horizon table
-HORIZON_NODE_DEG = 2.5
+HORIZON_NODE_DEG = 1.0
 #: sky light (uniform dome) colour at the start elevation, linear RGB
 SKY_RGB_START = (0.12, 0.1425, 0.1875)
 #: exponents of the sky dimming factor per channel (red fades least: the sky warms)

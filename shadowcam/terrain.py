@@ -333,7 +333,7 @@ def intersect_heightfield(terrain, origins, directions, *, min_step=0.5, bisect_
     return dist
 
 
-def horizon_distances(terrain, *, ratio=1.07, first=1.0):
+def horizon_distances(terrain, *, ratio=1.05, first=1.0):
     """Horizontal probe distances (m) of :func:`horizon_angles`: geometric from `first` to the
     grid's diagonal, ``d[i+1] = ratio * d[i]``."""
     if not ratio > 1:
@@ -344,12 +344,13 @@ def horizon_distances(terrain, *, ratio=1.07, first=1.0):
 
 
 def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elevation_rad,
-                   bias=0.5, ratio=1.07, refine=8, block=1024):
+                   bias=0.5, ratio=1.05, refine=12, candidates=2, block=1024):
     """Elevation angle of the terrain horizon seen from `points` toward each azimuth.
 
     ``H(p, az) = atan(max_d (h(p + d e_az) - z_p - bias) / d)`` where ``d`` runs over the
     probe distances of :func:`horizon_distances` (inside the grid) plus `refine` evenly
-    spaced distances on each side of the best probe (between its neighbours), clipped to
+    spaced distances on each side of each of the `candidates` best probes (between its
+    second neighbours; each candidate outside the others' brackets), clipped to
     ``[min_elevation_rad, max_elevation_rad]``. At distance ``d`` the probes are
     ``(ratio - 1) d`` apart; on a smooth crest of curvature ``k`` the angle is then within
     ``k ((ratio - 1) d / refine)**2 / (8 d)`` rad of the continuous maximum. This sampled
@@ -369,7 +370,9 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
     ratio : float, keyword-only
         Ratio of successive probe distances.
     refine : int, keyword-only
-        Extra probes on each side of the best probe.
+        Extra probes on each side of a best probe.
+    candidates : int, keyword-only
+        Number of best probes refined.
     block : int, keyword-only
         (point, azimuth) pairs processed at once (memory ~ block x probes x 40 bytes).
 
@@ -408,24 +411,27 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
     todo = np.flatnonzero(best < tan_max)
     for lo in range(0, len(todo), block):
         sl = todo[lo:lo + block]
-        tan_b, k = _probe(grid, fa0[sl], fb0[sl], ea[sl], eb[sl], z0[sl], dist[None, :])
-        # refine between the best probe's neighbours
-        d_lo = dist[np.maximum(k - 1, 0)]
-        d_hi = dist[np.minimum(k + 1, len(dist) - 1)]
+        tan_b, top = _probe(grid, fa0[sl], fb0[sl], ea[sl], eb[sl], z0[sl], dist[None, :],
+                            candidates=candidates)
+        # refine between the neighbours of each of the best probes
         frac = np.linspace(0.0, 1.0, 2 * refine + 1)
-        fine = d_lo[:, None] + (d_hi - d_lo)[:, None] * frac[None, :]
+        d_lo = dist[np.maximum(top - 2, 0)]
+        d_hi = dist[np.minimum(top + 2, len(dist) - 1)]
+        fine = (d_lo[:, :, None] + (d_hi - d_lo)[:, :, None] * frac).reshape(len(sl), -1)
         tan_f, _ = _probe(grid, fa0[sl], fb0[sl], ea[sl], eb[sl], z0[sl], fine)
         best[sl] = np.maximum(tan_b, tan_f)
     best = np.clip(best, np.tan(min_elevation_rad), np.tan(max_elevation_rad))
     return np.arctan(best).reshape(n, m)
 
 
-def _probe(grid, fa0, fb0, ea, eb, z0, dist):
-    """Max over probes of ``(h - z0) / d`` and the index of the best probe.
+def _probe(grid, fa0, fb0, ea, eb, z0, dist, candidates=1):
+    """Max over probes of ``(h - z0) / d`` and the indices of the `candidates` best probes.
 
     `grid` is the height grid padded with a ring of very low values, `fa0`, `fb0` index it;
     `dist` is (1, S) (shared) or (B, S). float32 bilinear lookups on the flattened grid
-    (the hot loop of the renderer)."""
+    (the hot loop of the renderer). Returns ``(B,)`` maxima and ``(B, candidates)`` indices
+    of the best probes, each outside the bracket (index +-2) of the better ones.
+    """
     nb, na = grid.shape
     dist = np.asarray(dist, dtype=np.float32)
     fa = fa0.astype(np.float32)[:, None] + dist * ea.astype(np.float32)[:, None]
@@ -446,5 +452,12 @@ def _probe(grid, fa0, fb0, ea, eb, z0, dist):
     top += (bottom - top) * fb
     top -= z0.astype(np.float32)[:, None]
     top /= dist
-    k = np.argmax(top, axis=1)
-    return top[np.arange(len(k)), k].astype(np.float64), k
+    rows = np.arange(len(top))
+    k = np.empty((len(top), candidates), dtype=np.intp)
+    k[:, 0] = np.argmax(top, axis=1)
+    best = top[rows, k[:, 0]].astype(np.float64)
+    for c in range(1, candidates):  # next best probe outside the earlier ones' brackets
+        for j in (-2, -1, 0, 1, 2):
+            top[rows, np.clip(k[:, c - 1] + j, 0, top.shape[1] - 1)] = -np.inf
+        k[:, c] = np.argmax(top, axis=1)
+    return best, k
