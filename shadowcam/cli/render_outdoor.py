@@ -99,7 +99,7 @@ def render_outdoor_capture_dir(options, out_dir):
     ext = options["format"]
     times = capture.times_s
     ae_ev = gt["ae_ev"].values
-    exposure_s = outdoor["base_exposure_s"] * 2.0 ** ae_ev
+    exposure_s = np.round(outdoor["base_exposure_s"] * 2.0 ** ae_ev, 6)  # as written (1 us)
     start = _capture_start(scene.sun.hour_angle0_deg)
 
     with staging_dir(out_dir) as tmp:
