@@ -135,7 +135,8 @@ def shake_offsets(frames, *, seed, max_px=1.0):
     size = rng.uniform(0.6, 1.0, frames) * max_px
     jitter[gust] += (size * np.stack([np.cos(angle), np.sin(angle)], axis=1).T).T[gust]
     norm = np.hypot(jitter[:, 0], jitter[:, 1])
-    jitter *= np.minimum(1.0, max_px / np.maximum(norm, 1e-12))[:, None]
+    limit = max_px - 1e-4  # so that rounding to 1e-4 px stays within max_px
+    jitter *= np.minimum(1.0, limit / np.maximum(norm, 1e-12))[:, None]
     return np.round(jitter[:, 0], 4), np.round(jitter[:, 1], 4)
 
 
