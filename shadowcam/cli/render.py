@@ -172,6 +172,18 @@ def staging_dir(out_dir):
         raise
 
 
+def write_ground_truth(folder, gt, *, sensor, scale, config, checksums, **attrs):
+    """Write `gt` with the sensor's attrs, `attrs` and provenance as ``folder/ground_truth.nc``
+    and add its checksum to `checksums` (which, before, lists the capture's frames)."""
+    gt = gt.assign_attrs(
+        electrons_per_unit_radiance=scale, black_level=sensor.black_level,
+        white_level=sensor.white_level, read_noise_dn=sensor.read_noise,
+        gain_dn_per_electron=sensor.gain, **attrs)
+    gt = attach_provenance(gt, config=config, input_checksums=checksums, step="render")
+    gt.to_netcdf(folder / "ground_truth.nc", engine="h5netcdf")
+    checksums["ground_truth.nc"] = file_sha256(folder / "ground_truth.nc")
+
+
 def render_capture_dir(options, out_dir):
     """Render a capture described by `options` (see ``resolve_options``) into `out_dir`."""
     from shadowcam.lab_render import SWEEP_INDEX, prepare_capture
@@ -215,15 +227,11 @@ def render_capture_dir(options, out_dir):
             del frames
         checksums = {rel: file_sha256(tmp / rel) for rel in written}
         config = {k: options[k] for k in DEFAULTS}
-        gt = renderer.ground_truth.assign_attrs(
-            electrons_per_unit_radiance=scale, black_level=sensor.black_level,
-            white_level=sensor.white_level, read_noise_dn=sensor.read_noise,
-            gain_dn_per_electron=sensor.gain, frame_format=ext,
+        write_ground_truth(
+            tmp, renderer.ground_truth, sensor=sensor, scale=scale, config=config,
+            checksums=checksums, frame_format=ext,
             noise_seed="numpy.random.default_rng([seed, sweep_index, frame]); "
                        "sweep_index u=0 v=1 cal_u=2 cal_v=3 reference=9")
-        gt = attach_provenance(gt, config=config, input_checksums=checksums, step="render")
-        gt.to_netcdf(tmp / "ground_truth.nc", engine="h5netcdf")
-        checksums["ground_truth.nc"] = file_sha256(tmp / "ground_truth.nc")
         capture = {
             "name": options["name"],
             "kind": "lab",

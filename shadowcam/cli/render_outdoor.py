@@ -25,7 +25,7 @@ import logging
 import time
 
 from shadowcam import __version__
-from shadowcam.provenance import attach_provenance, file_sha256
+from shadowcam.provenance import file_sha256
 
 log = logging.getLogger(__name__)
 
@@ -75,7 +75,7 @@ def render_outdoor_capture_dir(options, out_dir):
     """
     import numpy as np
 
-    from shadowcam.cli.render import DEFAULTS, _write_frame, staging_dir
+    from shadowcam.cli.render import DEFAULTS, _write_frame, staging_dir, write_ground_truth
     from shadowcam.outdoor_capture import NUISANCES, edge_speed, render_outdoor_capture
     from shadowcam.outdoor_render import make_outdoor_scene
     from shadowcam.sensor import SensorModel, exposure_scale
@@ -135,10 +135,8 @@ def render_outdoor_capture_dir(options, out_dir):
                              {"units": "s", "long_name": "ExposureTime metadata"}),
             dn_per_radiance=((), scale * sensor.gain,
                              {"units": "DN", "long_name": "DN per unit radiance at gain 1"}))
-        gt = gt.assign_attrs(
-            electrons_per_unit_radiance=scale,
-            black_level=sensor.black_level, white_level=sensor.white_level,
-            read_noise_dn=sensor.read_noise, gain_dn_per_electron=sensor.gain,
+        write_ground_truth(
+            tmp, gt, sensor=sensor, scale=scale, config=config, checksums=checksums,
             frame_format=ext, base_exposure_s=outdoor["base_exposure_s"],
             edge_fast_pair_fraction=fast, edge_median_frames_per_px=frames_per_px,
             image_formation="L_k = sun + sky + skydome (cloud on the sun term); "
@@ -146,9 +144,6 @@ def render_outdoor_capture_dir(options, out_dir):
                             "DN = clip(round(black + Poisson(scale E_k) + N(0, read^2)))"
                             " on the RGGB mosaic",
             noise_seed=f"numpy.random.default_rng([seed, {TIMELAPSE_SWEEP_INDEX}, frame])")
-        gt = attach_provenance(gt, config=config, input_checksums=checksums, step="render")
-        gt.to_netcdf(tmp / "ground_truth.nc", engine="h5netcdf")
-        checksums["ground_truth.nc"] = file_sha256(tmp / "ground_truth.nc")
         description = {
             "name": options["name"],
             "kind": "outdoor",
