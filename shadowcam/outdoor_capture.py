@@ -31,6 +31,9 @@ from shadowcam.sun import elevation_azimuth, sun_colour
 #: nuisance switches and their defaults (all on)
 NUISANCES = {"auto_exposure": True, "shake_px": 1.0, "cloud": True, "irregular_timing": True,
              "dropped_frames": 2}
+#: the cloud shadow: depth (1 - minimum transmittance) and Gaussian radius on the ground (m)
+CLOUD_DEPTH = 0.5
+CLOUD_SIGMA_M = 150.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -56,9 +59,11 @@ class OutdoorCapture:
 
 
 def _cloud_path(scene, seed):
+    """Seeded straight drift of the cloud shadow: from the valley over the cliff toward the
+    plateau (+a), across a band of the view (b), during the whole sequence."""
     rng = np.random.default_rng([int(seed), 53])
-    a0, b0 = 150.0 + rng.uniform(-100, 100), -1700.0
-    va, vb = rng.uniform(-0.03, 0.03), 3400.0 / scene.duration_s
+    a0, b0 = -700.0, rng.uniform(-700.0, 100.0)
+    va, vb = 1600.0 / scene.duration_s, rng.uniform(-0.05, 0.05)
     start = scene.terrain.to_xy(a0, b0)
     end = scene.terrain.to_xy(a0 + va * scene.duration_s, b0 + vb * scene.duration_s)
     velocity = (np.asarray(end) - np.asarray(start)) / scene.duration_s
@@ -124,7 +129,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         trans = np.ones(len(samples.sky))
         if cloud_on:
             trans[hit] = nz.cloud_transmittance(samples.position[hit, :2], t, start_xy=start_xy,
-                                                velocity_xy=velocity_xy)
+                                                velocity_xy=velocity_xy, depth=CLOUD_DEPTH,
+                                                sigma_m=CLOUD_SIGMA_M)
         L, L_clear = frame_radiance(samples, scene, t, shape=(rows, cols), supersample=s,
                                     lit=lit_sub[k], cloud=trans if cloud_on else None)
         radiance.append(L)
@@ -236,7 +242,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         "dropped_nominal_indices": json.dumps(dropped.tolist()),
         "nuisances": json.dumps(opts),
         "cloud": json.dumps({"enabled": cloud_on, "model": "1 - depth exp(-|p_xy - c(t)|^2 / (2 sigma^2))",
-                             "depth": 0.5, "sigma_m": 250.0, "start_xy": start_xy.tolist(),
+                             "depth": CLOUD_DEPTH, "sigma_m": CLOUD_SIGMA_M,
+                             "start_xy": start_xy.tolist(),
                              "velocity_xy_m_per_s": velocity_xy.tolist()}),
         "class_counts": json.dumps({name: int((cls == c).sum()) for c, name in gt.SHADOW_CLASSES.items()}
                                    | {"relit_after_arrival": int(classes["relit_after_arrival"].sum()),
