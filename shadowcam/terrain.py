@@ -99,6 +99,15 @@ class Heightfield:
         Node spacing, metres.
     axis_azimuth_deg : float
         Compass azimuth of ``+a``.
+
+    Attributes
+    ----------
+    node_normals : (nb, na, 3) ndarray
+        Unit normals at the nodes (central differences), world coordinates.
+    lipschitz : float
+        Bound of the bilinear surface's slope (rise per horizontal metre).
+    z_max : float
+        Highest node.
     """
 
     z: np.ndarray
