@@ -9,9 +9,9 @@ Sun visibility (the one test used by the frames and the ground truth)::
 
     lit(p, t) = n(p) . l(t) > 0  and  elevation(t) > H(p, azimuth(t))
 
-with ``H`` the terrain horizon of :func:`shadowcam.terrain.horizon_angles` sampled at
-azimuth nodes ``HORIZON_NODE_DEG`` apart over the sun's path and linearly interpolated in
-azimuth. Radiance of a terrain sample (Lambertian, sun irradiance pi so a white surface
+with ``H`` the terrain horizon of :func:`shadowcam.terrain.horizon_angles` tabulated at
+azimuth nodes ``HORIZON_FINE_DEG`` apart over the sun's path (probed where the sun crosses
+it, see :func:`trace_samples`) and linearly interpolated in azimuth. Radiance of a terrain sample (Lambertian, sun irradiance pi so a white surface
 facing the sun has radiance 1)::
 
     L = albedo (lit cloud max(n.l, 0) sun_rgb(t) + (1 + n_z) / 2 sky_rgb(t))
@@ -41,8 +41,11 @@ from shadowcam.scene import camera_rays, look_at_camera
 from shadowcam.sun import SunPath, sun_colour
 from shadowcam.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
 
-#: azimuth spacing (deg) of the horizon table
+#: azimuth spacing (deg) of the coarse and the fine horizon table
 HORIZON_NODE_DEG = 1.0
+HORIZON_FINE_DEG = 0.25
+#: fine nodes are probed where the coarse horizon is within this of the sun's elevation (deg)
+HORIZON_REFINE_MARGIN_DEG = 0.5
 #: sky light (uniform dome) colour at the start elevation, linear RGB
 SKY_RGB_START = (0.12, 0.1425, 0.1875)
 #: exponents of the sky dimming factor per channel (red fades least: the sky warms)
@@ -162,7 +165,7 @@ class SampleGeometry:
         Unit view-ray directions (world).
     depth_z : (N,) ndarray
         Camera z of the terrain point (NaN sky).
-    horizon : (N, A) ndarray
+    horizon : (N, A) float32 ndarray
         Horizon elevation (rad) at the azimuth nodes (``-inf`` for sky samples).
     node_azimuth : (A,) ndarray
         Azimuth nodes (rad, in the branch of the sun path's azimuths).
@@ -189,21 +192,38 @@ def _azimuth_nodes(scene, node_deg):
     return start + step * np.arange(n + 2) - step  # one spare node each side
 
 
-def trace_samples(scene, x, y, *, node_deg=HORIZON_NODE_DEG):
+def _sun_elevation_at_azimuth(scene, azimuths):
+    """Elevation (rad) of the sun when it stands at `azimuths` (rad, node branch; clamped to
+    the sequence)."""
+    t = np.linspace(0.0, scene.duration_s, 2048)
+    e, a = scene.sun.elevation_azimuth(t)
+    a = np.unwrap(a)
+    a = a + (2 * np.pi) * np.round((azimuths[0] - a[0]) / (2 * np.pi))
+    return np.interp(azimuths, a, e)
+
+
+def trace_samples(scene, x, y, *, node_deg=HORIZON_NODE_DEG, fine_deg=HORIZON_FINE_DEG,
+                  margin_deg=HORIZON_REFINE_MARGIN_DEG):
     """Intersect the view rays through image points with the terrain; horizons of the hits.
+
+    The horizon table has nodes every `fine_deg` over the sun's azimuth range. It is probed
+    (:func:`shadowcam.terrain.horizon_angles`) every `node_deg`, interpolated linearly onto
+    the fine nodes, and probed again at the fine nodes where the interpolated horizon is
+    within `margin_deg` of the sun's elevation at that azimuth (where the sun crosses it).
 
     Parameters
     ----------
     scene : OutdoorScene
     x, y : (N,) ndarray
         Pixel-edge image coordinates (col, row).
-    node_deg : float, keyword-only
-        Azimuth spacing of the horizon table.
+    node_deg, fine_deg, margin_deg : float, keyword-only
 
     Returns
     -------
     SampleGeometry
     """
+    if not 0 < fine_deg <= node_deg:
+        raise ValueError(f"fine_deg: must be in (0, node_deg], got {fine_deg}")
     origins, dirs = camera_rays(scene.camera, x, y)
     dist = intersect_heightfield(scene.terrain, origins, dirs)
     sky = np.isnan(dist)
@@ -214,16 +234,28 @@ def trace_samples(scene, x, y, *, node_deg=HORIZON_NODE_DEG):
     normal[hit] = scene.terrain.normal(pos[hit, 0], pos[hit, 1])
     albedo[hit] = scene.terrain.albedo_at(pos[hit, 0], pos[hit, 1])
     depth = (pos - scene.camera.center) @ scene.camera.R[2]
-    nodes = _azimuth_nodes(scene, node_deg)
-    horizon = np.full((len(x), len(nodes)), -np.inf)
-    e_lo = np.radians(scene.end_elevation_deg) - np.radians(0.5)
-    e_hi = np.radians(scene.start_elevation_deg) + np.radians(0.5)
-    horizon[hit] = horizon_angles(scene.terrain, pos[hit], nodes, min_elevation_rad=e_lo,
-                                  max_elevation_rad=e_hi)
+    coarse = _azimuth_nodes(scene, node_deg)
+    ratio = int(round(node_deg / fine_deg))
+    fine = coarse[0] + np.radians(node_deg / ratio) * np.arange((len(coarse) - 1) * ratio + 1)
+    clip = dict(min_elevation_rad=np.radians(scene.end_elevation_deg - 0.5),
+                max_elevation_rad=np.radians(scene.start_elevation_deg + 0.5))
+    points = pos[hit]
+    h_coarse = horizon_angles(scene.terrain, points, coarse, **clip)
+    # linear interpolation onto the fine nodes (every ratio-th fine node is a coarse node)
+    j = np.arange(len(fine)) / ratio
+    j0 = np.minimum(j.astype(np.intp), len(coarse) - 2)
+    f = (j - j0).astype(np.float32)
+    h_fine = (h_coarse[:, j0] * (1 - f) + h_coarse[:, j0 + 1] * f).astype(np.float32)
+    near = np.abs(h_fine - _sun_elevation_at_azimuth(scene, fine)) < np.radians(margin_deg)
+    near[:, ::ratio] = False  # coarse nodes are probed already
+    rows, cols = np.nonzero(near)
+    h_fine[rows, cols] = horizon_angles(scene.terrain, points[rows], fine[cols],
+                                        pairwise=True, **clip)
+    horizon = np.full((len(x), len(fine)), -np.inf, dtype=np.float32)
+    horizon[hit] = h_fine
     ambient = albedo * (0.5 * (1.0 + normal[:, 2]))[:, None]
     return SampleGeometry(sky=sky, position=pos, normal=normal, albedo=albedo, ambient=ambient,
-                          view_dir=dirs,
-                          depth_z=depth, horizon=horizon, node_azimuth=nodes)
+                          view_dir=dirs, depth_z=depth, horizon=horizon, node_azimuth=fine)
 
 
 def sun_lit(geometry, sun, t_s):

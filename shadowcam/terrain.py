@@ -353,7 +353,7 @@ def horizon_distances(terrain, *, ratio=1.05, first=1.0):
 
 
 def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elevation_rad,
-                   bias=0.5, ratio=1.05, refine=12, candidates=2, block=1024):
+                   bias=0.5, ratio=1.05, refine=12, candidates=2, block=1024, pairwise=False):
     """Elevation angle of the terrain horizon seen from `points` toward each azimuth.
 
     ``H(p, az) = atan(max_d (h(p + d e_az) - z_p - bias) / d)`` where ``d`` runs over the
@@ -371,7 +371,7 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
     points : (N, 3) ndarray
         World points (on the terrain).
     azimuths_rad : (A,) ndarray
-        Compass azimuths (rad, clockwise from north).
+        Compass azimuths (rad, clockwise from north); with `pairwise`, (N,): one per point.
     min_elevation_rad, max_elevation_rad : float, keyword-only
         Clip range of the result (only the sun's elevation range matters).
     bias : float, keyword-only
@@ -384,27 +384,32 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
         Number of best probes refined.
     block : int, keyword-only
         (point, azimuth) pairs processed at once (memory ~ block x probes x 40 bytes).
+    pairwise : bool, keyword-only
+        Horizon of point i toward azimuth i only.
 
     Returns
     -------
-    (N, A) ndarray
+    (N, A) ndarray, or (N,) with `pairwise`
         Horizon elevation (rad).
     """
     points = np.asarray(points, dtype=np.float64)
     az = np.asarray(azimuths_rad, dtype=np.float64).ravel()
     if points.ndim != 2 or points.shape[1] != 3:
         raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    if pairwise and len(az) != len(points):
+        raise ValueError(f"azimuths_rad: pairwise needs one azimuth per point ({len(points)}), "
+                         f"got {len(az)}")
     if not min_elevation_rad < max_elevation_rad:
         raise ValueError("min_elevation_rad: must be below max_elevation_rad")
-    n, m = len(points), len(az)
+    n, m = (len(points), 1) if pairwise else (len(points), len(az))
     sp = terrain.spacing
     pa, pb = terrain.to_ab(points[:, 0], points[:, 1])
     # unit horizontal direction of each azimuth in (a, b): rotate the world (east, north)
     da, db = terrain.to_ab(np.sin(az), np.cos(az))
     fa0 = np.repeat((pa - terrain.a0) / sp, m)
     fb0 = np.repeat((pb - terrain.b0) / sp, m)
-    ea = np.tile(da / sp, n)
-    eb = np.tile(db / sp, n)
+    ea = da / sp if pairwise else np.tile(da / sp, n)
+    eb = db / sp if pairwise else np.tile(db / sp, n)
     z0 = np.repeat(points[:, 2] + bias, m)
     dist = horizon_distances(terrain, ratio=ratio)
     # pad with a very low ring: probes leaving the grid read huge negative heights (ignored)
@@ -430,7 +435,7 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
         tan_f, _ = _probe(grid, fa0[sl], fb0[sl], ea[sl], eb[sl], z0[sl], fine)
         best[sl] = np.maximum(tan_b, tan_f)
     best = np.clip(best, np.tan(min_elevation_rad), np.tan(max_elevation_rad))
-    return np.arctan(best).reshape(n, m)
+    return np.arctan(best) if pairwise else np.arctan(best).reshape(n, m)
 
 
 def _probe(grid, fa0, fb0, ea, eb, z0, dist, candidates=1):
