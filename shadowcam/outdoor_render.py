@@ -42,10 +42,10 @@ from shadowcam.sun import SunPath, sun_colour
 from shadowcam.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
 
 #: azimuth spacing (deg) of the coarse and the fine horizon table
-HORIZON_NODE_DEG = 1.0
+HORIZON_NODE_DEG = 2.0
 HORIZON_FINE_DEG = 0.25
 #: fine nodes are probed where the coarse horizon is within this of the sun's elevation (deg)
-HORIZON_REFINE_MARGIN_DEG = 0.5
+HORIZON_REFINE_MARGIN_DEG = 0.75
 #: sky light (uniform dome) colour at the start elevation, linear RGB
 SKY_RGB_START = (0.12, 0.1425, 0.1875)
 #: exponents of the sky dimming factor per channel (red fades least: the sky warms)
