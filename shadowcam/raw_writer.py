@@ -5,6 +5,7 @@ Offers
 write_dng : write a Bayer CFA mosaic as an uncompressed DNG that rawpy decodes exactly.
 write_tiff16 : write a (rows, cols, 3) uint16 linear RGB image as a TIFF.
 format_capture_time : EXIF ``YYYY:MM:DD HH:MM:SS`` string of a ``datetime``.
+format_subseconds : EXIF ``SubSecTimeOriginal`` digits of a ``datetime`` (ms or us).
 
 Both writers take the destination path first-class (this is an I/O module) and do no maths.
 The DNG is written with pidng: one uncompressed tile, ``BitsPerSample`` = the sensor bit
@@ -32,7 +33,17 @@ def format_capture_time(when):
     return when.strftime("%Y:%m:%d %H:%M:%S")
 
 
-def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_time=None):
+def format_subseconds(when):
+    """Return the sub-second part of `when` as EXIF SubSec digits: 3 digits (milliseconds)
+    when that is exact, else 6 (microseconds)."""
+    if not isinstance(when, datetime.datetime):
+        raise ValueError(f"when: expected a datetime.datetime, got {type(when).__name__}")
+    us = when.microsecond
+    return f"{us // 1000:03d}" if us % 1000 == 0 else f"{us:06d}"
+
+
+def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_time=None,
+              exposure_time=None):
     """Write a Bayer RGGB mosaic as an uncompressed DNG.
 
     Parameters
@@ -49,7 +60,10 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
     white_level : int, optional
         Saturation level in DN; default ``2**bit_depth - 1``.
     capture_time : datetime.datetime, optional
-        Written as ``DateTimeOriginal`` and ``DateTime``.
+        Written as ``DateTimeOriginal`` and ``DateTime``, its sub-seconds as
+        ``SubsecTimeOriginal`` (when not zero).
+    exposure_time : float, optional
+        Seconds, written as ``ExposureTime`` (a rational with denominator 10**6).
 
     Returns
     -------
@@ -103,6 +117,12 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
         stamp = format_capture_time(capture_time)
         tags.set(Tag.DateTimeOriginal, stamp)
         tags.set(Tag.DateTime, stamp)
+        if capture_time.microsecond:
+            tags.set(Tag.SubsecTimeOriginal, format_subseconds(capture_time))
+    if exposure_time is not None:
+        if not exposure_time > 0:
+            raise ValueError(f"exposure_time: must be positive seconds, got {exposure_time}")
+        tags.set(Tag.ExposureTime, [[int(round(exposure_time * 1e6)), 1000000]])
 
     path = Path(path)
     converter = RAW2DNG()

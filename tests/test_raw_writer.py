@@ -44,3 +44,17 @@ def test_tiff16_round_trips(tmp_path):
     np.testing.assert_array_equal(tifffile.imread(path), img)
     with pytest.raises(ValueError, match="image"):
         write_tiff16(tmp_path / "g.tiff", img.astype(np.float32))
+
+
+def test_dng_sub_second_capture_time_and_exposure_read_back(tmp_path):
+    from shadowcam.decode import header_metadata
+
+    raw = np.full((32, 48), 300, dtype=np.uint16)
+    when = datetime.datetime(2025, 1, 21, 15, 12, 49, 123000)
+    path = write_dng(tmp_path / "f.dng", raw, bit_depth=14, black_level=256,
+                     capture_time=when, exposure_time=0.00635)
+    meta = header_metadata(path)
+    assert meta["capture_time"] == when.isoformat()
+    assert meta["exposure_s"] == pytest.approx(0.00635, rel=1e-6)
+    with pytest.raises(ValueError, match="exposure_time"):
+        write_dng(tmp_path / "g.dng", raw, bit_depth=14, black_level=256, exposure_time=0.0)

@@ -1,4 +1,4 @@
-"""``shadowcam render``: render a synthetic lab capture (frames, reference, GT, capture.json).
+"""``shadowcam render``: render a synthetic capture (frames, GT, capture.json): lab or outdoor.
 
 Usage::
 
@@ -7,13 +7,16 @@ Usage::
         --format dng --bit-depth 12 [--no-noise] [--calibration] --out DIR
 
 The manifest's ``synthetic`` block (docs/contracts.md) gives the options; explicit flags
-override it. DIR receives ``frames_u/000000.dng ...``, ``frames_v/``, ``cal_u/``, ``cal_v/``
+override it. Outdoor captures (manifest ``kind: outdoor`` or scene ``ridge``, options in
+``synthetic.outdoor``) are written by :mod:`shadowcam.cli.render_outdoor`; the rest of this
+docstring describes lab captures. DIR receives ``frames_u/000000.dng ...``, ``frames_v/``, ``cal_u/``, ``cal_v/``
 (with calibration), ``reference.dng``, ``ground_truth.nc`` and ``capture.json`` (the capture
 description in the manifest structure). Everything is written to a temporary sibling
 directory first and renamed into place at the end, so a killed run leaves no half capture.
 """
 
 import argparse
+import contextlib
 import datetime
 import json
 import logging
@@ -33,8 +36,10 @@ log = logging.getLogger(__name__)
 DEFAULTS = {
     "scene": "tabletop", "seed": 0, "height": 192, "width": 192, "frames": 96,
     "format": "dng", "bit_depth": 12, "noise": True, "calibration": False,
-    "light": "point", "supersample": 4, "exposure": 0.8,
+    "light": "point", "supersample": 4, "exposure": 0.8, "outdoor": None,
 }
+#: scenes rendered by the outdoor branch
+OUTDOOR_SCENES = ("ridge",)
 FORMATS = ("dng", "tiff")
 BIT_DEPTHS = (8, 10, 12, 14, 16)
 #: capture start time written into the DNGs; frame k of every sweep is k seconds later
@@ -43,7 +48,7 @@ CAPTURE_START = datetime.datetime(2024, 1, 1, 0, 0, 0)
 
 def add_parser(subparsers, name):
     """Register the ``render`` step and return its parser."""
-    p = subparsers.add_parser(name, help="render a synthetic lab capture",
+    p = subparsers.add_parser(name, help="render a synthetic lab or outdoor capture",
                               description=__doc__,
                               formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--manifest", type=Path, help="data_manifest YAML with a 'synthetic' block")
@@ -97,7 +102,7 @@ def resolve_options(args):
     Returns
     -------
     options : dict
-        Keys of ``DEFAULTS`` plus ``name``, ``description``.
+        Keys of ``DEFAULTS`` plus ``name``, ``kind``, ``description``.
     """
     options = dict(DEFAULTS)
     manifest = {}
@@ -120,12 +125,14 @@ def resolve_options(args):
             raise ValueError(f"{key}: DNG frames need at least 22 pixels (LibRaw limit)")
     options["name"] = (args.name or manifest.get("name")
                        or f"synthetic_{options['scene']}_{options['seed']}")
+    options["kind"] = manifest.get(
+        "kind", "outdoor" if options["scene"] in OUTDOOR_SCENES else "lab")
     options["description"] = manifest.get(
-        "description", f"synthetic lab capture of scene {options['scene']!r}")
+        "description", f"synthetic {options['kind']} capture of scene {options['scene']!r}")
     return options
 
 
-def _write_frame(path, radiance, *, options, sensor, scale, seed, when):
+def _write_frame(path, radiance, *, options, sensor, scale, seed, when, exposure_time=None):
     from shadowcam.raw_writer import write_dng, write_tiff16
     from shadowcam.sensor import raw_to_linear, simulate_raw
 
@@ -133,12 +140,48 @@ def _write_frame(path, radiance, *, options, sensor, scale, seed, when):
         raw = simulate_raw(radiance, sensor=sensor, scale=scale, seed=seed,
                            noise=options["noise"], mosaic=True)
         write_dng(path, raw, bit_depth=sensor.bit_depth, black_level=sensor.black_level,
-                  capture_time=when)
+                  capture_time=when, exposure_time=exposure_time)
     else:
         dn = simulate_raw(radiance, sensor=sensor, scale=scale, seed=seed,
                           noise=options["noise"], mosaic=False)
         linear = raw_to_linear(dn, sensor=sensor)
         write_tiff16(path, np.clip(np.rint(linear * 65535.0), 0, 65535).astype(np.uint16))
+
+
+@contextlib.contextmanager
+def staging_dir(out_dir):
+    """Yield a temporary sibling of `out_dir`; on success rename it into place (replacing
+    an old `out_dir`), on any error remove it, so no half-written capture is left."""
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out_dir.parent / f".{out_dir.name}.tmp-{os.getpid()}"
+    if tmp.exists():
+        shutil.rmtree(tmp)
+    tmp.mkdir()
+    try:
+        yield tmp
+        old = None
+        if out_dir.exists():
+            old = out_dir.parent / f".{out_dir.name}.old-{os.getpid()}"
+            out_dir.rename(old)
+        tmp.rename(out_dir)
+        if old is not None:
+            shutil.rmtree(old)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def write_ground_truth(folder, gt, *, sensor, scale, config, checksums, **attrs):
+    """Write `gt` with the sensor's attrs, `attrs` and provenance as ``folder/ground_truth.nc``
+    and add its checksum to `checksums` (which, before, lists the capture's frames)."""
+    gt = gt.assign_attrs(
+        electrons_per_unit_radiance=scale, black_level=sensor.black_level,
+        white_level=sensor.white_level, read_noise_dn=sensor.read_noise,
+        gain_dn_per_electron=sensor.gain, **attrs)
+    gt = attach_provenance(gt, config=config, input_checksums=checksums, step="render")
+    gt.to_netcdf(folder / "ground_truth.nc", engine="h5netcdf")
+    checksums["ground_truth.nc"] = file_sha256(folder / "ground_truth.nc")
 
 
 def render_capture_dir(options, out_dir):
@@ -160,13 +203,7 @@ def render_capture_dir(options, out_dir):
     ext = options["format"]
     seed = int(options["seed"])
 
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out_dir.parent / f".{out_dir.name}.tmp-{os.getpid()}"
-    if tmp.exists():
-        shutil.rmtree(tmp)
-    tmp.mkdir()
-    try:
+    with staging_dir(out_dir) as tmp:
         written = []
         ref_name = f"reference.{ext}"
         _write_frame(tmp / ref_name, renderer.reference, options=options, sensor=sensor,
@@ -190,15 +227,11 @@ def render_capture_dir(options, out_dir):
             del frames
         checksums = {rel: file_sha256(tmp / rel) for rel in written}
         config = {k: options[k] for k in DEFAULTS}
-        gt = renderer.ground_truth.assign_attrs(
-            electrons_per_unit_radiance=scale, black_level=sensor.black_level,
-            white_level=sensor.white_level, read_noise_dn=sensor.read_noise,
-            gain_dn_per_electron=sensor.gain, frame_format=ext,
+        write_ground_truth(
+            tmp, renderer.ground_truth, sensor=sensor, scale=scale, config=config,
+            checksums=checksums, frame_format=ext,
             noise_seed="numpy.random.default_rng([seed, sweep_index, frame]); "
                        "sweep_index u=0 v=1 cal_u=2 cal_v=3 reference=9")
-        gt = attach_provenance(gt, config=config, input_checksums=checksums, step="render")
-        gt.to_netcdf(tmp / "ground_truth.nc", engine="h5netcdf")
-        checksums["ground_truth.nc"] = file_sha256(tmp / "ground_truth.nc")
         capture = {
             "name": options["name"],
             "kind": "lab",
@@ -225,16 +258,6 @@ def render_capture_dir(options, out_dir):
         with open(tmp / "capture.json", "w") as handle:
             json.dump(capture, handle, indent=2)
             handle.write("\n")
-        old = None
-        if out_dir.exists():
-            old = out_dir.parent / f".{out_dir.name}.old-{os.getpid()}"
-            out_dir.rename(old)
-        tmp.rename(out_dir)
-        if old is not None:
-            shutil.rmtree(old)
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
     log.info("capture %s written to %s in %.2f s", options["name"], out_dir,
              time.perf_counter() - started)
     return out_dir
@@ -245,4 +268,9 @@ def run(args):
     if args.manifest is None and args.scene is None:
         raise ValueError("give --manifest (with a 'synthetic' block) or --scene")
     options = resolve_options(args)
-    render_capture_dir(options, args.out)
+    if options["kind"] == "outdoor":
+        from shadowcam.cli.render_outdoor import render_outdoor_capture_dir
+
+        render_outdoor_capture_dir(options, args.out)
+    else:
+        render_capture_dir(options, args.out)
