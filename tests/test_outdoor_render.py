@@ -221,6 +221,18 @@ def test_outdoor_manifests_validate():
     assert on["auto_exposure"] and on["cloud"] and on["shake_px"] > 0 and on["dropped_frames"]
 
 
+def test_accuracy_condition_is_clean_only_without_any_nuisance():
+    from shadowcam.cli.render_outdoor import OUTDOOR_OPTIONS, accuracy_condition
+
+    clean = dict(OUTDOOR_OPTIONS, auto_exposure=False, shake_px=0, cloud=False,
+                 irregular_timing=False, dropped_frames=0)
+    assert accuracy_condition(False, clean) == "clean"
+    assert accuracy_condition(True, clean) == "nuisances"
+    for key, value in (("auto_exposure", True), ("shake_px", 0.5), ("cloud", True),
+                       ("irregular_timing", True), ("dropped_frames", 2)):
+        assert accuracy_condition(False, dict(clean, **{key: value})) == "nuisances"
+
+
 def test_render_cli_writes_an_outdoor_capture(tmp_path):
     from shadowcam.cli import main
     from shadowcam.sensor import mosaic_rggb
@@ -236,7 +248,9 @@ def test_render_cli_writes_an_outdoor_capture(tmp_path):
     cap = load_manifest(out / "capture.json")
     verify_checksums(cap)
     assert cap["kind"] == "outdoor" and cap["light"] == "distant"
-    assert cap["ground_truth"] == {"format": "shadowcam_outdoor_nc", "file": "ground_truth.nc"}
+    # auto-exposure steps and a dropped frame are nuisances: the nuisance targets apply
+    assert cap["ground_truth"] == {"format": "shadowcam_outdoor_nc", "file": "ground_truth.nc",
+                                   "noise": "nuisances"}
     paths = [Path(p) for p in cap["sweeps"]["timelapse"]["paths"]]
     assert len(paths) == 14
     gt = xr.open_dataset(out / "ground_truth.nc", engine="h5netcdf")

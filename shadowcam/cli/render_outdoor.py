@@ -15,6 +15,7 @@ scene is an outdoor scene (``ridge``). The output directory receives::
 Offers
 ------
 OUTDOOR_OPTIONS : keys of the ``synthetic.outdoor`` block and their defaults.
+accuracy_condition : ``clean`` or ``nuisances`` (which accuracy targets apply) from the options.
 outdoor_options : merge the ``outdoor`` block over the defaults (validated).
 render_outdoor_capture_dir : render and write a capture.
 """
@@ -41,6 +42,17 @@ OUTDOOR_OPTIONS = {
 TIMELAPSE_SWEEP_INDEX = 5
 #: calendar date written with the apparent solar time of each frame
 CAPTURE_DATE = datetime.date(2025, 1, 21)
+
+
+def accuracy_condition(noise, outdoor):
+    """Accuracy-target condition of a rendered time-lapse: ``clean`` or ``nuisances``.
+
+    A capture is clean when no nuisance of the issue's list is on: sensor noise,
+    auto-exposure steps, shake, cloud, irregular intervals, dropped frames.
+    """
+    nuisances = (noise, outdoor["auto_exposure"], outdoor["shake_px"] > 0, outdoor["cloud"],
+                 outdoor["irregular_timing"], outdoor["dropped_frames"] > 0)
+    return "nuisances" if any(nuisances) else "clean"
 
 
 def outdoor_options(block):
@@ -153,7 +165,8 @@ def render_outdoor_capture_dir(options, out_dir):
             "sweeps": {"timelapse": {"files": f"frames/*.{ext}"}},
             "timing": {"source": "sidecar", "file": "timestamps.json", "key": "times_s"},
             "checksums": checksums,
-            "ground_truth": {"format": "shadowcam_outdoor_nc", "file": "ground_truth.nc"},
+            "ground_truth": {"format": "shadowcam_outdoor_nc", "file": "ground_truth.nc",
+                             "noise": accuracy_condition(options["noise"], outdoor)},
             "provenance": (f"rendered by shadowcam {__version__} 'shadowcam render' (scene "
                            f"{options['scene']}, seed {seed}, {options['height']}x"
                            f"{options['width']}, {len(times)} frames, {ext} "
