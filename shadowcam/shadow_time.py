@@ -17,6 +17,8 @@ classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 lit_colour : unshadowed colour per pixel from a summary with channel sums.
+sweep_shadow_times : shadow times of one sweep from streamed frame blocks.
+summary_shadow_times : shadow times of one sweep from its (possibly merged) summary.
 """
 
 import numpy as np
@@ -486,9 +488,29 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
     results : dict of (H, W) ndarrays
         As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
     """
-    summary, lit_image, saturated = track_sweep(
-        blocks, shape, half_window=half_window, progress=progress
-    )
+    summary, _, _ = track_sweep(blocks, shape, half_window=half_window, progress=progress)
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+                                method_params=method_params, classify_params=classify_params)
+
+
+def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
+                         classify_params=None):
+    """Shadow times of one sweep from its :class:`DipSummary` (with channel sums).
+
+    Parameters
+    ----------
+    summary : DipSummary
+        Of a tracker fed ``(T, H, W, C)`` frames (whole sweep, or merged chunks).
+    method, cfa_pattern, method_params, classify_params
+        As :func:`sweep_shadow_times`.
+
+    Returns
+    -------
+    dict
+        As :func:`sweep_shadow_times`.
+    """
+    lit_image = lit_colour(summary)
+    shape = lit_image.shape[:2]
     classify_params = dict(classify_params or {})
     if cfa_pattern:
         colour = cfa_site_colours(shape, cfa_pattern)
@@ -496,7 +518,7 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
             site_colour=colour,
             site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],
         )
-    results = shadow_times(summary, method=method, saturated=saturated,
+    results = shadow_times(summary, method=method, saturated=summary.saturated,
                            method_params=method_params, **classify_params)
     results["lit_image"] = lit_image
     results["n_frames"] = summary.n_frames

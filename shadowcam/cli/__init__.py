@@ -22,6 +22,7 @@ STEPS = {
     "dual-view": "dual_view",
     "accuracy": "accuracy",
     "report-figures": "report_figures",
+    "bench": "bench",
 }
 
 
