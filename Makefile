@@ -1,5 +1,7 @@
 # shadowcam: `make demo` runs the default synthetic dataset end to end and builds the
-# report; `make test` runs the test suite; `make lint` lints the workflow.
+# report; `make test` runs the test suite; `make lint` lints the workflow;
+# `make bench` prints the speed benchmark (not part of the tests; ~10 min, renders
+# its DNG input once into results/bench/dng and reuses it).
 # Both install the package (editable, with test extras) into .venv first.
 
 PYTHON ?= python3
@@ -9,7 +11,9 @@ STAMP := $(VENV)/.installed
 SNAKEMAKE := $(BIN)/snakemake
 DATASET ?= synthetic_lab
 
-.PHONY: demo test lint install clean
+BENCH_ARGS ?=
+
+.PHONY: demo test lint bench install clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -30,6 +34,9 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/pytest -q
+
+bench: $(STAMP)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/shadowcam bench --dir results/bench/dng --json results/bench/figures.json $(BENCH_ARGS)
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint

@@ -23,6 +23,7 @@ include: "workflow/rules/shadow_time.smk"
 include: "workflow/rules/dual.smk"
 include: "workflow/rules/accuracy.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/methods.smk"
 
 
 localrules:

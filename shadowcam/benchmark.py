@@ -75,17 +75,26 @@ class WireScene:
         return (0.3 + 0.6 * fine).astype(np.float32)
 
     def frame(self, k, albedo):
-        """Radiance of frame `k`, ``(H, W, 3)`` float32."""
+        """Radiance of frame `k`, ``(H, W, 3)`` float32.
+
+        Only the few columns per row that the band can touch are computed.
+        """
         centre = self.px_per_frame * (k - self.t0)  # band centre in x + tilt * y
         half = 0.5 * self.width * self.px_per_frame
-        cols = np.arange(self.width_px, dtype=np.float64)[None, :]
-        lit = np.zeros((self.height, self.width_px))
+        reach = int(np.ceil(half)) + 2
+        rows = np.arange(self.height)
+        first = np.floor(centre - self.tilt * (rows + 0.5)).astype(int)[:, None] - reach
+        cols = first + np.arange(2 * reach + 1)[None, :]  # (H, m) candidate columns
+        lit = np.zeros(cols.shape)
         for s in range(self.subrows):
-            y = np.arange(self.height)[:, None] + (s + 0.5) / self.subrows
+            y = rows[:, None] + (s + 0.5) / self.subrows
             left = cols + self.tilt * y  # pixel spans [left, left + 1] in x + tilt * y
             covered = np.clip(np.minimum(left + 1, centre + half) - np.maximum(left, centre - half), 0, 1)
             lit += 1.0 - covered
-        return albedo * (lit / self.subrows).astype(np.float32)[..., None]
+        fraction = np.ones((self.height, self.width_px), np.float32)
+        inside = (cols >= 0) & (cols < self.width_px)
+        fraction[np.broadcast_to(rows[:, None], cols.shape)[inside], cols[inside]] = lit[inside] / self.subrows
+        return albedo * fraction[..., None]
 
     def truth(self):
         """Exact shadow time at pixel centres, ``(H, W)`` float64 (NaN outside the sweep)."""

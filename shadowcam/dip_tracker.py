@@ -34,9 +34,7 @@ DipPartial : the state of one time chunk (``save`` / ``load``).
 merge_partials : the summary of a sweep from its time chunks.
 """
 
-import os
 from dataclasses import dataclass, fields
-from pathlib import Path
 
 import numpy as np
 
@@ -151,11 +149,11 @@ class DipPartial:
     saturated: np.ndarray
 
     def save(self, path):
-        """Write to `path` (``.npz``) atomically: a temporary file, then a rename."""
-        path = Path(path)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
-        os.replace(tmp, path)
+        """Write to `path` (ending ``.npz``) atomically: a temporary file, then a rename."""
+        from shadowcam.image_io import atomic_path
+
+        with atomic_path(path) as tmp:
+            np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
 
     @classmethod
     def load(cls, path):

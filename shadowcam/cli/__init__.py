@@ -23,6 +23,7 @@ STEPS = {
     "accuracy": "accuracy",
     "report-figures": "report_figures",
     "bench": "bench",
+    "methods-comparison": "methods_comparison",
 }
 
 
