@@ -15,8 +15,9 @@ accurate) says which defaults the data justify.
   throughput is camera pixels per second; error is the gain-fitted relative
   RMSE against the reciprocal render inside the covered, visible mask.
 
-Each measurement runs twice: once timed, once under ``tracemalloc`` for the
-peak numpy/Python heap (compiled kernels' own buffers are not counted).
+Each measurement runs three times: a warm-up (compiled kernels load from their
+cache), once under ``tracemalloc`` for the peak numpy/Python heap (compiled
+kernels' own buffers are not counted), and once timed.
 
 Offers
 ------
@@ -38,16 +39,18 @@ from shadowcam.shadow_time import SHADOW_TIME_METHODS, summary_shadow_times, tra
 
 
 def _measured(call):
-    """Run `call` twice: timed, then under ``tracemalloc``; return (result, seconds, peak MiB)."""
-    start = time.perf_counter()
-    result = call()
-    seconds = time.perf_counter() - start
+    """Run `call` three times: to warm up (compiled kernels load), under ``tracemalloc``,
+    then timed; return (result, seconds, peak MiB)."""
+    call()
     tracemalloc.start()
     try:
         call()
         peak = tracemalloc.get_traced_memory()[1] / 2**20
     finally:
         tracemalloc.stop()
+    start = time.perf_counter()
+    result = call()
+    seconds = time.perf_counter() - start
     return result, seconds, peak
 
 
