@@ -244,6 +244,23 @@ def _white_balance_rgb(multipliers):
     return [mult[0] / mult[1], 1.0, mult[2] / mult[1]]
 
 
+def _normalise_in_place(image, black, span):
+    """``image = (image - black) / span`` in place; per-channel (3,) constants as scalars.
+
+    numpy broadcasts a (3,) operand over the last axis with a slow inner loop
+    of length 3 (~40x slower than a scalar), so each channel is done on its
+    strided view with scalar constants; full (M, N, 3) maps are used as they are.
+    """
+    if black.ndim == 1 and span.ndim == 1:
+        for c in range(image.shape[2]):
+            channel = image[..., c]
+            np.subtract(channel, black[c], out=channel)
+            np.divide(channel, span[c], out=channel)
+    else:
+        image -= black
+        np.divide(image, span, out=image)
+
+
 def _decode_raw(path):
     import rawpy
 
@@ -278,8 +295,7 @@ def _decode_raw(path):
     if np.any(span <= 0):
         raise ValueError(f"{path}: white level {white_sites.tolist()} not above black {black_sites.tolist()}")
     image = rgb.astype(np.float32)
-    image -= black
-    np.divide(image, span, out=image)
+    _normalise_in_place(image, black, span)
     header = header_metadata(path)
     bits = header["bits_per_sample"] or int(math.ceil(math.log2(white_sites.max() + 1)))
     info = {
