@@ -248,10 +248,14 @@ def _normalise_in_place(image, black, span):
     """``image = (image - black) / span`` in place; per-channel (3,) constants as scalars.
 
     numpy broadcasts a (3,) operand over the last axis with a slow inner loop
-    of length 3 (~40x slower than a scalar), so each channel is done on its
-    strided view with scalar constants; full (M, N, 3) maps are used as they are.
+    of length 3 (~40x slower than a scalar), so equal constants are applied as
+    scalars and different ones channel by channel on strided views; full
+    (M, N, 3) maps are used as they are.
     """
-    if black.ndim == 1 and span.ndim == 1:
+    if black.ndim == 1 and span.ndim == 1 and np.all(black == black[0]) and np.all(span == span[0]):
+        np.subtract(image, black[0], out=image)  # the same constants for every channel
+        np.divide(image, span[0], out=image)
+    elif black.ndim == 1 and span.ndim == 1:
         for c in range(image.shape[2]):
             channel = image[..., c]
             np.subtract(channel, black[c], out=channel)

@@ -40,7 +40,7 @@ def run(args):
     scene = WireScene(height=args.height, width_px=args.width, n_frames=args.frames,
                       px_per_frame=span / max(args.frames - 20, 1))
     figures = run_benchmark(args.dir, scene=scene, short=args.short, workers=args.workers,
-                            stage_frames=min(48, args.frames), log=lambda m: print(m, flush=True))
+                            stage_frames=min(240, args.frames), log=lambda m: print(m, flush=True))
     print()
     print(format_report(figures))
     if args.json:
