@@ -2,7 +2,9 @@
 # report; `make test` runs the test suite; `make lint` lints the workflow;
 # `make bench-outdoor` reruns the outdoor pipeline on dev_ridge and prints per-stage
 # wall time / peak memory and the arrival-time accuracy (ours and the naive baseline).
-# Both install the package (editable, with test extras) into .venv first.
+# `make bench` prints the speed benchmark (not part of the tests; ~10 min, renders
+# its DNG input once into results/bench/dng and reuses it).
+# Every target installs the package (editable, with test extras) into .venv first.
 
 PYTHON ?= python3
 VENV := .venv
@@ -12,8 +14,9 @@ SNAKEMAKE := $(BIN)/snakemake
 DATASET ?= synthetic_lab
 
 OUTDOOR ?= dev_ridge
+BENCH_ARGS ?=
 
-.PHONY: demo test lint install clean bench-outdoor
+.PHONY: demo test lint install clean bench bench-outdoor
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -44,6 +47,9 @@ bench-outdoor: $(STAMP)
 	[print(f\"{e:18s} {d:14s} median {s['median_abs']:.3f} p95 {s['p95_abs']:.3f} >5 {100*s['frac_over_5']:.2f}% \
 	within1 {100*s['frac_within_1']:.1f}% coverage {100*s['coverage']:.2f}%\") for e, by in r['errors'].items() for d, s in by.items()]; \
 	print('targets (' + r['condition'] + '):', 'met' if r['all_targets_pass'] else 'NOT met')"
+
+bench: $(STAMP)
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/shadowcam bench --dir results/bench/dng --json results/bench/figures.json $(BENCH_ARGS)
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint

@@ -25,6 +25,7 @@ include: "workflow/rules/accuracy.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/evaluate.smk"
 include: "workflow/rules/outdoor.smk"
+include: "workflow/rules/methods.smk"
 
 
 localrules:

@@ -37,12 +37,17 @@ _SQ_HI = 1.5 * 2.0**44  # (q + c) - c rounds q to a multiple of 2**-8
 _SQ_LO = 1.5 * 2.0**12  # ... and to a multiple of 2**-40
 _HALF = np.float32(0.5)
 _QUARTER = np.float32(0.25)
+_ZERO = np.float32(0.0)
+
+
+_ROUND = 1.5 * 2.0**52  # (q + c) - c rounds q to an integer (half to even)
 
 
 def quantise_sum(values):
     """Samples as int64 multiples of ``1 / SUM_SCALE`` (round half to even), NaN -> 0."""
     values = np.asarray(values, np.float64)
-    return np.rint(np.where(np.isfinite(values), values, 0.0) * SUM_SCALE).astype(np.int64)
+    scaled = np.where(np.isfinite(values), values, 0.0) * SUM_SCALE
+    return ((scaled + _ROUND) - _ROUND).astype(np.int64)
 
 
 def split_square(values):
@@ -55,99 +60,173 @@ def split_square(values):
 
 
 @nb.njit(cache=True, inline="always")
-def _smoothed(ring, i, end):
-    """[1, 2, 1]/4 smoothing at frame `i`; neighbours outside [0, end) replaced by frame i."""
-    r = ring.shape[0]
-    mid = ring[i % r]
-    prev = ring[(i - 1) % r] if i >= 1 else mid
-    nxt = ring[(i + 1) % r] if i + 1 < end else mid
+def _fixed(x):
+    """float64 `x` -> int64 multiple of 1 / SUM_SCALE, as :func:`quantise_sum`."""
+    return np.int64((x * SUM_SCALE + _ROUND) - _ROUND)
+
+
+@nb.njit(cache=True, inline="always")
+def _smooth_into(raw, smooth, p, slots, row, e, i, end):
+    """Store the [1, 2, 1]/4 smoothing of pixel `p`'s frame `i` (ring slot ``slots[row, e]``).
+
+    Neighbours outside ``[0, end)`` are replaced by frame `i` itself.
+    """
+    mid = raw[p, slots[row, e]]
+    prev = raw[p, slots[row, e - 1]] if i >= 1 else mid
+    nxt = raw[p, slots[row, e + 1]] if i + 1 < end else mid
     s = mid * _HALF
     s += _QUARTER * prev
     s += _QUARTER * nxt
-    return s
+    smooth[p, slots[row, e]] = s
 
 
 @nb.njit(cache=True)
-def _consider(ring, centre, end, half_window, top_value, top_frame, window):
-    """Insert frame `centre` among the pixel's deepest local minima if it is one.
+def _is_candidate(smooth, p, slots, row, centre, end, half_window, worst):
+    """Whether frame `centre` of pixel `p` is a local minimum deeper than `worst`.
 
+    `slots[row, e]` is the ring slot of frame ``centre - half_window - 1 + e``;
+    the smoothed values of frames ``centre +- half_window`` must be in `smooth`.
     A local minimum is smaller than every smoothed value in the ``half_window``
     frames before it and not larger than those after it (ties go to the
-    earlier frame). When it becomes the deepest, its raw window is copied.
+    earlier frame).
     """
-    s = _smoothed(ring, centre, end)
-    if not s < top_value[TOP - 1]:  # also rejects NaN
-        return
-    lo = max(centre - half_window, 0)
-    hi = min(centre + half_window, end - 1)
-    for i in range(lo, hi + 1):
-        if i < centre:
-            if _smoothed(ring, i, end) <= s:
-                return
-        elif i > centre:
-            if _smoothed(ring, i, end) < s:
-                return
+    h = half_window
+    s = smooth[p, slots[row, h + 1]]
+    if not s < worst:  # also rejects NaN
+        return False
+    for d in range(1, h + 1):
+        if centre + d < end and smooth[p, slots[row, h + 1 + d]] < s:
+            return False
+        if centre - d >= 0 and smooth[p, slots[row, h + 1 - d]] <= s:
+            return False
+    return True
+
+
+@nb.njit(cache=True)
+def _insert(raw, smooth, p, slots, row, centre, end, half_window, top_value, top_frame, window):
+    """Insert local minimum `centre` into pixel `p`'s sorted list; copy its raw window if deepest."""
+    h = half_window
+    s = smooth[p, slots[row, h + 1]]
     pos = TOP - 1
-    while pos > 0 and s < top_value[pos - 1]:
-        top_value[pos] = top_value[pos - 1]
-        top_frame[pos] = top_frame[pos - 1]
+    while pos > 0 and s < top_value[p, pos - 1]:
+        top_value[p, pos] = top_value[p, pos - 1]
+        top_frame[p, pos] = top_frame[p, pos - 1]
         pos -= 1
-    top_value[pos] = s
-    top_frame[pos] = centre
+    top_value[p, pos] = s
+    top_frame[p, pos] = centre
     if pos == 0:
-        r = ring.shape[0]
-        for q in range(window.shape[0]):
-            f = centre - half_window + q
-            window[q] = ring[f % r] if 0 <= f < end else np.nan
+        for q in range(2 * h + 1):
+            f = centre - h + q
+            window[p, q] = raw[p, slots[row, q + 1]] if 0 <= f < end else np.nan
+
+
+@nb.njit(cache=True, inline="always")
+def _consider(raw, smooth, p, slots, row, centre, end, half_window, top_value, top_frame, window):
+    """Insert frame `centre` among pixel `p`'s deepest local minima if it is one."""
+    if _is_candidate(smooth, p, slots, row, centre, end, half_window, top_value[p, TOP - 1]):
+        _insert(raw, smooth, p, slots, row, centre, end, half_window, top_value, top_frame, window)
+
+
+@nb.njit(cache=True)
+def _slot_table(first_centre, n_centres, r):
+    """Ring slots of frames ``centre - h - 1 .. centre + h + 1`` for consecutive centres."""
+    table = np.empty((n_centres, r), np.int64)
+    for t in range(n_centres):
+        for e in range(r):
+            table[t, e] = (first_centre + t - (r - 1) // 2 + e) % r
+    return table
 
 
 @nb.njit(cache=True, parallel=True)
 def track_block(block, first_index, start, stop, half_window, saturation_level,
-                ring, top_value, top_frame, window, signal_sum, square_hi, square_lo,
+                raw, smooth, top_value, top_frame, window, signal_sum, square_hi, square_lo,
                 count, invalid, channel_sum, saturated):
-    """Feed frames ``first_index + t`` of `block` ``(T, P, C)`` float32 to the state.
+    """Feed frames ``first_index + t`` of `block` ``(T, P, C)`` float32 (C <= 3) to the state.
 
     The signal is the channel sum (float32, channels added in order). Sums,
     counts and saturation cover frames in ``[start, stop)`` only; centres in
     ``[start, stop)`` are tested once the frames up to ``centre + half_window + 1``
-    are in the ring ``(P, 2 * half_window + 3)``.
+    are in the rings of raw and smoothed samples ``(P, 2 * half_window + 3)``.
     """
     n_t, n_p, n_c = block.shape
-    r = ring.shape[1]
+    r = raw.shape[1]
+    # frame j = first_index + t is the last of centre j - h - 1's slots
+    slots = _slot_table(first_index - half_window - 1, n_t, r)
     for p in nb.prange(n_p):
-        ring_p = ring[p]
+        total = signal_sum[p]
+        hi_sum = square_hi[p]
+        lo_sum = square_lo[p]
+        n_ok = count[p]
+        n_bad = invalid[p]
+        sat = saturated[p]
+        c0 = channel_sum[p, 0]
+        c1 = channel_sum[p, 1] if n_c > 1 else 0
+        c2 = channel_sum[p, 2] if n_c > 2 else 0
         for t in range(n_t):
             j = first_index + t
-            x = block[t, p, 0]
-            for c in range(1, n_c):
-                x += block[t, p, c]
-            ring_p[j % r] = x
+            v0 = block[t, p, 0]
+            v1 = block[t, p, 1] if n_c > 1 else _ZERO
+            v2 = block[t, p, 2] if n_c > 2 else _ZERO
+            x = v0
+            if n_c > 1:
+                x += v1
+            if n_c > 2:
+                x += v2
+            raw[p, slots[t, r - 1]] = x
+            if j >= 1:
+                _smooth_into(raw, smooth, p, slots, t, r - 2, j - 1, j + 1)
             if start <= j < stop:
                 if np.isfinite(x):
                     x64 = np.float64(x)
-                    signal_sum[p] += np.int64(np.rint(x64 * SUM_SCALE))
+                    total += _fixed(x64)
                     sq = x64 * x64
                     hi = (sq + _SQ_HI) - _SQ_HI
-                    square_hi[p] += hi
-                    square_lo[p] += ((sq - hi) + _SQ_LO) - _SQ_LO
-                    count[p] += 1
+                    hi_sum += hi
+                    lo_sum += ((sq - hi) + _SQ_LO) - _SQ_LO
+                    n_ok += 1
                 else:
-                    invalid[p] += 1
-                for c in range(n_c):
-                    v = block[t, p, c]
-                    if np.isfinite(v):
-                        channel_sum[p, c] += np.int64(np.rint(np.float64(v) * SUM_SCALE))
-                        # +inf is corrupt input (counted above), not a clipped channel
-                        if v >= saturation_level:
-                            saturated[p] = True
+                    n_bad += 1
+                if np.isfinite(v0):
+                    c0 += _fixed(np.float64(v0))
+                if np.isfinite(v1):
+                    c1 += _fixed(np.float64(v1))
+                if np.isfinite(v2):
+                    c2 += _fixed(np.float64(v2))
+                # +inf is corrupt input (counted above), not a clipped channel
+                sat |= (((v0 >= saturation_level) & (v0 < np.inf)) | ((v1 >= saturation_level) & (v1 < np.inf))
+                        | ((v2 >= saturation_level) & (v2 < np.inf)))
             centre = j - half_window - 1
             if centre >= start and centre >= 0 and centre < stop:
-                _consider(ring_p, centre, j + 1, half_window, top_value[p], top_frame[p], window[p])
+                _consider(raw, smooth, p, slots, t, centre, j + 1, half_window, top_value, top_frame,
+                          window)
+        signal_sum[p] = total
+        square_hi[p] = hi_sum
+        square_lo[p] = lo_sum
+        count[p] = n_ok
+        invalid[p] = n_bad
+        saturated[p] = sat
+        channel_sum[p, 0] = c0
+        if n_c > 1:
+            channel_sum[p, 1] = c1
+        if n_c > 2:
+            channel_sum[p, 2] = c2
 
 
 @nb.njit(cache=True, parallel=True)
-def finish_centres(first, last, end, half_window, ring, top_value, top_frame, window):
-    """Test centres ``first .. last - 1`` of a sequence whose last frame is ``end - 1``."""
-    for p in nb.prange(ring.shape[0]):
+def finish_centres(first, last, end, half_window, raw, smooth, top_value, top_frame, window):
+    """Test centres ``first .. last - 1`` of a sequence whose last frame is ``end - 1``.
+
+    The last frame's smoothed value (its next neighbour replaced by itself)
+    is computed first.
+    """
+    if end < 1:
+        return
+    r = raw.shape[1]
+    # row 0: slots around centre end - h - 1, whose slot r - 2 is frame end - 1
+    last_frame = _slot_table(end - half_window - 1, 1, r)
+    slots = _slot_table(first, max(last - first, 0), r)
+    for p in nb.prange(raw.shape[0]):
+        _smooth_into(raw, smooth, p, last_frame, 0, r - 2, end - 1, end)
         for centre in range(first, last):
-            _consider(ring[p], centre, end, half_window, top_value[p], top_frame[p], window[p])
+            _consider(raw, smooth, p, slots, centre - first, centre, end, half_window, top_value,
+                      top_frame, window)

@@ -34,9 +34,7 @@ DipPartial : the state of one time chunk (``save`` / ``load``).
 merge_partials : the summary of a sweep from its time chunks.
 """
 
-import os
 from dataclasses import dataclass, fields
-from pathlib import Path
 
 import numpy as np
 
@@ -151,11 +149,11 @@ class DipPartial:
     saturated: np.ndarray
 
     def save(self, path):
-        """Write to `path` (``.npz``) atomically: a temporary file, then a rename."""
-        path = Path(path)
-        tmp = path.with_name(path.name + ".tmp.npz")
-        np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
-        os.replace(tmp, path)
+        """Write to `path` (ending ``.npz``) atomically: a temporary file, then a rename."""
+        from shadowcam.image_io import atomic_path
+
+        with atomic_path(path) as tmp:
+            np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
 
     @classmethod
     def load(cls, path):
@@ -213,7 +211,8 @@ class DipTracker:
         p = self.shape[0] * self.shape[1]
         self._first = max(0, start - self.padding(h))
         self._next = self._first
-        self._ring = np.full((p, k + 2), np.nan, np.float32)
+        self._raw = np.full((p, k + 2), np.nan, np.float32)
+        self._smooth = np.full((p, k + 2), np.nan, np.float32)
         self._top_value = np.full((p, _k.TOP), np.inf, np.float32)
         self._top_frame = np.full((p, _k.TOP), -1, np.int64)
         self._window = np.full((p, k), np.nan, np.float32)
@@ -267,13 +266,15 @@ class DipTracker:
                 f"max(0, start - padding) at first), got {first}"
             )
         n_c = block.shape[3]
+        if n_c > 3:
+            raise ValueError(f"block must have at most 3 channels, got {n_c}")
         if self._channel_sum is None:
-            self._channel_sum = np.zeros((self._ring.shape[0], n_c), np.int64)
+            self._channel_sum = np.zeros((self._raw.shape[0], n_c), np.int64)
         elif self._channel_sum.shape[1] != n_c:
             raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[1]}")
         flat = np.ascontiguousarray(block).reshape(block.shape[0], -1, n_c)
         _k.track_block(flat, first, *self.owned, self.half_window, np.float32(self.saturation_level),
-                       self._ring, self._top_value, self._top_frame, self._window, self._signal_sum,
+                       self._raw, self._smooth, self._top_value, self._top_frame, self._window, self._signal_sum,
                        self._square_hi, self._square_lo, self._count, self._invalid,
                        self._channel_sum, self._saturated)
         self._next = first + block.shape[0]
@@ -288,7 +289,7 @@ class DipTracker:
             start, stop = self.owned
             end = self._next
             first = max(end - self.half_window - 1, start)
-            _k.finish_centres(first, min(stop, end), end, self.half_window, self._ring,
+            _k.finish_centres(first, min(stop, end), end, self.half_window, self._raw, self._smooth,
                               self._top_value, self._top_frame, self._window)
             h, w = self.shape
             channels = self._channel_sum if self._channel_sum is not None else np.zeros((h * w, 0), np.int64)
@@ -300,7 +301,7 @@ class DipTracker:
                 count=self._count.reshape(h, w), invalid=self._invalid.reshape(h, w),
                 channel_sum=channels.reshape(h, w, -1), saturated=self._saturated.reshape(h, w),
             )
-            self._ring = None
+            self._raw = self._smooth = None
         return self._partial
 
     def result(self):

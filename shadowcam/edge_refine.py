@@ -17,6 +17,7 @@ refine_times : local robust plane fit of a time map.
 shifted : an image shifted by a neighbour offset, filled outside.
 """
 
+import numba as nb
 import numpy as np
 
 
@@ -30,54 +31,75 @@ def shifted(array, dr, dc, fill):
     return out
 
 
-def _plane_fit(time, weight_of, radius):
-    """Weighted local plane fit at every pixel.
+@nb.njit(cache=True, parallel=True)
+def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
+    """Per pixel: IRLS local plane fit of the neighbours' times (see :func:`refine_times`).
 
-    `weight_of(dr, dc, neighbour_time)` returns the ``(H, W)`` weights of the
-    neighbour at offset ``(dr, dc)``. Returns the plane's value, its row and
-    column slopes, and the weight sum.
+    Each pass fits ``t = a + b*dr + c*dc`` to the ``(2 * radius + 1)**2``
+    neighbours weighted by their inverse variance and a Gaussian range kernel
+    on their residual from the pixel's previous plane (first pass: the flat
+    plane through its own time). Returns the plane values ``a`` (NaN where the
+    pixel has no time) and the last pass's weight sums, ``(H, W)`` float64.
     """
-    h, w = time.shape
-    moments = {key: np.zeros((h, w)) for key in
-               ("s", "r", "c", "rr", "rc", "cc", "t", "tr", "tc")}
-    for dr in range(-radius, radius + 1):
-        for dc in range(-radius, radius + 1):
-            t_n = shifted(time, dr, dc, np.nan)
-            wgt = weight_of(dr, dc, t_n)
-            wgt = np.where(np.isfinite(t_n), wgt, 0.0)
-            t_n = np.where(wgt > 0, t_n, 0.0)
-            moments["s"] += wgt
-            moments["r"] += wgt * dr
-            moments["c"] += wgt * dc
-            moments["rr"] += wgt * dr * dr
-            moments["rc"] += wgt * dr * dc
-            moments["cc"] += wgt * dc * dc
-            moments["t"] += wgt * t_n
-            moments["tr"] += wgt * t_n * dr
-            moments["tc"] += wgt * t_n * dc
-    m = moments
-    # solve [[s, r, c], [r, rr, rc], [c, rc, cc]] x = [t, tr, tc] by Cramer's rule
-    det = (m["s"] * (m["rr"] * m["cc"] - m["rc"] ** 2)
-           - m["r"] * (m["r"] * m["cc"] - m["rc"] * m["c"])
-           + m["c"] * (m["r"] * m["rc"] - m["rr"] * m["c"]))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        a = (m["t"] * (m["rr"] * m["cc"] - m["rc"] ** 2)
-             - m["r"] * (m["tr"] * m["cc"] - m["rc"] * m["tc"])
-             + m["c"] * (m["tr"] * m["rc"] - m["rr"] * m["tc"])) / det
-        b = (m["s"] * (m["tr"] * m["cc"] - m["tc"] * m["rc"])
-             - m["t"] * (m["r"] * m["cc"] - m["rc"] * m["c"])
-             + m["c"] * (m["r"] * m["tc"] - m["tr"] * m["c"])) / det
-        c = (m["s"] * (m["rr"] * m["tc"] - m["rc"] * m["tr"])
-             - m["r"] * (m["r"] * m["tc"] - m["tr"] * m["c"])
-             + m["t"] * (m["r"] * m["rc"] - m["rr"] * m["c"])) / det
-        mean = m["t"] / m["s"]
-    # too few or collinear neighbours: fall back to the weighted mean
-    scale = np.maximum(m["s"], 1e-300) ** 3 * max(radius, 1) ** 4
-    degenerate = ~(np.abs(det) > 1e-6 * scale) | ~np.isfinite(a)
-    a = np.where(degenerate, mean, a)
-    b = np.where(degenerate, 0.0, b)
-    c = np.where(degenerate, 0.0, c)
-    return a, b, c, m["s"]
+    h, w = t64.shape
+    centre_out = np.full((h, w), np.nan)
+    weight_out = np.zeros((h, w))
+    for row in nb.prange(h):
+        for col in range(w):
+            centre = t64[row, col]
+            if not np.isfinite(centre):
+                continue
+            slope_r = 0.0
+            slope_c = 0.0
+            s = 0.0
+            for _ in range(iterations):
+                s = m_r = m_c = m_rr = m_rc = m_cc = m_t = m_tr = m_tc = 0.0
+                for dr in range(-radius, radius + 1):
+                    rr = row + dr
+                    for dc in range(-radius, radius + 1):
+                        cc = col + dc
+                        if rr < 0 or rr >= h or cc < 0 or cc >= w:
+                            continue
+                        t_n = t64[rr, cc]
+                        if not np.isfinite(t_n):
+                            continue
+                        predicted = centre + slope_r * dr + slope_c * dc
+                        residual = (t_n - predicted) / range_sigma
+                        wgt = inv_var[rr, cc] * np.exp(-0.5 * residual**2)
+                        if not np.isfinite(wgt):
+                            continue
+                        if not wgt > 0:
+                            t_n = 0.0
+                        s += wgt
+                        m_r += wgt * dr
+                        m_c += wgt * dc
+                        m_rr += wgt * dr * dr
+                        m_rc += wgt * dr * dc
+                        m_cc += wgt * dc * dc
+                        m_t += wgt * t_n
+                        m_tr += wgt * t_n * dr
+                        m_tc += wgt * t_n * dc
+                # solve [[s, r, c], [r, rr, rc], [c, rc, cc]] x = [t, tr, tc] by Cramer's rule
+                det = (s * (m_rr * m_cc - m_rc**2) - m_r * (m_r * m_cc - m_rc * m_c)
+                       + m_c * (m_r * m_rc - m_rr * m_c))
+                scale = max(s, 1e-300) ** 3 * max(radius, 1) ** 4
+                a = np.nan
+                if det != 0.0:
+                    a = (m_t * (m_rr * m_cc - m_rc**2) - m_r * (m_tr * m_cc - m_rc * m_tc)
+                         + m_c * (m_tr * m_rc - m_rr * m_tc)) / det
+                if abs(det) > 1e-6 * scale and np.isfinite(a):
+                    slope_r = (s * (m_tr * m_cc - m_tc * m_rc) - m_t * (m_r * m_cc - m_rc * m_c)
+                               + m_c * (m_r * m_tc - m_tr * m_c)) / det
+                    slope_c = (s * (m_rr * m_tc - m_rc * m_tr) - m_r * (m_r * m_tc - m_tr * m_c)
+                               + m_t * (m_r * m_rc - m_rr * m_c)) / det
+                    centre = a
+                else:  # too few or collinear neighbours: the weighted mean
+                    centre = m_t / s if s != 0.0 else np.nan
+                    slope_r = 0.0
+                    slope_c = 0.0
+            centre_out[row, col] = centre
+            weight_out[row, col] = s
+    return centre_out, weight_out
 
 
 def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
@@ -120,15 +142,8 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         inv_var = np.where(valid & (time_std > 0), 1.0 / time_std**2, 0.0)
     inv_var = np.nan_to_num(inv_var, nan=0.0, posinf=0.0)
 
-    centre, slope_r, slope_c = t64, np.zeros_like(t64), np.zeros_like(t64)
-    for _ in range(max(int(iterations), 1)):
-        def weight_of(dr, dc, t_n, centre=centre, slope_r=slope_r, slope_c=slope_c):
-            predicted = centre + slope_r * dr + slope_c * dc
-            residual = (t_n - predicted) / range_sigma
-            return shifted(inv_var, dr, dc, 0.0) * np.exp(-0.5 * residual**2)
-
-        centre, slope_r, slope_c, weight_sum = _plane_fit(t64, weight_of, radius)
-        centre = np.where(valid, centre, np.nan)
+    centre, weight_sum = _robust_plane_fit(t64, inv_var, int(radius), float(range_sigma),
+                                           max(int(iterations), 1))
     with np.errstate(invalid="ignore", divide="ignore"):
         refined_std = np.sqrt(1.0 / weight_sum)
     refined = np.where(valid & np.isfinite(centre), centre, time)

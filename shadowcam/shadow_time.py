@@ -17,6 +17,8 @@ classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 lit_colour : unshadowed colour per pixel from a summary with channel sums.
+sweep_shadow_times : shadow times of one sweep from streamed frame blocks.
+summary_shadow_times : shadow times of one sweep from its (possibly merged) summary.
 """
 
 import numpy as np
@@ -159,6 +161,63 @@ def time_dip_centroid(summary):
     return time, entry, exit_, std
 
 
+def time_gaussian_fit_Caruana1986(summary):
+    """Vertex of a Gaussian through the three most covered frames of the dip.
+
+    Caruana, Searle, Heller & Shupack, "Fast algorithm for the resolution of
+    spectra", Anal. Chem. 58 (1986): the logarithm of a Gaussian is a
+    parabola, so the vertex of the parabola through ``log coverage`` at the
+    most covered frame and its two neighbours is the Gaussian's centre
+    (offset clipped to +-1 frame; a flat top falls back to the frame).
+    """
+    coverage = np.nan_to_num(_coverage(summary), nan=0.0)
+    k = coverage.shape[0]
+    peak = np.clip(np.argmax(coverage, axis=0), 1, k - 2)[None]
+    c_m, c_0, c_p = (np.take_along_axis(coverage, peak + d, 0)[0] for d in (-1, 0, 1))
+    l_m, l_0, l_p = (np.log(np.maximum(c, 1e-3)) for c in (c_m, c_0, c_p))
+    curvature = l_m - 2 * l_0 + l_p
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.where(curvature < 0, 0.5 * (l_m - l_p) / curvature, 0.0)
+        # noise sigma / level on each coverage sample, through d offset / d log c = 1 / c
+        rel = summary.noise / summary.lit_level
+        std = 0.5 * rel * np.sqrt(1 / np.maximum(c_m, 1e-3) ** 2 + 1 / np.maximum(c_p, 1e-3) ** 2)
+        std = std / np.abs(curvature)
+    time = summary.window_start + peak[0] + np.clip(offset, -1.0, 1.0)
+    threshold = 0.5 * (summary.lit_level + summary.minimum_value)
+    entry, exit_ = _crossings(summary, threshold)
+    return time, entry, exit_, np.minimum(std, 1.0)
+
+
+def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
+    """Deepest frame of the Gaussian-smoothed profile, refined by a parabola.
+
+    Temporal smoothing before the minimum: the window is convolved with a
+    Gaussian of `sigma` frames (samples outside the window or non-finite
+    replaced by the nearest valid edge), then the parabola through the
+    smoothed minimum and its neighbours gives the sub-frame offset.
+    """
+    if not sigma > 0:
+        raise ValueError(f"sigma must be > 0, got {sigma!r}")
+    win = summary.window.astype(np.float64)
+    k = win.shape[0]
+    radius = max(1, int(np.ceil(3 * sigma)))
+    taps = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
+    taps /= taps.sum()
+    filled = np.where(np.isfinite(win), win, summary.lit_level[None])
+    padded = np.concatenate([np.repeat(filled[:1], radius, 0), filled, np.repeat(filled[-1:], radius, 0)])
+    smooth = sum(t * padded[i:i + k] for i, t in enumerate(taps))
+    centre = np.clip(np.argmin(smooth[1:-1], axis=0) + 1, 1, k - 2)[None]
+    s_m, s_0, s_p = (np.take_along_axis(smooth, centre + d, 0)[0] for d in (-1, 0, 1))
+    curvature = s_m - 2 * s_0 + s_p
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.clip(0.5 * (s_m - s_p) / curvature, -0.5, 0.5)
+        noise = summary.noise * np.sqrt(np.sum(taps**2))
+        std = np.minimum(noise / np.abs(curvature), 0.5)
+    time = summary.window_start + centre[0] + np.where(np.isfinite(offset), offset, 0.0)
+    entry, exit_ = _crossings(summary, 0.5 * (summary.lit_level + summary.minimum_value))
+    return time, entry, exit_, std
+
+
 def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15):
     """Dip centroid refined by an edge-aware local plane fit of neighbours' times.
 
@@ -179,6 +238,8 @@ SHADOW_TIME_METHODS = {
     "argmin_parabolic": time_argmin_parabolic,
     "midpoint_crossing_BouguetPerona1998": time_midpoint_crossing_BouguetPerona1998,
     "dip_centroid": time_dip_centroid,
+    "gaussian_fit_Caruana1986": time_gaussian_fit_Caruana1986,
+    "argmin_gaussian_smoothed": time_argmin_gaussian_smoothed,
     "edge_fit": time_edge_fit,
 }
 
@@ -509,9 +570,29 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
     results : dict of (H, W) ndarrays
         As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
     """
-    summary, lit_image, saturated = track_sweep(
-        blocks, shape, half_window=half_window, progress=progress
-    )
+    summary, _, _ = track_sweep(blocks, shape, half_window=half_window, progress=progress)
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+                                method_params=method_params, classify_params=classify_params)
+
+
+def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
+                         classify_params=None):
+    """Shadow times of one sweep from its :class:`DipSummary` (with channel sums).
+
+    Parameters
+    ----------
+    summary : DipSummary
+        Of a tracker fed ``(T, H, W, C)`` frames (whole sweep, or merged chunks).
+    method, cfa_pattern, method_params, classify_params
+        As :func:`sweep_shadow_times`.
+
+    Returns
+    -------
+    dict
+        As :func:`sweep_shadow_times`.
+    """
+    lit_image = lit_colour(summary)
+    shape = lit_image.shape[:2]
     classify_params = dict(classify_params or {})
     if cfa_pattern:
         colour = cfa_site_colours(shape, cfa_pattern)
@@ -519,7 +600,7 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
             site_colour=colour,
             site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],
         )
-    results = shadow_times(summary, method=method, saturated=saturated,
+    results = shadow_times(summary, method=method, saturated=summary.saturated,
                            method_params=method_params, **classify_params)
     results["lit_image"] = lit_image
     results["n_frames"] = summary.n_frames

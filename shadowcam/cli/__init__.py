@@ -30,6 +30,8 @@ STEPS = {
     "pushbroom": "pushbroom",
     "outdoor-accuracy": "outdoor_accuracy",
     "outdoor-figures": "outdoor_figures",
+    "bench": "bench",
+    "methods-comparison": "methods_comparison",
 }
 
 

@@ -290,3 +290,19 @@ def get_outdoor_accuracy(wildcards):
 def get_outdoor_accuracy_option(wildcards, input):
     """``--accuracy PATH`` for the outdoor figures when accuracy was computed, else empty."""
     return f"--accuracy {input.accuracy}" if input.accuracy else ""
+
+
+def get_scene_sweeps(wildcards):
+    """Scene sweep names (u v) of the dataset, for ``--sweeps``."""
+    return list(scene_sweeps(wildcards.ds))
+
+
+def get_scene_frames(wildcards):
+    """Decoded frame stores of the scene sweeps (u, v), in `get_scene_sweeps` order."""
+    return [f"results/{wildcards.ds}/frames/{s}.zarr" for s in scene_sweeps(wildcards.ds)]
+
+
+def get_methods_params(wildcards):
+    """JSON ``--params`` of ``shadowcam methods-comparison``: the shadow-time half window."""
+    options = config["shadow_time"]["params"]
+    return as_json({k: options[k] for k in ("half_window",) if k in options})
