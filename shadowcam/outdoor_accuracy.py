@@ -17,6 +17,8 @@ check_targets : the targets of a condition against error statistics.
 evaluate_arrivals : errors of several estimators against every GT definition, with targets.
 false_arrivals : arrivals where the GT has none, per GT class.
 edge_errors : tracked edge rows against the GT edge rows.
+map_to_truth_camera : a map in the first frame's coordinates resampled into the GT camera's.
+edges_to_truth_camera : per-column edge rows of the first frame's coordinates in the GT camera's.
 """
 
 import numpy as np
@@ -203,3 +205,61 @@ def edge_errors(edge_row, truth_edge_row, *, unambiguous=None):
             "median_abs_px": float(np.median(diff)) if diff.size else float("nan"),
             "p95_abs_px": float(np.percentile(diff, 95)) if diff.size else float("nan"),
             "found_fraction": float(use.sum() / max(np.isfinite(gt).sum(), 1))}
+
+
+def map_to_truth_camera(values, *, shift_row, shift_col):
+    """Resample a per-pixel map from the first frame's coordinates into the GT camera's.
+
+    The pipeline registers every frame to the first one, so its maps are in
+    that frame's pixel grid; synthetic ground truth is in the unshaken camera,
+    and the first frame shows it moved by its own shake (``frame_0(r, c) =
+    truth(r - shift_row, c - shift_col)``). The map is sampled at ``(r +
+    shift_row, c + shift_col)``, bilinear; NaN where a neighbour is NaN or
+    outside the image.
+
+    Parameters
+    ----------
+    values : (H, W) ndarray
+        Map in the first frame's coordinates (NaN = none).
+    shift_row, shift_col : float
+        Shake of the first frame (pixels, content moved by +shift).
+
+    Returns
+    -------
+    (H, W) float64 ndarray
+    """
+    from scipy.ndimage import map_coordinates
+
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim != 2:
+        raise ValueError(f"values must be (H, W), got shape {values.shape}")
+    if shift_row == 0 and shift_col == 0:
+        return values.copy()
+    rows, cols = np.indices(values.shape, dtype=np.float64)
+    coords = np.stack([rows + shift_row, cols + shift_col])
+    missing = ~np.isfinite(values)
+    sampled = map_coordinates(np.where(missing, 0.0, values), coords, order=1, mode="constant", cval=np.nan)
+    touched = map_coordinates(missing.astype(np.float64), coords, order=1, mode="constant", cval=1.0)
+    return np.where(touched > 0, np.nan, sampled)
+
+
+def edges_to_truth_camera(edge_row, *, shift_row, shift_col):
+    """Per-column edge rows ``(T, W)`` of the first frame's coordinates in the GT camera's.
+
+    The GT column ``c`` is the first frame's column ``c + shift_col``
+    (linear between columns, NaN past the image); its row moves by ``-shift_row``.
+    """
+    edge = np.asarray(edge_row, dtype=np.float64)
+    if edge.ndim != 2:
+        raise ValueError(f"edge_row must be (T, W), got shape {edge.shape}")
+    width = edge.shape[1]
+    if width < 2:
+        raise ValueError(f"edge_row needs at least 2 columns, got {width}")
+    cols = np.arange(width) + shift_col
+    left = np.clip(np.floor(cols).astype(int), 0, width - 2)
+    frac = cols - left
+    lo, hi = edge[:, left], edge[:, left + 1]
+    with np.errstate(invalid="ignore"):
+        out = np.where(frac == 0, lo, np.where(frac == 1, hi, (1 - frac) * lo + frac * hi))
+    out[:, (cols < 0) | (cols > width - 1)] = np.nan
+    return out - shift_row

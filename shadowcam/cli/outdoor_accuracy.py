@@ -25,7 +25,10 @@ from shadowcam.frame_times import median_interval
 from shadowcam.ground_truth import load_ground_truth
 from shadowcam.image_io import atomic_path
 from shadowcam.manifest import load_manifest
-from shadowcam.outdoor_accuracy import NaiveBaseline, TARGETS, edge_errors, evaluate_arrivals, false_arrivals
+from shadowcam.outdoor_accuracy import (
+    NaiveBaseline, TARGETS, edge_errors, edges_to_truth_camera, evaluate_arrivals, false_arrivals,
+    map_to_truth_camera,
+)
 
 log = logging.getLogger(__name__)
 
@@ -67,18 +70,28 @@ def run(args):
     baseline = NaiveBaseline((frames.sizes["row"], frames.sizes["col"]))
     for frame, t in zip(iter_frames(frames), time_s):
         baseline.update(frame, t)
+    # our maps are in the first frame's pixel grid; synthetic GT is in the unshaken camera
+    shift = {"shift_row": 0.0, "shift_col": 0.0}
+    if "shake_dy_px" in truth and truth["shake_dy_px"].size == time_s.size:
+        shift = {"shift_row": float(truth["shake_dy_px"].values[0]),
+                 "shift_col": float(truth["shake_dx_px"].values[0])}
+        log.info("first frame's shake (GT): row %+.3f px, col %+.3f px; maps resampled into the GT camera",
+                 shift["shift_row"], shift["shift_col"])
     estimates = {
-        "combined": arrival["arrival_time_s"].values,
-        "edge_crossing": arrival["edge_arrival_s"].values,
-        "coverage_crossing": arrival["coverage_arrival_s"].values,
-        "naive_baseline": baseline.arrival_s,
+        name: map_to_truth_camera(arrival[variable].values, **shift)
+        for name, variable in (("combined", "arrival_time_s"), ("edge_crossing", "edge_arrival_s"),
+                               ("coverage_crossing", "coverage_arrival_s"))
     }
+    # the baseline works on the frames as delivered (no registration)
+    estimates["naive_baseline"] = baseline.arrival_s
     interval = median_interval(time_s)
     report = evaluate_arrivals(estimates, truth, interval_s=interval, condition=_condition(params, manifest))
     report["false_arrivals"] = {name: false_arrivals(est, truth) for name, est in estimates.items()}
+    report["first_frame_shake_px"] = shift
     if "pb_edge_y" in truth and truth["pb_edge_y"].shape == edges["edge_row"].shape:
         unambiguous = truth["pb_n_transitions"].values == 1 if "pb_n_transitions" in truth else None
-        report["edge_row"] = edge_errors(edges["edge_row"].values, truth["pb_edge_y"].values, unambiguous=unambiguous)
+        report["edge_row"] = edge_errors(edges_to_truth_camera(edges["edge_row"].values, **shift),
+                                         truth["pb_edge_y"].values, unambiguous=unambiguous)
     if "pb_front" in truth and truth["pb_front"].shape == pushbroom["pushbroom"].shape:
         ours, gt = pushbroom["pushbroom"].values, truth["pb_front"].values
         both = np.isfinite(ours).all(-1) & np.isfinite(gt).all(-1) & (gt.sum(-1) > 0)
