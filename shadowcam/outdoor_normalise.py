@@ -19,7 +19,8 @@ aligned_luminance : one frame's registered luminance from the pass's results.
 import numpy as np
 
 from shadowcam.photometric import estimate_gain, lit_at_start, luminance
-from shadowcam.registration import apply_shift, shift_lucas_kanade_LucasKanade1981, static_weight
+from shadowcam.registration import (apply_shift, block_all, block_mean, registration_factor,
+                                    shift_lucas_kanade_LucasKanade1981, static_weight)
 from shadowcam.sky_mask import auto_sky_mask
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
@@ -38,12 +39,19 @@ class SequenceNormaliser:
         Gains from exposure metadata (NaN where unknown); seed the gain search.
     sky_params : dict, optional
         Options of :func:`shadowcam.sky_mask.auto_sky_mask`.
+    registration_size : int, optional
+        Shifts and gains are estimated on frames reduced by an integer factor
+        (:func:`shadowcam.registration.block_mean`) to at most this many pixels
+        on the longer side; the shift is scaled back and the per-pixel levels
+        stay at full resolution. Frames this small or smaller are not reduced.
     """
 
-    def __init__(self, *, sky=None, exposure_gain=None, sky_params=None):
+    def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536):
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
+        self._registration_size = int(registration_size)
+        registration_factor((1, 1), max_size=self._registration_size)  # validates the option
         self.shifts, self.gain_lit, self.gain_sky, self.kept_lit = [], [], [], []
         self._recent = []
 
@@ -58,6 +66,12 @@ class SequenceNormaliser:
         self.lit_at_start, _ = lit_at_start(self.reference_luma, valid=~self._sky)
         self.shadowed_at_start = ~self._sky & ~self.lit_at_start
         self._shadow_min = np.full((height, width), np.inf, dtype=np.float32)
+        # working size of registration and gains: masks hold where the whole block does
+        self.factor = registration_factor((height, width), max_size=self._registration_size)
+        self._small_reference = block_mean(self.reference_luma, self.factor)
+        self._small_lit = block_all(self.lit_at_start, self.factor)
+        self._small_valid = block_all(~self._sky, self.factor)
+        self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
 
     def _prior(self, previous, k):
         if self._exposure is not None and k < self._exposure.size and np.isfinite(self._exposure[k]):
@@ -73,22 +87,26 @@ class SequenceNormaliser:
         k = len(self.shifts)
         if k == 0:
             self._start(frame)
-            shift, gain_lit, gain_sky, kept, luma = np.zeros(2), 1.0, 1.0, int(self.lit_at_start.sum()), self.reference_luma
+            shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
+            kept = int(self._small_lit.sum())
         else:
             if frame.shape != self.reference.shape:
                 raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
             raw = luminance(frame)
-            rough, _ = estimate_gain(raw, self.reference_luma, pixels=self.lit_at_start,
-                                     prior=self._prior(self.gain_lit[-1], k))
-            weight = static_weight(raw, self.reference_luma, lit_reference=self.lit_at_start, gain=rough,
-                                   valid=~self._sky)
-            shift, _ = shift_lucas_kanade_LucasKanade1981(raw, self.reference_luma, weight=weight,
-                                                          initial=self.shifts[-1])
+            factor, ref = self.factor, self._small_reference
+            small = block_mean(raw, factor)
+            rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(self.gain_lit[-1], k))
+            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid)
+            shift, _ = shift_lucas_kanade_LucasKanade1981(small, ref, weight=weight,
+                                                          initial=self.shifts[-1] / factor)
+            shift = shift * factor
             luma = apply_shift(raw, shift)
-            gain_lit, kept = estimate_gain(luma, self.reference_luma, pixels=self.lit_at_start, prior=rough)
-            gain_sky, _ = estimate_gain(luma, self.reference_luma, pixels=self.shadowed_at_start,
+            del raw, small
+            small = block_mean(luma, factor)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed,
                                         prior=self.gain_sky[-1] * gain_lit / self.gain_lit[-1])
-            if not self.shadowed_at_start.any():
+            if not self._small_shadowed.any():
                 gain_sky = gain_lit
         self.shifts.append(np.asarray(shift, dtype=np.float64))
         self.gain_lit.append(float(gain_lit))

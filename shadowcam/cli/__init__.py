@@ -30,6 +30,7 @@ STEPS = {
     "pushbroom": "pushbroom",
     "outdoor-accuracy": "outdoor_accuracy",
     "outdoor-figures": "outdoor_figures",
+    "outdoor-sample": "outdoor_sample",
 }
 
 
