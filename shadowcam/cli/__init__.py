@@ -25,6 +25,7 @@ STEPS = {
     "evaluate": "evaluate",
     "plan": "plan",
     "outdoor-normalise": "outdoor_normalise",
+    "outdoor-merge-photometry": "outdoor_merge_photometry",
     "track-edges": "track_edges",
     "arrival": "arrival",
     "pushbroom": "pushbroom",
