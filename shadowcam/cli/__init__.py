@@ -32,6 +32,7 @@ STEPS = {
     "outdoor-accuracy": "outdoor_accuracy",
     "outdoor-figures": "outdoor_figures",
     "outdoor-sample": "outdoor_sample",
+    "bench-report": "bench_report",
 }
 
 
