@@ -299,9 +299,9 @@ def get_outdoor_accuracy_option(wildcards, input):
 
 _OUTDOOR_FRAME_CACHE = {}
 #: measured peak RSS per megapixel of frame (MB/MP) and fixed part (MB), with margin
-OUTDOOR_MEM_MB = {"normalise": (400, 60), "track": (400, 90), "per_pixel": (400, 40)}
+OUTDOOR_MEM_MB = {"normalise": (400, 85), "track": (400, 100), "per_pixel": (400, 70)}
 #: measured seconds per frame and megapixel on one core (x3 margin in outdoor_runtime)
-OUTDOOR_S_PER_MP_FRAME = {"normalise": 0.25, "track": 0.35, "per_pixel": 0.02}
+OUTDOOR_S_PER_MP_FRAME = {"normalise": 0.25, "track": 0.35, "per_pixel": 0.05}
 
 
 def outdoor_frame_layout(ds):
