@@ -1,7 +1,8 @@
 # shadowcam: `make demo` runs the default synthetic dataset end to end and builds the
 # report; `make test` runs the test suite; `make lint` lints the workflow;
 # `make bench-outdoor` reruns the outdoor pipeline on dev_ridge and prints per-stage
-# wall time / peak memory and the arrival-time accuracy (ours and the naive baseline).
+# wall time / peak memory and the arrival-time accuracy (ours and the naive baseline);
+# `make bench-outdoor-size` the same stages at a camera's size (24 MP by default), extrapolated.
 # `make bench` prints the speed benchmark (not part of the tests; ~10 min, renders
 # its DNG input once into results/bench/dng and reuses it).
 # Every target installs the package (editable, with test extras) into .venv first.
@@ -15,8 +16,16 @@ DATASET ?= synthetic_lab
 
 OUTDOOR ?= dev_ridge
 BENCH_ARGS ?=
+# bench-outdoor-size: real-size sample (COLSxROWS), frames, frames per first-pass job, scratch dir
+BENCH_SIZE ?= 6000x4000
+BENCH_FRAMES ?= 16
+BENCH_PART ?= 8
+BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
+# frames per chunk of the decoded store: one 24 MP frame is 288 MB of float32 RGB, and the
+# streaming passes hold one chunk, so the default 16 would cost 4.6 GB per job
+BENCH_CHUNK ?= 1
 
-.PHONY: demo test lint install clean bench bench-outdoor
+.PHONY: demo test lint install clean bench bench-outdoor bench-outdoor-size
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -50,6 +59,25 @@ bench-outdoor: $(STAMP)
 
 bench: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/shadowcam bench --dir results/bench/dng --json results/bench/figures.json $(BENCH_ARGS)
+
+# The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of dev_ridge
+# upsampled to BENCH_SIZE (14-bit DNG, full-resolution noise) run in a scratch copy of the
+# workflow (2 cores, first pass in parts of BENCH_PART frames); prints per stage s/frame,
+# frames/s, MP/s, peak RSS (and its growth from the half run), and the 1000-frame extrapolation.
+bench-outdoor-size: $(STAMP)
+	rm -rf $(BENCH_DIR) && mkdir -p $(BENCH_DIR)/data_manifest
+	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
+	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART)}\n' > $(BENCH_DIR)/bench.yaml
+	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
+	  $(BIN)/shadowcam outdoor-sample --source data_manifest/dev_ridge.yaml --size $(BENCH_SIZE) --frames $$n \
+	    --name bench$$n --outdir $(BENCH_DIR)/data/bench$$n --manifest-out $(BENCH_DIR)/data_manifest/bench$$n.yaml \
+	    > $(BENCH_DIR)/sample$$n.log 2>&1 || exit 1; \
+	  (cd $(BENCH_DIR) && PATH="$(CURDIR)/$(BIN):$$PATH" $(CURDIR)/$(SNAKEMAKE) --profile profiles/local --cores 2 \
+	    --configfile config/config.yaml bench.yaml --config datasets=[bench$$n] --quiet) || exit 1; \
+	done
+	$(BIN)/shadowcam bench-report --benchmarks $(BENCH_DIR)/benchmarks/bench$(BENCH_FRAMES) \
+	  --frames $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/frames/timelapse.zarr \
+	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 ))
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint

@@ -126,7 +126,7 @@ class CoverageCrossing:
 
     def update(self, cover, time_s):
         """Add the coverage ``(H, W)`` of the next frame, taken at `time_s` seconds."""
-        cover = np.asarray(cover, dtype=np.float64)
+        cover = np.asarray(cover)
         if cover.shape != self._arrival.shape:
             raise ValueError(f"cover {cover.shape} must have shape {self._arrival.shape}")
         if self._previous is not None:
@@ -138,12 +138,14 @@ class CoverageCrossing:
                 confirmed = pending & below
                 self._arrival[confirmed] = self._pending[confirmed]
                 self._pending[pending] = np.nan
-                prev = self._previous
-                cross = (prev >= self.level) & below & self.eligible & np.isnan(self._arrival)
-            frac = (prev - self.level) / np.where(prev > cover, prev - cover, 1.0)
+                cross = (self._previous >= self.level) & below & self.eligible & np.isnan(self._arrival)
+            # interpolate (float64) only where a crossing happened: few pixels per frame
+            prev = self._previous[cross].astype(np.float64)
+            curr = cover[cross].astype(np.float64)
+            frac = (prev - self.level) / np.where(prev > curr, prev - curr, 1.0)
             value = self._time + np.clip(frac, 0.0, 1.0) * (time_s - self._time)
-            (self._pending if self.confirm else self._arrival)[cross] = value[cross]
-        self._previous = cover
+            (self._pending if self.confirm else self._arrival)[cross] = value
+        self._previous = cover.copy()
         self._time = float(time_s)
 
 

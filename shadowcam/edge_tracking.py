@@ -62,7 +62,8 @@ def column_edges(cover, *, valid, band=None, previous=None, half_window=3, max_s
     if half_window < 1:
         raise ValueError(f"half_window must be >= 1; got {half_window}")
     height, width = cover.shape
-    clipped = np.clip(np.nan_to_num(cover, nan=0.0), 0.0, 1.0)
+    clipped = np.clip(cover, np.float32(0.0), np.float32(1.0))
+    clipped[np.isnan(clipped)] = 0.0
     usable = valid & np.isfinite(cover)
     lit = (clipped >= 0.5) & usable
     pairs = lit[:-1] & ~lit[1:] & usable[1:]
@@ -73,13 +74,18 @@ def column_edges(cover, *, valid, band=None, previous=None, half_window=3, max_s
         preferred |= pairs & (band[:-1] | band[1:])
     if previous is not None:
         prev = np.asarray(previous, dtype=np.float64)
-        boundary = np.arange(1, height)[:, None]
+        boundary = np.arange(1, height, dtype=np.int32)[:, None]
+        # |boundary - prev| <= max_step for integer boundaries, without an (H, W) float temporary
         with np.errstate(invalid="ignore"):
-            preferred |= pairs & (np.abs(boundary - prev[None, :]) <= max_step)
+            low, high = np.ceil(prev - max_step)[None, :], np.floor(prev + max_step)[None, :]
+            preferred |= pairs & (boundary >= low) & (boundary <= high)
     use_preferred = preferred.any(axis=0)
     chosen = np.where(use_preferred[None, :], preferred, pairs)
     has = chosen.any(axis=0)
-    last = height - 2 - np.argmax(chosen[::-1], axis=0)  # lowest pair: rows (r, r+1)
+    # lowest pair (rows r, r + 1) per column: a max over rows, fast along contiguous rows
+    index_type = np.uint16 if height < 2**16 else np.uint32
+    last = np.max(chosen * np.arange(1, height, dtype=index_type)[:, None], axis=0).astype(np.int64) - 1
+    last = np.where(has, last, height - 2)
     offsets = np.arange(-half_window + 1, half_window + 1)  # rows of the window, relative to r
     rows = last[None, :] + offsets[:, None]
     inside = (rows >= 0) & (rows < height)

@@ -39,7 +39,7 @@ def difference_band(previous, current, *, valid=None, min_drop=0.2, margin=2):
     if not min_drop > 0:
         raise ValueError(f"min_drop must be positive; got {min_drop}")
     with np.errstate(invalid="ignore"):
-        drop = np.nan_to_num(prev - curr, nan=0.0) >= min_drop
+        drop = (prev - curr) >= np.float32(min_drop)  # NaN never counts as a drop
     if valid is not None:
         drop &= np.asarray(valid, dtype=bool)
     size = 2 * int(margin) + 1

@@ -7,6 +7,8 @@ Offers
 ------
 photometry_dataset : per-frame shifts and gains, per-pixel masks and levels.
 photometry_arrays : the dict :class:`shadowcam.outdoor_tracking.EdgeTracker` takes, from that dataset.
+photometry_part_dataset : one time part of the first pass (per-frame values, running minimum).
+photometry_part_arrays : the dict :func:`shadowcam.outdoor_normalise.merge_parts` takes, from that dataset.
 edges_dataset : tracked edges over (time, col), keyframes, interpolation flags.
 arrival_dataset : the arrival-time map over (row, col) with reasons.
 pushbroom_dataset : the ridge pushbroom over (time, col, channel).
@@ -78,6 +80,56 @@ def photometry_arrays(dataset):
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),
         "lit_level": dataset["lit_level"].values,
         "shadow_level": dataset["shadow_level"].values,
+    }
+
+
+def photometry_part_dataset(part, time_s, *, exposure_gain=None, sky_source="auto"):
+    """Assemble one time part of the first pass (:func:`shadowcam.outdoor_normalise.normalise_part`).
+
+    Parameters
+    ----------
+    part : dict
+        :meth:`shadowcam.outdoor_normalise.SequenceNormaliser.partial`.
+    time_s : (T_part,) ndarray
+        Times of the part's frames, seconds.
+    exposure_gain : (T_part,) ndarray, optional
+    sky_source : str, optional
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time`` (the part's frame indices): coords ``time_s``, ``shift_row``,
+        ``shift_col``, ``gain``; ``gain_sky``, ``kept_lit``, ``exposure_gain``; over
+        ``(row, col)``: ``shadow_min`` (linear), ``sky``, ``lit_at_start``;
+        ``reference (row, col, channel)`` only in the part holding frame 0.
+        Attrs ``first_frame``, ``sky_source``.
+    """
+    n_frames = len(part["gain_lit"])
+    first = int(part["first_frame"])
+    result = {**part, "shadow_ratio": np.nan, "lit_level": part["shadow_min"], "shadow_level": part["shadow_min"]}
+    dataset = photometry_dataset(result, time_s, exposure_gain=exposure_gain, sky_source=sky_source)
+    dataset = dataset.drop_vars(["lit_level", "shadow_level"]).assign_coords(time=np.arange(first, first + n_frames))
+    dataset["shadow_min"] = (("row", "col"), part["shadow_min"],
+                             {"units": "linear", "long_name": "minimum of 3-frame smoothed luminance / gain_sky over the part"})
+    if first != 0:
+        dataset = dataset.drop_vars(["reference", "channel"])
+    dataset.attrs.update(first_frame=first)
+    del dataset.attrs["shadow_ratio"]
+    return dataset
+
+
+def photometry_part_arrays(dataset):
+    """Return a part dataset (:func:`photometry_part_dataset`) as the dict ``merge_parts`` takes."""
+    return {
+        "first_frame": int(dataset.attrs["first_frame"]),
+        "shift": np.stack([dataset["shift_row"].values, dataset["shift_col"].values], axis=1),
+        "gain_lit": dataset["gain"].values,
+        "gain_sky": dataset["gain_sky"].values,
+        "kept_lit": dataset["kept_lit"].values,
+        "shadow_min": dataset["shadow_min"].values,
+        "sky": dataset["sky"].values.astype(bool),
+        "lit_at_start": dataset["lit_at_start"].values.astype(bool),
+        "reference": dataset["reference"].values if "reference" in dataset else None,
     }
 
 

@@ -7,6 +7,7 @@ percentile white point and display gamma, NaN drawn grey). The sky is masked
 
 Offers
 ------
+display_step : decimation step of large images for display.
 keyframes_figure : frames with their tracked edge overlaid.
 edge_over_time_figure : edge rows of every column over time (time x col image) and sample curves.
 arrival_map_figure : the arrival-time map in minutes, sky masked.
@@ -19,13 +20,29 @@ from matplotlib import colormaps
 from shadowcam.figures import NAN_GREY, _new_figure, display_rgb
 
 
-def _masked_rgb(image, sky):
+#: images are shown at most this many pixels wide / high (a 24 MP frame is decimated)
+DISPLAY_SIZE = 1600
+
+
+def display_step(shape, *, max_size=DISPLAY_SIZE):
+    """Decimation step that brings an ``(H, W)`` image to at most `max_size` pixels a side."""
+    return max(1, -(-max(int(n) for n in shape[:2]) // int(max_size)))
+
+
+def _extent(shape, step):
+    """imshow extent of an image decimated by `step`, in full-resolution pixel coordinates."""
+    return (-0.5, shape[1] * step - 0.5, shape[0] * step - 0.5, -0.5)
+
+
+def _masked_rgb(image, sky, step=1):
+    """Display RGB of `image` (already decimated by `step`), sky grey."""
     rgb = display_rgb(image)
-    rgb[np.asarray(sky, dtype=bool)] = NAN_GREY
+    sky = np.asarray(sky, dtype=bool)[::step, ::step]
+    rgb[sky[: rgb.shape[0], : rgb.shape[1]]] = NAN_GREY
     return rgb
 
 
-def keyframes_figure(frames, edge_rows, times_s, *, sky, is_keyframe=None, size=None):
+def keyframes_figure(frames, edge_rows, times_s, *, sky, is_keyframe=None, size=None, step=1):
     """Frames with the tracked edge of each drawn on it.
 
     Parameters
@@ -53,7 +70,8 @@ def keyframes_figure(frames, edge_rows, times_s, *, sky, is_keyframe=None, size=
     figure = _new_figure(size or (4.0 * cols, 3.0 * rows))
     for i, (frame, edge, t) in enumerate(zip(frames, edge_rows, times_s)):
         axes = figure.add_subplot(rows, cols, i + 1)
-        axes.imshow(_masked_rgb(frame, sky), interpolation="nearest", origin="upper")
+        axes.imshow(_masked_rgb(frame, sky, step), interpolation="nearest", origin="upper",
+                    extent=_extent(np.shape(frame), step))
         x = np.arange(len(edge)) + 0.5
         axes.plot(x, np.asarray(edge) - 0.5, color="red", linewidth=1.0)  # imshow: centre of row r at r
         mark = "" if is_keyframe is None or is_keyframe[i] else " (interpolated)"
@@ -97,8 +115,10 @@ def edge_over_time_figure(edge_row, time_s, *, reference=None, sky=None, n_curve
     figure.colorbar(shown, ax=axes, label="edge row (pixel)")
     if reference is not None:
         axes = figure.add_subplot(1, panels, 2)
-        axes.imshow(_masked_rgb(reference, np.zeros(reference.shape[:2], bool) if sky is None else sky),
-                    interpolation="nearest", origin="upper")
+        step = display_step(reference.shape)
+        axes.imshow(_masked_rgb(reference[::step, ::step], np.zeros(reference.shape[:2], bool) if sky is None
+                                else sky, step), interpolation="nearest", origin="upper",
+                    extent=_extent(reference[::step, ::step].shape, step))
         cmap = colormaps["plasma"]
         for k in np.linspace(0, edge.shape[0] - 1, n_curves).astype(int):
             axes.plot(np.arange(edge.shape[1]) + 0.5, edge[k] - 0.5, color=cmap(k / max(edge.shape[0] - 1, 1)),
@@ -128,8 +148,10 @@ def arrival_map_figure(arrival_s, *, sky, size=(6.5, 4.5)):
     arrival = np.where(np.asarray(sky, dtype=bool), np.nan, arrival)
     figure = _new_figure(size)
     axes = figure.add_subplot()
-    shown = axes.imshow(np.ma.masked_invalid(arrival), cmap=colormaps["viridis"].with_extremes(bad=NAN_GREY),
-                        interpolation="nearest", origin="upper")
+    step = display_step(arrival.shape)
+    shown = axes.imshow(np.ma.masked_invalid(arrival[::step, ::step]),
+                        cmap=colormaps["viridis"].with_extremes(bad=NAN_GREY), interpolation="nearest",
+                        origin="upper", extent=_extent(arrival[::step, ::step].shape, step))
     axes.set_title("shadow arrival (sky, never / always shadowed: grey)")
     axes.set_xlabel("col")
     axes.set_ylabel("row")
@@ -160,12 +182,14 @@ def pushbroom_figure(view, pushbroom, time_s, *, sky, size=(11.0, 4.5)):
         raise ValueError(f"pushbroom must be (T, W, 3) and time_s (T,); got {pushbroom.shape}, {times.shape}")
     figure = _new_figure(size)
     axes = figure.add_subplot(1, 2, 1)
-    axes.imshow(_masked_rgb(view, sky), interpolation="nearest", origin="upper")
+    step = display_step(view.shape)
+    axes.imshow(_masked_rgb(view[::step, ::step], sky, step), interpolation="nearest", origin="upper",
+                extent=_extent(view[::step, ::step].shape, step))
     axes.set_title("real view (first frame)")
     axes.set_xlabel("col")
     axes.set_ylabel("row")
     axes = figure.add_subplot(1, 2, 2)
-    axes.imshow(display_rgb(pushbroom), interpolation="nearest", origin="lower", aspect="auto",
+    axes.imshow(display_rgb(pushbroom[:, ::step]), interpolation="nearest", origin="lower", aspect="auto",
                 extent=(0, pushbroom.shape[1], times[0] / 60, times[-1] / 60))
     axes.set_title("ridge pushbroom (colour along the edge)")
     axes.set_xlabel("col")

@@ -9,17 +9,32 @@ update the per-pixel shadow level (running minimum of the 3-frame smoothed
 sky-normalised luminance). State is a few ``(H, W)`` arrays whatever the
 number of frames.
 
+Time parts (one job each): given frame 0, each frame's shift and gains depend
+on the previous frame only through the starting point of their searches (the
+gain prior, the shift's initial value), and the per-pixel minimum merges
+exactly. A part ``start:stop`` therefore first runs over ``overlap`` warm-up
+frames before `start` (searches started from the exposure metadata and zero
+shift; the 3-frame windows need two frames before `start`) and records
+``start .. stop - 1``; :func:`merge_parts` concatenates and takes the minimum.
+The parts equal the single job where the searches converge to the same
+solution from both starting points (measured on dev_ridge: see
+``tests/test_outdoor_normalise.py``).
+
 Offers
 ------
-SequenceNormaliser : the streaming pass; :meth:`update` per frame, :meth:`result`.
-normalise_frames : run it over an iterable of frames.
+SequenceNormaliser : the streaming pass; :meth:`update` per frame, :meth:`result` (or :meth:`partial`).
+normalise_frames : run it over an iterable of frames (one job).
+normalise_part : run it over one time part (with warm-up frames before it).
+part_frames : the frames a time part reads.
+merge_parts : merge the parts' results (concatenation and per-pixel minimum).
 aligned_luminance : one frame's registered luminance from the pass's results.
 """
 
 import numpy as np
 
 from shadowcam.photometric import estimate_gain, lit_at_start, luminance
-from shadowcam.registration import apply_shift, shift_lucas_kanade_LucasKanade1981, static_weight
+from shadowcam.registration import (apply_shift, block_all, block_mean, registration_factor,
+                                    shift_lucas_kanade_LucasKanade1981, static_weight)
 from shadowcam.sky_mask import auto_sky_mask
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
@@ -38,16 +53,51 @@ class SequenceNormaliser:
         Gains from exposure metadata (NaN where unknown); seed the gain search.
     sky_params : dict, optional
         Options of :func:`shadowcam.sky_mask.auto_sky_mask`.
+    registration_size : int, optional
+        Shifts and gains are estimated on frames reduced by an integer factor
+        (:func:`shadowcam.registration.block_mean`) to at most this many pixels
+        on the longer side; the shift is scaled back and the per-pixel levels
+        stay at full resolution. Frames this small or smaller are not reduced.
+    reference : (H, W, C) ndarray, optional
+        The first frame of the time-lapse, required when `first_index` > 0
+        (a time part: the frames fed start later).
+    first_index : int, optional
+        Index of the first frame fed to :meth:`update`. 0: it is the reference.
+        Otherwise the search for the first frame fed starts from the exposure
+        metadata (or gain 1) and zero shift, and converges over the frames
+        before `record_from` (the warm-up).
+    record_from : int, optional
+        Frames before this index are processed (warm-up) but not recorded,
+        and the running minimum uses the 3-frame windows ending at this frame
+        or later; ``record_from - first_index`` must be >= 2 when ``first_index > 0``.
     """
 
-    def __init__(self, *, sky=None, exposure_gain=None, sky_params=None):
+    def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
+                 reference=None, first_index=0, record_from=0):
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
+        self._registration_size = int(registration_size)
+        registration_factor((1, 1), max_size=self._registration_size)  # validates the option
+        self._k, self.record_from = int(first_index), int(record_from)
+        if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
+            raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
+                             "0 <= first_index <= record_from - 2 (two warm-up frames), or both 0")
         self.shifts, self.gain_lit, self.gain_sky, self.kept_lit = [], [], [], []
         self._recent = []
+        self._last = None  # (shift, gain_lit, gain_sky) of the previous frame processed
+        if self._k > 0:
+            if reference is None:
+                raise ValueError("reference (the first frame) is required when first_index > 0")
+            self._start(np.asarray(reference, dtype=np.float32))
+            seed = self._exposure[self._k - 1] if self._exposure is not None and self._k - 1 < self._exposure.size \
+                else np.nan
+            seed = float(seed) if np.isfinite(seed) else 1.0
+            self._last = (np.zeros(2), seed, seed)
 
     def _start(self, frame):
+        if frame.ndim != 3:
+            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
         height, width = frame.shape[:2]
         if self._sky is None:
             self._sky = auto_sky_mask(frame, **self._sky_params)
@@ -58,6 +108,12 @@ class SequenceNormaliser:
         self.lit_at_start, _ = lit_at_start(self.reference_luma, valid=~self._sky)
         self.shadowed_at_start = ~self._sky & ~self.lit_at_start
         self._shadow_min = np.full((height, width), np.inf, dtype=np.float32)
+        # working size of registration and gains: masks hold where the whole block does
+        self.factor = registration_factor((height, width), max_size=self._registration_size)
+        self._small_reference = block_mean(self.reference_luma, self.factor)
+        self._small_lit = block_all(self.lit_at_start, self.factor)
+        self._small_valid = block_all(~self._sky, self.factor)
+        self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
 
     def _prior(self, previous, k):
         if self._exposure is not None and k < self._exposure.size and np.isfinite(self._exposure[k]):
@@ -66,64 +122,125 @@ class SequenceNormaliser:
         return previous
 
     def update(self, frame):
-        """Process the next frame ``(H, W, C)`` (the first call sets the reference)."""
+        """Process the next frame ``(H, W, C)`` (frame 0 sets the reference)."""
         frame = np.asarray(frame, dtype=np.float32)
         if frame.ndim != 3:
             raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
-        k = len(self.shifts)
+        k = self._k
         if k == 0:
             self._start(frame)
-            shift, gain_lit, gain_sky, kept, luma = np.zeros(2), 1.0, 1.0, int(self.lit_at_start.sum()), self.reference_luma
+            shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
+            kept = int(self._small_lit.sum())
         else:
             if frame.shape != self.reference.shape:
                 raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
+            last_shift, last_gain, last_sky = self._last
             raw = luminance(frame)
-            rough, _ = estimate_gain(raw, self.reference_luma, pixels=self.lit_at_start,
-                                     prior=self._prior(self.gain_lit[-1], k))
-            weight = static_weight(raw, self.reference_luma, lit_reference=self.lit_at_start, gain=rough,
-                                   valid=~self._sky)
-            shift, _ = shift_lucas_kanade_LucasKanade1981(raw, self.reference_luma, weight=weight,
-                                                          initial=self.shifts[-1])
+            factor, ref = self.factor, self._small_reference
+            small = block_mean(raw, factor)
+            rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
+            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid)
+            shift, _ = shift_lucas_kanade_LucasKanade1981(small, ref, weight=weight, initial=last_shift / factor)
+            shift = shift * factor
             luma = apply_shift(raw, shift)
-            gain_lit, kept = estimate_gain(luma, self.reference_luma, pixels=self.lit_at_start, prior=rough)
-            gain_sky, _ = estimate_gain(luma, self.reference_luma, pixels=self.shadowed_at_start,
-                                        prior=self.gain_sky[-1] * gain_lit / self.gain_lit[-1])
-            if not self.shadowed_at_start.any():
+            del raw, small
+            small = block_mean(luma, factor)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed,
+                                        prior=last_sky * gain_lit / last_gain)
+            if not self._small_shadowed.any():
                 gain_sky = gain_lit
-        self.shifts.append(np.asarray(shift, dtype=np.float64))
-        self.gain_lit.append(float(gain_lit))
-        self.gain_sky.append(float(gain_sky))
-        self.kept_lit.append(int(kept))
+        self._last = (np.asarray(shift, dtype=np.float64), float(gain_lit), float(gain_sky))
+        if k >= self.record_from:
+            self.shifts.append(self._last[0])
+            self.gain_lit.append(self._last[1])
+            self.gain_sky.append(self._last[2])
+            self.kept_lit.append(int(kept))
         self._recent = (self._recent + [luma / np.float32(gain_sky)])[-3:]
-        if len(self._recent) == 3:
+        if len(self._recent) == 3 and k >= self.record_from:
             smooth = 0.25 * self._recent[0] + 0.5 * self._recent[1] + 0.25 * self._recent[2]
             np.minimum(self._shadow_min, smooth, out=self._shadow_min)
+        self._k += 1
 
-    def result(self):
-        """Return the pass's results (a dict of arrays; see :func:`normalise_frames`)."""
+    def partial(self):
+        """Return the recorded frames' results, to merge with :func:`merge_parts`.
+
+        Returns
+        -------
+        dict
+            ``first_frame`` (index of the first recorded frame), ``shift (T_part, 2)``,
+            ``gain_lit``, ``gain_sky``, ``kept_lit (T_part,)``, ``shadow_min (H, W)``
+            (running minimum over the part's 3-frame windows), ``sky``, ``lit_at_start``
+            ``(H, W)`` and ``reference (H, W, C)`` (frame 0; the same in every part).
+        """
         if not self.shifts:
-            raise ValueError("no frames were given")
-        if len(self.shifts) < 3:
-            raise ValueError(f"an outdoor time-lapse needs at least 3 frames; got {len(self.shifts)}")
-        ref = self.reference_luma
-        with np.errstate(divide="ignore", invalid="ignore"):
-            contrast = np.where(ref > 0, self._shadow_min / ref, np.inf)
-        shadowed = self.lit_at_start & (contrast < SHADOWED_CONTRAST)
-        ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
-        shadow_level = np.where(shadowed | self.shadowed_at_start, self._shadow_min, ratio * ref)
-        lit_level = np.where(self.lit_at_start, ref, self._shadow_min / ratio)
+            raise ValueError("no frames were recorded (feed frames up to and past record_from)")
         return {
+            "first_frame": self.record_from,
             "shift": np.array(self.shifts),
             "gain_lit": np.array(self.gain_lit),
             "gain_sky": np.array(self.gain_sky),
             "kept_lit": np.array(self.kept_lit),
+            "shadow_min": self._shadow_min,
             "sky": self._sky,
             "lit_at_start": self.lit_at_start,
-            "lit_level": lit_level.astype(np.float32),
-            "shadow_level": shadow_level.astype(np.float32),
-            "shadow_ratio": ratio,
             "reference": self.reference,
         }
+
+    def result(self):
+        """Return the pass's results (a dict of arrays; see :func:`normalise_frames`)."""
+        return merge_parts([self.partial()])
+
+
+def merge_parts(parts):
+    """Merge the results of time parts of the first pass (exactly: concatenation and minimum).
+
+    Parameters
+    ----------
+    parts : sequence of dict
+        :meth:`SequenceNormaliser.partial` of consecutive parts covering frames
+        ``0 .. T-1`` (any order; ``reference`` is needed in one of them).
+
+    Returns
+    -------
+    dict
+        As :func:`normalise_frames`.
+    """
+    parts = sorted(parts, key=lambda part: part["first_frame"])
+    if not parts:
+        raise ValueError("parts must hold at least one part")
+    expected = 0
+    for part in parts:
+        if part["first_frame"] != expected:
+            raise ValueError(f"parts must cover consecutive frames from 0; a part starts at frame "
+                             f"{part['first_frame']}, expected {expected}")
+        expected += len(part["gain_lit"])
+    if expected < 3:
+        raise ValueError(f"an outdoor time-lapse needs at least 3 frames; got {expected}")
+    reference = next((part["reference"] for part in parts if part.get("reference") is not None), None)
+    if reference is None:
+        raise ValueError("no part holds the reference frame (frame 0)")
+    shadow_min = parts[0]["shadow_min"].copy()
+    for part in parts[1:]:
+        np.minimum(shadow_min, part["shadow_min"], out=shadow_min)
+    sky, lit = np.asarray(parts[0]["sky"], dtype=bool), np.asarray(parts[0]["lit_at_start"], dtype=bool)
+    ref = luminance(reference)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        contrast = np.where(ref > 0, shadow_min / ref, np.inf)
+    shadowed = lit & (contrast < SHADOWED_CONTRAST)
+    ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
+    shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
+    lit_level = np.where(lit, ref, shadow_min / ratio)
+    joined = {key: np.concatenate([part[key] for part in parts]) for key in ("shift", "gain_lit", "gain_sky", "kept_lit")}
+    return {
+        **joined,
+        "sky": sky,
+        "lit_at_start": lit,
+        "lit_level": lit_level.astype(np.float32),
+        "shadow_level": shadow_level.astype(np.float32),
+        "shadow_ratio": ratio,
+        "reference": reference,
+    }
 
 
 def normalise_frames(frames, **options):
@@ -150,6 +267,51 @@ def normalise_frames(frames, **options):
     for frame in frames:
         normaliser.update(frame)
     return normaliser.result()
+
+
+def normalise_part(frames, *, start, stop, reference=None, overlap=2, **options):
+    """First pass over one time part ``start .. stop - 1`` (a job of its own).
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, C) ndarray
+        Frames ``max(0, start - overlap) .. stop - 1`` in time order
+        (:func:`part_frames` gives the range).
+    start, stop : int
+        Frames recorded by this part.
+    reference : (H, W, C) ndarray, optional
+        Frame 0 (needed when ``start - overlap > 0``).
+    overlap : int, optional
+        Warm-up frames before `start` (>= 2: the 3-frame windows of the running
+        minimum, and the gain and shift searches start from the previous frame's).
+    **options
+        Other keyword options of :class:`SequenceNormaliser`.
+
+    Returns
+    -------
+    dict
+        :meth:`SequenceNormaliser.partial`, to merge with :func:`merge_parts`.
+    """
+    first, stop = part_frames(start, stop, overlap=overlap)
+    normaliser = SequenceNormaliser(reference=reference if first > 0 else None, first_index=first,
+                                    record_from=start, **options)
+    fed = 0
+    for frame in frames:
+        normaliser.update(frame)
+        fed += 1
+    if fed != stop - first:
+        raise ValueError(f"part {start}:{stop} with overlap {overlap} needs frames {first}..{stop - 1} "
+                         f"({stop - first}); got {fed}")
+    return normaliser.partial()
+
+
+def part_frames(start, stop, *, overlap=2):
+    """Return ``(first, stop)``: the frames a part ``start:stop`` reads (warm-up included)."""
+    if not 0 <= start < stop:
+        raise ValueError(f"part start {start} and stop {stop}: need 0 <= start < stop")
+    if overlap < 2:
+        raise ValueError(f"overlap must be >= 2 frames; got {overlap}")
+    return max(0, start - overlap), stop
 
 
 def aligned_luminance(frame, shift):

@@ -104,7 +104,7 @@ class EdgeTracker:
                 far = ~(self._centre > self.edge_row[k][None, :] - self.update_distance)
             update = self.lit_at_start & (cover > 0.9) & far
             blended = (1 - self.lit_update) * self.lit_level + self.lit_update * luma
-            self.lit_level = np.where(update, blended, self.lit_level).astype(np.float32)
+            np.copyto(self.lit_level, blended, where=update)
         self._previous = cover
         self._k += 1
 

@@ -20,6 +20,9 @@ bandpass_log : band-passed log luminance used for matching.
 static_weight : weight mask of pixels whose illumination state did not change.
 shift_lucas_kanade_LucasKanade1981 : translation by iterative least squares.
 apply_shift : resample an image so that it aligns with the reference.
+registration_factor : integer downsampling factor that brings a frame to a working size.
+block_mean : mean over factor x factor blocks (area downsampling; a shift scales by 1/factor).
+block_all : True where all pixels of a factor x factor block are (masks at the working size).
 """
 
 import cv2
@@ -98,6 +101,66 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_
     weight[:margin + 1], weight[-margin - 1:] = 0, 0
     weight[:, :margin + 1], weight[:, -margin - 1:] = 0, 0
     return weight
+
+
+def registration_factor(shape, *, max_size=1536):
+    """Integer factor that brings the longer side of `shape` to at most `max_size` pixels.
+
+    Registration and the frame gains work at this reduced size (the shift is
+    scaled back); at 24 MP (6000 x 4000) and the default this is 4 (1500 x 1000).
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)`` of the frames.
+    max_size : int, optional
+        Longest side of the working image, pixels (>= 64).
+
+    Returns
+    -------
+    int
+        >= 1 (1 = full resolution).
+    """
+    if int(max_size) < 64:
+        raise ValueError(f"max_size (registration_size) must be >= 64 pixels; got {max_size}")
+    return max(1, -(-max(int(s) for s in shape[:2]) // int(max_size)))
+
+
+def block_mean(image, factor):
+    """Mean over non-overlapping ``factor x factor`` blocks.
+
+    Parameters
+    ----------
+    image : (H, W) ndarray
+    factor : int
+        1 returns `image` itself (no copy).
+
+    Returns
+    -------
+    (H // factor, W // factor) float32 ndarray
+        Block ``(i, j)`` averages rows ``factor i .. factor i + factor - 1`` (and
+        likewise columns); the remainder rows / columns are dropped. A
+        translation ``d`` of `image` is a translation ``d / factor`` of the result.
+    """
+    image = np.asarray(image)
+    if image.ndim != 2:
+        raise ValueError(f"image must be 2-D (H, W); got shape {image.shape}")
+    factor = int(factor)
+    if factor < 1:
+        raise ValueError(f"factor must be >= 1; got {factor}")
+    if factor == 1:
+        return image
+    height, width = (image.shape[0] // factor) * factor, (image.shape[1] // factor) * factor
+    cropped = np.ascontiguousarray(image[:height, :width], dtype=np.float32)
+    return cv2.resize(cropped, (width // factor, height // factor), interpolation=cv2.INTER_AREA)
+
+
+def block_all(mask, factor):
+    """True where every pixel of a ``factor x factor`` block is True (see :func:`block_mean`)."""
+    mask = np.asarray(mask, dtype=bool)
+    if int(factor) == 1:
+        return mask
+    return block_mean(mask.astype(np.float32), factor) >= np.float32(1.0)
 
 
 def apply_shift(image, shift, *, interpolation=cv2.INTER_CUBIC):

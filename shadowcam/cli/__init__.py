@@ -25,6 +25,7 @@ STEPS = {
     "evaluate": "evaluate",
     "plan": "plan",
     "outdoor-normalise": "outdoor_normalise",
+    "outdoor-merge-photometry": "outdoor_merge_photometry",
     "track-edges": "track_edges",
     "arrival": "arrival",
     "pushbroom": "pushbroom",
@@ -32,6 +33,8 @@ STEPS = {
     "outdoor-figures": "outdoor_figures",
     "bench": "bench",
     "methods-comparison": "methods_comparison",
+    "outdoor-sample": "outdoor_sample",
+    "bench-report": "bench_report",
 }
 
 

@@ -22,7 +22,8 @@ from shadowcam.figures import save_png
 from shadowcam.frame_store import open_frames
 from shadowcam.frame_times import median_interval
 from shadowcam.image_io import atomic_path
-from shadowcam.outdoor_figures import arrival_map_figure, edge_over_time_figure, keyframes_figure, pushbroom_figure
+from shadowcam.outdoor_figures import (arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure,
+                                       pushbroom_figure)
 from shadowcam.pushbroom import resample_uniform_time
 from shadowcam.registration import apply_shift
 
@@ -72,13 +73,15 @@ def run(args):
     sky = photometry["sky"].values.astype(bool)
     time_s = edges["time_s"].values
     picks = np.linspace(0, time_s.size - 1, 6).round().astype(int)
+    step = display_step(sky.shape)
     shown = []
-    for k in picks:  # six frames only: registered and divided by their lit gain
+    for k in picks:  # six frames only: registered, divided by their lit gain, decimated for display
         frame = frames["image"].isel(time=int(k)).values
         shift = (float(photometry["shift_row"][k]), float(photometry["shift_col"][k]))
-        shown.append(apply_shift(frame, shift) / np.float32(photometry["gain"].values[k]))
+        shown.append(apply_shift(frame, shift)[::step, ::step] / np.float32(photometry["gain"].values[k]))
+        del frame
     save_png(keyframes_figure(shown, [edges["edge_row"].values[k] for k in picks], time_s[picks], sky=sky,
-                              is_keyframe=edges["is_keyframe"].values[picks]), outdir / "keyframes.png")
+                              is_keyframe=edges["is_keyframe"].values[picks], step=step), outdir / "keyframes.png")
     reference = photometry["reference"].values
     save_png(edge_over_time_figure(edges["edge_row"].values, time_s, reference=reference, sky=sky),
              outdir / "edge_over_time.png")

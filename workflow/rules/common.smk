@@ -306,3 +306,79 @@ def get_methods_params(wildcards):
     """JSON ``--params`` of ``shadowcam methods-comparison``: the shadow-time half window."""
     options = config["shadow_time"]["params"]
     return as_json({k: options[k] for k in ("half_window",) if k in options})
+
+
+# --- Outdoor time parts and job sizes (rules in workflow/rules/outdoor.smk) ---
+# The first outdoor pass runs as one job per time part of config outdoor.part_frames
+# frames; job memory and run time are sized from the frame size (header of the first
+# frame) with per-megapixel figures measured by `make bench-outdoor-size`.
+
+_OUTDOOR_FRAME_CACHE = {}
+#: measured peak RSS per megapixel of frame (MB/MP) and fixed part (MB), with margin
+OUTDOOR_MEM_MB = {"normalise": (400, 85), "track": (400, 100), "per_pixel": (400, 70)}
+#: measured seconds per frame and megapixel on one core (x3 margin in outdoor_runtime)
+OUTDOOR_S_PER_MP_FRAME = {"normalise": 0.25, "track": 0.35, "per_pixel": 0.05}
+
+
+def outdoor_frame_layout(ds):
+    """Return ``(n_frames, megapixels)`` of the time-lapse of `ds` ((None, None) if rendered)."""
+    if ds not in _OUTDOOR_FRAME_CACHE:
+        if is_synthetic(ds):
+            _OUTDOOR_FRAME_CACHE[ds] = (None, None)
+        else:
+            from shadowcam.decode import frame_info
+
+            files = capture_files(ds, outdoor_sweep(ds))[1:]
+            info = frame_info(files[0])
+            _OUTDOOR_FRAME_CACHE[ds] = (len(files), info["height"] * info["width"] / 1e6)
+    return _OUTDOOR_FRAME_CACHE[ds]
+
+
+def outdoor_parts(ds):
+    """Time parts of the first outdoor pass of `ds`: ``START-STOP`` names (one ``0-end`` if unknown)."""
+    n_frames, _ = outdoor_frame_layout(ds)
+    size = int(config["outdoor"]["part_frames"])
+    if n_frames is None or size <= 0:
+        return ["0-end"]
+    return [f"{start}-{min(start + size, n_frames)}" for start in range(0, n_frames, size)]
+
+
+def get_outdoor_photometry_parts(wildcards):
+    """Part datasets of the first outdoor pass, merged into photometry.nc."""
+    return [f"results/{wildcards.ds}/outdoor/photometry.parts/{part}.nc" for part in outdoor_parts(wildcards.ds)]
+
+
+def get_outdoor_part_range(wildcards):
+    """``--part START:STOP`` value of a part name ``START-STOP`` (``end`` = to the last frame)."""
+    start, stop = wildcards.part.split("-")
+    return f"{start}:{'' if stop == 'end' else stop}"
+
+
+def _outdoor_frames_in_job(wildcards, stage):
+    n_frames, _ = outdoor_frame_layout(wildcards.ds)
+    if stage == "normalise" and n_frames is not None and not wildcards.part.endswith("end"):
+        start, stop = (int(v) for v in wildcards.part.split("-"))
+        return stop - start + 3  # warm-up frames and the reference
+    return n_frames or 1000
+
+
+def outdoor_mem_mb(stage):
+    """Resource function: MB of memory of an outdoor job of `stage`, from the frame size."""
+
+    def mem_mb(wildcards):
+        megapixels = outdoor_frame_layout(wildcards.ds)[1] or 24.0
+        fixed, per_mp = OUTDOOR_MEM_MB[stage]
+        return int(fixed + per_mp * megapixels)
+
+    return mem_mb
+
+
+def outdoor_runtime(stage):
+    """Resource function: minutes of an outdoor job of `stage` (3x the measured rate, >= 10)."""
+
+    def runtime(wildcards):
+        megapixels = outdoor_frame_layout(wildcards.ds)[1] or 24.0
+        seconds = OUTDOOR_S_PER_MP_FRAME[stage] * megapixels * _outdoor_frames_in_job(wildcards, stage)
+        return max(10, int(3 * seconds / 60) + 1)
+
+    return runtime

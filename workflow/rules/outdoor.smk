@@ -1,19 +1,45 @@
 # Stages of an outdoor time-lapse (manifest kind: outdoor): registration and
-# photometric normalisation, shadow-edge tracking with keyframe interpolation,
+# photometric normalisation (one job per time part of config outdoor.part_frames
+# frames, then an exact merge), shadow-edge tracking with keyframe interpolation,
 # the per-pixel arrival-time map, the ridge pushbroom, accuracy (datasets with
 # ground truth) and the report figures (paper Fig. 18). The frames come from
 # the shared `decode` rule (results/{ds}/frames/<sweep>.zarr).
 
 
-rule outdoor_normalise:
+rule outdoor_normalise_part:
     input:
         capture=get_capture_input,
         frames=get_outdoor_frames,
     output:
-        "results/{ds}/outdoor/photometry.nc",
+        temp("results/{ds}/outdoor/photometry.parts/{part}.nc"),
     params:
         manifest=get_capture_manifest,
+        part=get_outdoor_part_range,
         options=as_json(config["outdoor"]["normalise"]),
+    resources:
+        mem_mb=outdoor_mem_mb("normalise"),
+        runtime=outdoor_runtime("normalise"),
+    threads: 1
+    log:
+        "logs/{ds}/outdoor_normalise_part{part}.log",
+    benchmark:
+        "benchmarks/{ds}/outdoor_normalise_part{part}.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    shell:
+        "shadowcam outdoor-normalise --manifest {params.manifest} --frames {input.frames}"
+        " --part {params.part} --params {params.options:q} --out {output} > {log} 2>&1"
+
+
+rule outdoor_normalise:
+    input:
+        get_outdoor_photometry_parts,
+    output:
+        "results/{ds}/outdoor/photometry.nc",
+    resources:
+        mem_mb=outdoor_mem_mb("per_pixel"),
+        runtime=10,
+    threads: 1
     log:
         "logs/{ds}/outdoor_normalise.log",
     benchmark:
@@ -21,8 +47,7 @@ rule outdoor_normalise:
     conda:
         "../envs/shadowcam.yaml"
     shell:
-        "shadowcam outdoor-normalise --manifest {params.manifest} --frames {input.frames}"
-        " --params {params.options:q} --out {output} > {log} 2>&1"
+        "shadowcam outdoor-merge-photometry --parts {input} --out {output} > {log} 2>&1"
 
 
 rule track_edges:
@@ -33,6 +58,10 @@ rule track_edges:
         "results/{ds}/outdoor/edges.nc",
     params:
         options=as_json(config["outdoor"]["track_edges"]),
+    resources:
+        mem_mb=outdoor_mem_mb("track"),
+        runtime=outdoor_runtime("track"),
+    threads: 1
     log:
         "logs/{ds}/track_edges.log",
     benchmark:
@@ -52,6 +81,10 @@ rule arrival:
         "results/{ds}/outdoor/arrival.nc",
     params:
         options=as_json(config["outdoor"]["arrival"]),
+    resources:
+        mem_mb=outdoor_mem_mb("per_pixel"),
+        runtime=outdoor_runtime("per_pixel"),
+    threads: 1
     log:
         "logs/{ds}/arrival.log",
     benchmark:
@@ -70,6 +103,10 @@ rule pushbroom:
     output:
         nc="results/{ds}/outdoor/pushbroom.nc",
         png="results/{ds}/outdoor/pushbroom.png",
+    resources:
+        mem_mb=outdoor_mem_mb("per_pixel"),
+        runtime=outdoor_runtime("per_pixel"),
+    threads: 1
     log:
         "logs/{ds}/pushbroom.log",
     benchmark:
@@ -101,6 +138,10 @@ rule outdoor_accuracy:
     params:
         manifest=get_capture_manifest,
         options=as_json(config["outdoor"]["accuracy"]),
+    resources:
+        mem_mb=outdoor_mem_mb("per_pixel"),
+        runtime=outdoor_runtime("per_pixel"),
+    threads: 1
     log:
         "logs/{ds}/outdoor_accuracy.log",
     benchmark:
@@ -133,6 +174,10 @@ rule outdoor_figures:
         ),
     params:
         accuracy=get_outdoor_accuracy_option,
+    resources:
+        mem_mb=outdoor_mem_mb("per_pixel"),
+        runtime=outdoor_runtime("per_pixel"),
+    threads: 1
     log:
         "logs/{ds}/outdoor_figures.log",
     benchmark:
