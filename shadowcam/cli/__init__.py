@@ -17,6 +17,7 @@ STEPS = {
     "render": "render",
     "checksum": "checksum",
     "decode": "decode",
+    "merge-frames": "merge_frames",
     "shadow-time": "shadow_time",
     "dual-coords": "dual_coords",
     "dual-view": "dual_view",

@@ -10,6 +10,9 @@ rule shadow_time:
         sweeps=get_sweeps,
         method=config["shadow_time"]["method"],
         options=as_json(config["shadow_time"]["params"]),
+    resources:
+        mem_mb=get_shadow_time_mem_mb,
+        runtime=get_shadow_time_runtime,
     log:
         "logs/{ds}/shadow_time.log",
     benchmark:
