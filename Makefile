@@ -1,6 +1,6 @@
 # shadowcam: `make demo` runs the default synthetic dataset end to end and builds the
 # report; `make test` runs the test suite; `make lint` lints the workflow.
-# Both install the package (editable, with test extras) into .venv first.
+# Both install the package (editable, with test and SLURM-executor extras) into .venv first.
 
 PYTHON ?= python3
 VENV := .venv
@@ -16,7 +16,7 @@ $(BIN)/python:
 
 # Reinstall only when the package metadata changes.
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m pip install --quiet -e ".[test,slurm]"
 	touch $(STAMP)
 
 install: $(STAMP)
