@@ -23,6 +23,8 @@ include: "workflow/rules/shadow_time.smk"
 include: "workflow/rules/dual.smk"
 include: "workflow/rules/accuracy.smk"
 include: "workflow/rules/report.smk"
+include: "workflow/rules/evaluate.smk"
+include: "workflow/rules/outdoor.smk"
 
 
 localrules:

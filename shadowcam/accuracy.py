@@ -7,10 +7,13 @@ Metrics (synthetic data with exact ground truth, docs/architecture.md form):
   those pixels with an estimate; false-time rate = fraction of GT-unlit pixels
   that were given a time.
 * dual coordinates: Euclidean error (dual pixels) of ``(u, v)`` against the
-  GT times expressed on the same dual grid (uniform model only).
+  GT times expressed on the same dual grid (uniform model: the mask plane
+  scaled; calibration model: the calibration plane's window, reached from
+  the mask plane by the exact GT homography of the central projection).
 * dual image against the GT reciprocal render, after ONE least-squares gain
   fitted inside the valid mask (coverage & dual_cam_visible & finite
-  reciprocal): relative RMSE inside that mask, and over the whole image with
+  reciprocal; the render resampled onto the dual grid when the grids
+  differ): relative RMSE inside that mask, and over the whole image with
   holes counted as zero -- the two curves of the paper's Fig. 5.
 
 Targets (foundation issue) are checked and reported pass/fail.
@@ -237,14 +240,77 @@ def check_targets(report, *, noise="noise_free"):
     return rows
 
 
-def _uniform_truth(dual_coords, t_u, t_v):
-    """GT times on the dual grid of a uniform-model ``dual_coords`` dataset, else None."""
+def _dual_grid_map(dual_coords, ground_truth):
+    """Homography from GT mask-plane coordinates (``t_u``, ``t_v``) to the dual grid.
+
+    The uniform model's grid is an axis scaling of the mask plane. A
+    calibration plane's grid is the plane window of the dual coordinates
+    (attrs ``plane_window``, ``axes_flipped``, ``dual_width``,
+    ``dual_height``); for a point light the mask plane and the calibration
+    plane are related by the central projection from the light, a
+    homography, fitted exactly to the GT calibration times and plane points.
+    Returns None when the GT cannot express that grid.
+    """
     attrs = dual_coords.attrs
-    if attrs.get("method", attrs.get("model")) != "uniform":
+    method = attrs.get("method", attrs.get("model"))
+    if method == "uniform":
+        scale = np.asarray(attrs.get("scale", (1.0, 1.0)), dtype=np.float64)
+        offset = np.asarray(attrs.get("offset", (0.0, 0.0)), dtype=np.float64)
+        return np.array([[scale[0], 0, offset[0]], [0, scale[1], offset[1]], [0, 0, 1.0]])
+    needed = ("t_cal_u", "t_cal_v", "plane_xy")
+    if method != "calibration" or not all(k in ground_truth for k in needed):
         return None
-    scale = np.asarray(attrs.get("scale", (1.0, 1.0)), dtype=np.float64)
-    offset = np.asarray(attrs.get("offset", (0.0, 0.0)), dtype=np.float64)
-    return scale[0] * t_u + offset[0], scale[1] * t_v + offset[1]
+    import cv2
+
+    times = np.stack([ground_truth["t_cal_u"].values, ground_truth["t_cal_v"].values], -1)
+    plane = ground_truth["plane_xy"].values
+    ok = np.all(np.isfinite(times), -1) & np.all(np.isfinite(plane), -1)
+    if ok.sum() < 4:
+        return None
+    to_plane, _ = cv2.findHomography(times[ok].astype(np.float64), plane[ok].astype(np.float64), 0)
+    x0, y0, x1, y1 = (float(w) for w in attrs["plane_window"])
+    flip_x, flip_y = (bool(f) for f in attrs.get("axes_flipped", (False, False)))
+    sx = float(attrs["dual_width"]) / (x1 - x0)
+    sy = float(attrs["dual_height"]) / (y1 - y0)
+    to_grid = np.array([
+        [-sx if flip_x else sx, 0, (sx * x1 if flip_x else -sx * x0) - 0.5],
+        [0, -sy if flip_y else sy, (sy * y1 if flip_y else -sy * y0) - 0.5],
+        [0, 0, 1.0],
+    ])
+    return to_grid @ to_plane
+
+
+def _map_points(homography, x, y):
+    """Apply a 3x3 homography to coordinate arrays `x`, `y` of any shape."""
+    w = homography[2, 0] * x + homography[2, 1] * y + homography[2, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return ((homography[0, 0] * x + homography[0, 1] * y + homography[0, 2]) / w,
+                (homography[1, 0] * x + homography[1, 1] * y + homography[1, 2]) / w)
+
+
+def _reciprocal_on_grid(ground_truth, grid_map, shape):
+    """GT reciprocal render and camera visibility resampled onto a dual grid.
+
+    Each grid pixel centre is mapped back to mask-plane coordinates (the
+    reciprocal render's pixel grid: centre of column i is ``t_u = i``) and
+    the render is interpolated bilinearly there (NaN outside it); visibility
+    is taken from the nearest reciprocal pixel.
+    """
+    from scipy.ndimage import map_coordinates
+
+    reciprocal = ground_truth["reciprocal"].transpose("v", "u", "channel").values.astype(np.float64)
+    visible = ground_truth["dual_cam_visible"].transpose("v", "u").values
+    rows, cols = np.indices(shape, dtype=np.float64)
+    t_u, t_v = _map_points(np.linalg.inv(grid_map), cols, rows)
+    h, w = visible.shape
+    inside = (t_u >= -0.5) & (t_u <= w - 0.5) & (t_v >= -0.5) & (t_v <= h - 0.5)
+    coords = np.stack([np.where(inside, t_v, 0), np.where(inside, t_u, 0)])
+    resampled = np.stack([map_coordinates(reciprocal[..., c], coords, order=1, mode="nearest")
+                          for c in range(reciprocal.shape[2])], axis=-1)
+    resampled[~inside] = np.nan
+    nearest = np.rint(coords).astype(np.intp)
+    visible_on_grid = inside & visible[np.clip(nearest[0], 0, h - 1), np.clip(nearest[1], 0, w - 1)]
+    return resampled, visible_on_grid
 
 
 def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=None,
@@ -282,26 +348,25 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
         est = shadow_time["shadow_time"].sel(sweep=sweep).transpose("row", "col").values
         report["shadow_time"][sweep] = shadow_time_errors(
             est, ground_truth[f"t_{sweep}"].transpose("row", "col").values, lit=lit)
+    # without dual coordinates the dual view is taken to be on the reciprocal grid
+    grid_map = np.eye(3) if dual_coords is None else _dual_grid_map(dual_coords, ground_truth)
     if dual_coords is not None:
-        truth = _uniform_truth(dual_coords, ground_truth["t_u"].values.astype(np.float64),
-                               ground_truth["t_v"].values.astype(np.float64))
-        if truth is None:
-            report["dual_coords"] = {"skipped": "calibration dual grid: GT times are not dual "
-                                                "coordinates on this grid"}
+        if grid_map is None:
+            report["dual_coords"] = {"skipped": "the ground truth cannot express this dual grid"}
         else:
+            true_u, true_v = _map_points(grid_map, ground_truth["t_u"].values.astype(np.float64),
+                                         ground_truth["t_v"].values.astype(np.float64))
             report["dual_coords"] = dual_coord_errors(
-                dual_coords["u"].values, dual_coords["v"].values, *truth,
+                dual_coords["u"].values, dual_coords["v"].values, true_u, true_v,
                 valid=dual_coords["valid"].values)
     if dual_view is not None:
         image = dual_view["dual_view"].transpose("v", "u", "channel").values
-        reciprocal = ground_truth["reciprocal"].transpose("v", "u", "channel").values
-        if image.shape != reciprocal.shape:
-            report["dual_image"] = {
-                "skipped": f"dual view {image.shape} and reciprocal {reciprocal.shape} differ in grid"}
+        if grid_map is None:
+            report["dual_image"] = {"skipped": "the ground truth cannot express this dual grid"}
         else:
+            reciprocal, visible = _reciprocal_on_grid(ground_truth, grid_map, image.shape[:2])
             report["dual_image"] = dual_image_errors(
-                image, dual_view["coverage"].values, reciprocal,
-                dual_cam_visible=ground_truth["dual_cam_visible"].values)
+                image, dual_view["coverage"].values, reciprocal, dual_cam_visible=visible)
     report["targets"] = check_targets(report, noise=noise)
     report["all_targets_pass"] = bool(report["targets"]) and all(t["pass"] for t in report["targets"])
     return report

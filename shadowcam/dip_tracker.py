@@ -5,28 +5,42 @@ intensity over time (paper section II-A). Finding it needs neither the whole
 video nor its length in memory: frames are fed in time order, one block at a
 time, and each pixel keeps only
 
-* running sums of its signal (float64: exact over 10,000+ frames), from which
-  the unshadowed level and the noise are computed with the dip removed;
-* the window of ``2 * half_window + 1`` raw samples around the deepest point of
-  its temporally smoothed signal, plus the depth and position of the deepest
-  point that lies at least one window away from it (a second dip).
+* exact running sums of its signal, its square and each channel (see
+  :mod:`shadowcam.dip_kernels`), from which the unshadowed level and the
+  noise are computed with the dip removed;
+* its deepest local minima of the temporally [1, 2, 1]-smoothed signal (a
+  local minimum is below every smoothed value within ``half_window`` frames;
+  ties go to the earlier frame), and the raw window of ``2 * half_window + 1``
+  samples around the deepest one.
 
-Memory is ``O(H * W * window)``, independent of the number of frames, and the
-result equals that of a single pass over the whole sequence whatever the
-block sizes (blocks are processed frame by frame inside).
+The deepest minimum is the deepest smoothed value of the sweep; the second
+dip is the deepest local minimum at least one window (``2 * half_window + 1``
+frames) away from it. Memory is ``O(H * W * window)``, independent of the
+number of frames.
+
+Time chunks: a tracker built with ``owned=(start, stop)`` is fed the frames
+``[max(0, start - pad), min(n, stop + pad))`` (``pad = DipTracker.padding(h)``)
+and contributes the centres and sums of frames ``[start, stop)`` only; its
+:meth:`DipTracker.partial` is a :class:`DipPartial` (plain arrays, saved
+atomically to ``.npz``), and :func:`merge_partials` of the chunks of a sweep
+equals the single-pass :meth:`DipTracker.result` bit for bit, whatever the
+chunking and block sizes (the sums are exact, the minima are a selection).
 
 Offers
 ------
-DipTracker : the streaming accumulator (``update`` with frame blocks, then ``result``).
+DipTracker : the streaming accumulator (``update`` with frame blocks, then ``result`` or ``partial``).
 DipSummary : what the tracker hands to the timing methods (plain arrays).
+DipPartial : the state of one time chunk (``save`` / ``load``).
+merge_partials : the summary of a sweep from its time chunks.
 """
 
-from dataclasses import dataclass
+import os
+from dataclasses import dataclass, fields
+from pathlib import Path
 
 import numpy as np
 
-#: temporal smoothing kernel used to locate minima (binomial [1, 2, 1] / 4)
-_SMOOTHING = np.array([0.25, 0.5, 0.25], dtype=np.float32)
+from shadowcam import dip_kernels as _k
 
 
 @dataclass
@@ -45,8 +59,8 @@ class DipSummary:
     minimum_value : (H, W) float32 ndarray
         Smoothed signal at `minimum_frame`.
     second_value : (H, W) float32 ndarray
-        Deepest smoothed value at least one window away from `minimum_frame`
-        (``+inf`` when none).
+        Deepest smoothed local minimum at least one window away from
+        `minimum_frame` (``+inf`` when none).
     second_frame : (H, W) int64 ndarray
         Frame of `second_value` (negative when none).
     lit_level : (H, W) float64 ndarray
@@ -61,6 +75,11 @@ class DipSummary:
         Number of non-finite samples seen.
     n_frames : int
         Frames seen.
+    channel_sum : (H, W, C) float64 ndarray or None
+        Sum over all frames of each channel (non-finite samples as 0), when
+        the tracker was fed ``(T, H, W, C)`` blocks.
+    saturated : (H, W) bool ndarray or None
+        Whether any channel reached the saturation level in any frame.
     """
 
     window: np.ndarray
@@ -75,11 +94,80 @@ class DipSummary:
     mean_level: np.ndarray
     invalid_count: np.ndarray
     n_frames: int
+    channel_sum: np.ndarray = None
+    saturated: np.ndarray = None
 
     @property
     def half_window(self):
         """Half width of the stored window, in frames."""
         return (self.window.shape[0] - 1) // 2
+
+
+@dataclass
+class DipPartial:
+    """State of a :class:`DipTracker` over its owned frames (one time chunk).
+
+    Arrays are pixel-major; ``TOP`` = :data:`shadowcam.dip_kernels.TOP`,
+    ``K = 2 * half_window + 1``.
+
+    Attributes
+    ----------
+    start, stop : int
+        Owned frames ``[start, stop)`` (`stop` clipped to the frames fed).
+    end : int
+        One past the last frame fed.
+    half_window : int
+    top_value : (H, W, TOP) float32 ndarray
+        Deepest smoothed local minima with centre in ``[start, stop)``, ascending
+        (``+inf`` = empty slot).
+    top_frame : (H, W, TOP) int64 ndarray
+        Their frames (-1 = empty).
+    window : (H, W, K) float32 ndarray
+        Raw samples around ``top_frame[..., 0]``.
+    signal_sum : (H, W) int64 ndarray
+        Fixed-point sum (units ``2**-32``) of the finite signal samples.
+    square_hi, square_lo : (H, W) float64 ndarray
+        Exact-summing parts of the sum of squares.
+    count, invalid : (H, W) int64 ndarray
+        Finite and non-finite signal samples.
+    channel_sum : (H, W, C) int64 ndarray
+        Fixed-point per-channel sums (C = 0 if fed scalar frames).
+    saturated : (H, W) bool ndarray
+    """
+
+    start: int
+    stop: int
+    end: int
+    half_window: int
+    top_value: np.ndarray
+    top_frame: np.ndarray
+    window: np.ndarray
+    signal_sum: np.ndarray
+    square_hi: np.ndarray
+    square_lo: np.ndarray
+    count: np.ndarray
+    invalid: np.ndarray
+    channel_sum: np.ndarray
+    saturated: np.ndarray
+
+    def save(self, path):
+        """Write to `path` (``.npz``) atomically: a temporary file, then a rename."""
+        path = Path(path)
+        tmp = path.with_name(path.name + ".tmp.npz")
+        np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
+        os.replace(tmp, path)
+
+    @classmethod
+    def load(cls, path):
+        """Read a partial written by :meth:`save`."""
+        with np.load(path) as data:
+            missing = {f.name for f in fields(cls)} - set(data.files)
+            if missing:
+                raise ValueError(f"path {path} is not a DipPartial file: missing {sorted(missing)}")
+            values = {f.name: data[f.name] for f in fields(cls)}
+        for name in ("start", "stop", "end", "half_window"):
+            values[name] = int(values[name])
+        return cls(**values)
 
 
 class DipTracker:
@@ -92,6 +180,13 @@ class DipTracker:
     half_window : int, optional
         Frames kept on each side of the minimum; the dip must fit in
         ``2 * half_window + 1`` frames for entry and exit to be seen.
+    owned : (int, int), optional
+        Time chunk ``(start, stop)`` this tracker contributes; feed it frames
+        ``[max(0, start - pad), min(n, stop + pad))`` with
+        ``pad = DipTracker.padding(half_window)`` and take :meth:`partial`.
+        Default: the whole sequence.
+    saturation_level : float, optional
+        Channel value at or above which a pixel counts as saturated.
 
     Examples
     --------
@@ -102,156 +197,224 @@ class DipTracker:
     7
     """
 
-    def __init__(self, shape, *, half_window=4):
+    def __init__(self, shape, *, half_window=4, owned=None, saturation_level=0.999):
         if len(shape) != 2 or min(shape) < 1:
             raise ValueError(f"shape must be (H, W) with positive sizes, got {shape!r}")
         if int(half_window) < 1:
             raise ValueError(f"half_window must be >= 1, got {half_window!r}")
+        start, stop = (0, np.iinfo(np.int64).max) if owned is None else (int(owned[0]), int(owned[1]))
+        if not 0 <= start < stop:
+            raise ValueError(f"owned must be (start, stop) with 0 <= start < stop, got {owned!r}")
         self.shape = tuple(int(s) for s in shape)
-        self.half_window = int(half_window)
-        k = 2 * self.half_window + 1
-        h, w = self.shape
-        # ring buffer of the last k raw frames (NaN = not yet seen)
-        self._ring = np.full((k, h, w), np.nan, np.float32)
-        self._window = np.full((k, h, w), np.nan, np.float32)
-        self._min_value = np.full((h, w), np.inf, np.float32)
-        self._min_frame = np.full((h, w), -1, np.int64)
-        self._second_value = np.full((h, w), np.inf, np.float32)
-        self._second_frame = np.full((h, w), -(k + 1), np.int64)
-        self._sum = np.zeros((h, w), np.float64)
-        self._sumsq = np.zeros((h, w), np.float64)
-        self._count = np.zeros((h, w), np.int64)
-        self._invalid = np.zeros((h, w), np.int64)
-        self._n = 0
-        self._finished = False
-        self._scratch = np.empty((h, w), np.float32)
-        self._mask = np.empty((h, w), bool)
+        self.half_window = h = int(half_window)
+        self.owned = (start, stop)
+        self.saturation_level = float(saturation_level)
+        k = 2 * h + 1
+        p = self.shape[0] * self.shape[1]
+        self._first = max(0, start - self.padding(h))
+        self._next = self._first
+        self._ring = np.full((p, k + 2), np.nan, np.float32)
+        self._top_value = np.full((p, _k.TOP), np.inf, np.float32)
+        self._top_frame = np.full((p, _k.TOP), -1, np.int64)
+        self._window = np.full((p, k), np.nan, np.float32)
+        self._signal_sum = np.zeros(p, np.int64)
+        self._square_hi = np.zeros(p, np.float64)
+        self._square_lo = np.zeros(p, np.float64)
+        self._count = np.zeros(p, np.int64)
+        self._invalid = np.zeros(p, np.int64)
+        self._channel_sum = None
+        self._saturated = np.zeros(p, bool)
+        self._partial = None
+
+    @staticmethod
+    def padding(half_window):
+        """Frames needed on each side of an owned time chunk: ``half_window + 1``."""
+        return int(half_window) + 1
 
     @property
     def n_frames(self):
-        """Number of frames fed so far."""
-        return self._n
+        """One past the last frame fed so far (the frames seen, for a whole sweep)."""
+        return self._next
 
-    def update(self, block):
+    def update(self, block, *, first_index=None):
         """Feed the next frames.
 
         Parameters
         ----------
-        block : (T, H, W) or (H, W) array_like
-            Scalar signal of the next frames, in time order. Non-finite
-            samples are counted and ignored.
+        block : (T, H, W), (H, W) or (T, H, W, C) array_like
+            Signal of the next frames, in time order; with channels, the
+            signal is their sum and per-channel sums and saturation are kept
+            too. Non-finite samples are counted and ignored.
+        first_index : int, optional
+            Frame index of ``block[0]``; blocks must follow each other without
+            gaps. Default: the next frame.
         """
+        if self._partial is not None:
+            raise ValueError("update() called after result()/partial(); start a new DipTracker")
         block = np.asarray(block, dtype=np.float32)
         if block.ndim == 2:
             block = block[None]
-        if block.ndim != 3 or block.shape[1:] != self.shape:
+        if block.ndim == 3:
+            block = block[..., None]
+        if block.ndim != 4 or block.shape[1:3] != self.shape:
             raise ValueError(
-                f"block must have shape (T, {self.shape[0]}, {self.shape[1]}), got {block.shape}"
+                f"block must have shape (T, {self.shape[0]}, {self.shape[1]}[, C]), got {block.shape}"
             )
-        for frame in block:
-            self._push(frame)
+        first = self._next if first_index is None else int(first_index)
+        if first != self._next:
+            raise ValueError(
+                f"first_index must be {self._next} (the frame after the last one fed, or "
+                f"max(0, start - padding) at first), got {first}"
+            )
+        n_c = block.shape[3]
+        if self._channel_sum is None:
+            self._channel_sum = np.zeros((self._ring.shape[0], n_c), np.int64)
+        elif self._channel_sum.shape[1] != n_c:
+            raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[1]}")
+        flat = np.ascontiguousarray(block).reshape(block.shape[0], -1, n_c)
+        _k.track_block(flat, first, *self.owned, self.half_window, np.float32(self.saturation_level),
+                       self._ring, self._top_value, self._top_frame, self._window, self._signal_sum,
+                       self._square_hi, self._square_lo, self._count, self._invalid,
+                       self._channel_sum, self._saturated)
+        self._next = first + block.shape[0]
 
-    def _push(self, frame):
-        if self._finished:
-            raise ValueError("update() called after result(); start a new DipTracker")
-        k = self._ring.shape[0]
-        finite = np.isfinite(frame)
-        clean = np.where(finite, frame, 0.0)
-        self._sum += clean
-        self._sumsq += np.square(clean, dtype=np.float64)
-        self._count += finite
-        self._invalid += ~finite
+    def partial(self):
+        """Finish the owned chunk and return its :class:`DipPartial`.
 
-        self._ring[self._n % k] = frame
-        self._n += 1
-        centre = self._n - 1 - self.half_window  # newest frame whose window is complete
-        if centre >= 0:
-            self._consider(centre)
-
-    def _consider(self, centre):
-        """Test frame `centre` as the minimum; its window must be in the ring.
-
-        Neighbours outside the sequence are replaced by the centre itself in
-        the smoothing, and by NaN in the stored window.
+        Centres whose window runs past the last frame fed are tested as the
+        end of the sequence. The tracker cannot be updated afterwards.
         """
-        k = self._ring.shape[0]
-        h = self.half_window
-        mid = self._ring[centre % k]
-        prev = self._ring[(centre - 1) % k] if centre >= 1 else mid
-        nxt = self._ring[(centre + 1) % k] if centre + 1 < self._n else mid
-        smoothed = self._scratch
-        np.multiply(mid, _SMOOTHING[1], out=smoothed)
-        smoothed += _SMOOTHING[0] * prev
-        smoothed += _SMOOTHING[2] * nxt
-
-        better = self._mask
-        np.less(smoothed, self._min_value, out=better)
-        far_from_min = (centre - self._min_frame) >= k
-        # a deeper minimum a window away: the old one becomes the second dip
-        demote = better & far_from_min
-        # a deeper minimum close to the second dip absorbs it (same dip)
-        absorb = better & ((centre - self._second_frame) < k)
-        self._second_value[absorb] = np.inf
-        self._second_frame[absorb] = -(k + 1)
-        take = demote & (self._min_value < self._second_value)
-        self._second_value[take] = self._min_value[take]
-        self._second_frame[take] = self._min_frame[take]
-        # a shallower dip a window away from the minimum is a second-dip candidate
-        second = ~better & far_from_min & (smoothed < self._second_value)
-        self._second_value[second] = smoothed[second]
-        self._second_frame[second] = centre
-        if not better.any():
-            return
-        self._min_value[better] = smoothed[better]
-        self._min_frame[better] = centre
-        for j in range(k):
-            frame_index = centre - h + j
-            if 0 <= frame_index < self._n:
-                self._window[j][better] = self._ring[frame_index % k][better]
-            else:
-                self._window[j][better] = np.nan
+        if self._partial is None:
+            start, stop = self.owned
+            end = self._next
+            first = max(end - self.half_window - 1, start)
+            _k.finish_centres(first, min(stop, end), end, self.half_window, self._ring,
+                              self._top_value, self._top_frame, self._window)
+            h, w = self.shape
+            channels = self._channel_sum if self._channel_sum is not None else np.zeros((h * w, 0), np.int64)
+            self._partial = DipPartial(
+                start=start, stop=max(min(stop, end), start), end=end, half_window=self.half_window,
+                top_value=self._top_value.reshape(h, w, -1), top_frame=self._top_frame.reshape(h, w, -1),
+                window=self._window.reshape(h, w, -1), signal_sum=self._signal_sum.reshape(h, w),
+                square_hi=self._square_hi.reshape(h, w), square_lo=self._square_lo.reshape(h, w),
+                count=self._count.reshape(h, w), invalid=self._invalid.reshape(h, w),
+                channel_sum=channels.reshape(h, w, -1), saturated=self._saturated.reshape(h, w),
+            )
+            self._ring = None
+        return self._partial
 
     def result(self):
-        """Finish the sweep and return its :class:`DipSummary`.
+        """Finish the sweep and return its :class:`DipSummary` (the tracker must own it all)."""
+        partial = self.partial()
+        if partial.start != self._first:
+            raise ValueError("result() needs a tracker owning the whole sweep; use partial() and merge_partials()")
+        return merge_partials([partial], n_frames=partial.end)
 
-        The last ``half_window`` frames, whose windows run past the end of the
-        sequence, are tested too. The tracker cannot be updated afterwards.
-        """
-        if not self._finished:
-            for centre in range(max(self._n - self.half_window, 0), self._n):
-                self._consider(centre)
-            self._finished = True
-        return self._summary()
 
-    def _summary(self):
-        k = self._window.shape[0]
-        h = self.half_window
-        win = self._window
-        win_finite = np.isfinite(win)
-        win_sum = np.where(win_finite, win, 0).sum(axis=0, dtype=np.float64)
-        win_sumsq = np.square(np.where(win_finite, win, 0), dtype=np.float64).sum(axis=0)
-        win_count = win_finite.sum(axis=0)
-        found = self._min_frame >= 0
-        lit_count = self._count - np.where(found, win_count, 0)
-        lit_sum = self._sum - np.where(found, win_sum, 0)
-        lit_sumsq = self._sumsq - np.where(found, win_sumsq, 0)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            lit_level = np.where(lit_count > 0, lit_sum / lit_count, np.nan)
-            variance = lit_sumsq / lit_count - lit_level**2
-            # unbiased, and never negative from round-off
-            variance = np.maximum(variance, 0) * lit_count / np.maximum(lit_count - 1, 1)
-            mean_level = np.where(self._count > 0, self._sum / self._count, np.nan)
-        return DipSummary(
-            window=win.copy(),
-            window_start=np.where(found, self._min_frame - h, 0),
-            minimum_frame=self._min_frame.copy(),
-            minimum_value=self._min_value.copy(),
-            second_value=self._second_value.copy(),
-            second_frame=self._second_frame.copy(),
-            lit_level=lit_level,
-            noise=np.sqrt(variance),
-            lit_count=lit_count,
-            mean_level=mean_level,
-            invalid_count=self._invalid.copy(),
-            n_frames=self._n,
-        )
+def _check_tiling(partials, n_frames):
+    """Raise ValueError unless the partials' owned chunks tile ``[0, n_frames)`` and were fed enough."""
+    if not partials:
+        raise ValueError("partials is empty: give the partials of every time chunk")
+    ordered = sorted(partials, key=lambda part: part.start)
+    expected = 0
+    for part in ordered:
+        if part.start != expected:
+            raise ValueError(
+                f"partials must tile frames [0, {n_frames}) without gaps or overlaps; "
+                f"a chunk starts at {part.start} where {expected} was expected"
+            )
+        pad = DipTracker.padding(part.half_window)
+        if part.end < min(n_frames, part.stop + pad):
+            raise ValueError(
+                f"the chunk owning [{part.start}, {part.stop}) was fed frames up to {part.end} only; "
+                f"feed it up to min(n_frames, stop + {pad})"
+            )
+        expected = part.stop
+    if expected != n_frames:
+        raise ValueError(f"n_frames is {n_frames} but the partials cover frames [0, {expected})")
+    if len({part.half_window for part in ordered}) != 1:
+        raise ValueError("partials have different half_window values; track every chunk alike")
+    if len({part.channel_sum.shape[2] for part in ordered}) != 1:
+        raise ValueError("partials have different channel counts; feed every chunk alike")
+
+
+def _lexicographic_min(values, frames, allowed):
+    """Index of the smallest (value, frame) among `allowed` entries along the last axis."""
+    v = np.where(allowed, values, np.inf)
+    best = v.min(axis=-1, keepdims=True)
+    tie = allowed & (v == best)
+    f = np.where(tie, frames, np.iinfo(np.int64).max)
+    return np.argmin(f, axis=-1), np.isfinite(best[..., 0])
+
+
+def merge_partials(partials, *, n_frames):
+    """The :class:`DipSummary` of a sweep from the partials of its time chunks.
+
+    Parameters
+    ----------
+    partials : sequence of DipPartial
+        One per chunk, in any order; their owned chunks must tile ``[0, n_frames)``.
+    n_frames : int
+        Frames of the sweep.
+
+    Returns
+    -------
+    DipSummary
+        Equal bit for bit to the single-pass :meth:`DipTracker.result`.
+    """
+    n_frames = int(n_frames)
+    _check_tiling(partials, n_frames)
+    h = partials[0].half_window
+    k = 2 * h + 1
+    values = np.concatenate([p.top_value for p in partials], axis=-1)
+    frames = np.concatenate([p.top_frame for p in partials], axis=-1)
+    finite = np.isfinite(values)
+    first, found = _lexicographic_min(values, frames, finite)
+    pick = first[..., None]
+    minimum_value = np.take_along_axis(values, pick, -1)[..., 0]
+    minimum_frame = np.where(found, np.take_along_axis(frames, pick, -1)[..., 0], -1)
+    far = np.abs(frames - minimum_frame[..., None]) >= k
+    second, has_second = _lexicographic_min(values, frames, finite & far & found[..., None])
+    second_value = np.where(has_second, np.take_along_axis(values, second[..., None], -1)[..., 0], np.inf)
+    second_frame = np.where(has_second, np.take_along_axis(frames, second[..., None], -1)[..., 0], -(k + 1))
+    owner = first // _k.TOP
+    window = np.full(partials[0].window.shape, np.nan, np.float32)
+    for index, part in enumerate(partials):
+        np.copyto(window, part.window, where=(found & (owner == index))[..., None])
+    window = np.ascontiguousarray(np.moveaxis(window, -1, 0))
+
+    def total(name):
+        return sum(getattr(p, name) for p in partials)
+
+    win_finite = np.isfinite(window)
+    win_hi, win_lo = _k.split_square(window)
+    keep = found
+    lit_count = total("count") - np.where(keep, win_finite.sum(axis=0), 0)
+    lit_sum = (total("signal_sum") - np.where(keep, _k.quantise_sum(window).sum(axis=0), 0)) / _k.SUM_SCALE
+    lit_sumsq = ((total("square_hi") - np.where(keep, win_hi.sum(axis=0), 0))
+                 + (total("square_lo") - np.where(keep, win_lo.sum(axis=0), 0)))
+    count = total("count")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit_level = np.where(lit_count > 0, lit_sum / lit_count, np.nan)
+        variance = lit_sumsq / lit_count - lit_level**2
+        # unbiased, and never negative from round-off
+        variance = np.maximum(variance, 0) * lit_count / np.maximum(lit_count - 1, 1)
+        mean_level = np.where(count > 0, total("signal_sum") / _k.SUM_SCALE / count, np.nan)
+    channel_sum = total("channel_sum")
+    saturated = np.logical_or.reduce([p.saturated for p in partials])
+    return DipSummary(
+        window=window,
+        window_start=np.where(found, minimum_frame - h, 0),
+        minimum_frame=minimum_frame.astype(np.int64),
+        minimum_value=minimum_value.astype(np.float32),
+        second_value=second_value.astype(np.float32),
+        second_frame=second_frame.astype(np.int64),
+        lit_level=lit_level,
+        noise=np.sqrt(variance),
+        lit_count=lit_count.astype(np.int64),
+        mean_level=mean_level,
+        invalid_count=total("invalid").astype(np.int64),
+        n_frames=n_frames,
+        channel_sum=channel_sum / _k.SUM_SCALE if channel_sum.shape[-1] else None,
+        saturated=saturated,
+    )

@@ -561,6 +561,12 @@ def dual_coords_calibration(
         if len(plane_xy) == 0:
             raise ValueError("cal_t_u/cal_t_v: no calibration-plane pixel has both times")
         lo, hi = plane_xy.min(axis=0), plane_xy.max(axis=0)
+        if not np.all(hi > lo):
+            raise ValueError(
+                f"cal_t_u/cal_t_v: the {len(plane_xy)} calibration-plane pixels are collinear "
+                "in the plane (degenerate bounding box); the calibration plane must be seen "
+                "over an area (check plane_mask)"
+            )
         plane_window = (lo[0], lo[1], hi[0], hi[1])
     x0, y0, x1, y1 = (float(w) for w in plane_window)
     if not (x1 > x0 and y1 > y0):

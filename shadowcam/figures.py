@@ -14,6 +14,7 @@ primal_figure : the camera (primal) image.
 time_map_figure : a shadow-time map with colour bar.
 dual_view_figure : the dual view, next to the ground-truth reciprocal view if given.
 error_histogram_figure : histogram of shadow-time errors per sweep.
+study_factor_figure : the simulation study's error curves against one factor (paper Fig. 5).
 save_png : write a figure as PNG (exact pixel size).
 """
 
@@ -237,3 +238,52 @@ def save_png(figure, path):
     path = Path(path)
     figure.savefig(path, format="png", dpi=FIGURE_DPI)
     return path
+
+
+def study_factor_figure(values, *, whole, masked, coord_error, factor, unit="",
+                        size=(6.0, 4.0)):
+    """Error curves of the simulation study against one factor (the paper's Fig. 5).
+
+    Parameters
+    ----------
+    values : (L,) ndarray
+        The factor's levels (NaN entries are skipped).
+    whole, masked : (L,) ndarray
+        Relative RMSE of the dual view over the whole image and inside the GT valid mask.
+    coord_error : (L,) ndarray
+        RMS dual-coordinate error (dual pixels), drawn on a second axis.
+    factor : str
+        Name of the factor (x-axis label).
+    unit : str
+        Unit of the factor.
+    size : (float, float)
+        Figure size in inches.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    values = np.asarray(values, dtype=np.float64)
+    curves = [np.asarray(c, dtype=np.float64) for c in (whole, masked, coord_error)]
+    if values.ndim != 1 or any(c.shape != values.shape for c in curves):
+        raise ValueError(f"values, whole, masked, coord_error must be 1-D of one length, got "
+                         f"{values.shape}, {[c.shape for c in curves]}")
+    keep = np.isfinite(values)
+    figure = _new_figure(size)
+    axes = figure.add_subplot(1, 1, 1)
+    axes.plot(values[keep], curves[0][keep], "o-", color="tab:blue", label="dual view, whole image")
+    axes.plot(values[keep], curves[1][keep], "s-", color="tab:orange",
+              label="dual view, GT valid mask")
+    axes.set_xlabel(f"{factor} ({unit})" if unit else factor)
+    axes.set_ylabel("relative RMSE vs reciprocal render")
+    axes.set_ylim(bottom=0)
+    twin = axes.twinx()
+    twin.plot(values[keep], curves[2][keep], "^--", color="tab:green",
+              label="dual coordinates (right axis)")
+    twin.set_ylabel("RMS (u, v) error (dual pixel)")
+    twin.set_ylim(bottom=0)
+    lines = axes.get_lines() + twin.get_lines()
+    axes.legend(lines, [line.get_label() for line in lines], fontsize="small", loc="best")
+    axes.set_title(f"simulation study: {factor}")
+    figure.tight_layout()
+    return figure

@@ -16,6 +16,15 @@ Supported formats (the manifest's ``ground_truth.format``):
 * ``mitsuba_lab_npz`` -- ``gt.npz`` of the shared lab development data
   (``shared/data/README.md`` section 1.5).
 
+Outdoor time-lapses (manifest ``kind: outdoor``) have their own standard form,
+:data:`OUTDOOR_REQUIRED` (``shadow_class``, ``sky_mask``, ``arrival_time_s``, ...
+over ``(row, col)``; ``times_s`` over ``time``; ``pb_edge_y`` over ``(time, col)``,
+the definitions of ``shared/data/README.md`` section 2.6), from
+
+* ``shadowcam_outdoor_nc`` -- the ``ground_truth.nc`` of the project's outdoor
+  renderer (same variable names and dims);
+* ``mitsuba_outdoor_npz`` -- ``gt.npz`` of the shared outdoor development data.
+
 Offers
 ------
 GT_FORMATS : format name -> loader(path) -> Dataset.
@@ -23,6 +32,9 @@ REQUIRED : standard variables and their dims.
 load_ground_truth : the standard GT Dataset of a manifest.
 mitsuba_lab_npz_to_dataset : convert the arrays of a lab ``gt.npz``.
 check_ground_truth : raise ValueError unless a Dataset is in standard form.
+OUTDOOR_REQUIRED : standard outdoor variables and their dims.
+mitsuba_outdoor_npz_to_dataset : convert the arrays of an outdoor ``gt.npz``.
+check_outdoor_ground_truth : raise ValueError unless a Dataset is in outdoor standard form.
 """
 
 import logging
@@ -73,12 +85,118 @@ _LAB_NPZ_VARS = {
 }
 
 
+#: standard outdoor variables and their dims
+OUTDOOR_REQUIRED = {
+    "shadow_class": ("row", "col"),
+    "sky_mask": ("row", "col"),
+    "arrival_time_s": ("row", "col"),
+    "arrival_frame": ("row", "col"),
+    "first_shadowed_frame": ("row", "col"),
+    "relit_after_arrival": ("row", "col"),
+    "times_s": ("time",),
+}
+_TIME = ("time",)
+# outdoor gt.npz key -> (dims, attrs); keys not listed here are skipped
+_OUTDOOR_NPZ_VARS = {
+    "shadow_class": (_CAM, {"long_name": "0 sky, 1 never shadowed, 2 shadowed at start, 3 shadow arrives"}),
+    "sky_mask": (_CAM, {"long_name": "pixel-centre ray misses terrain"}),
+    "never_shadowed": (_CAM, {"long_name": "class 1"}),
+    "shadowed_at_start": (_CAM, {"long_name": "class 2: unlit in frame 0"}),
+    "always_shadowed": (_CAM, {"long_name": "unlit in every frame"}),
+    "relit_after_arrival": (_CAM, {"long_name": "lit again after the first shadowed frame"}),
+    "cause": (_CAM, {"long_name": "class 3: 1 cast shadow, 2 attached"}),
+    "arrival_time_s": (_CAM, {"units": "s", "long_name": "first time the pixel-centre point is unlit"}),
+    "arrival_frame": (_CAM, {"units": "frame", "long_name": "arrival_time_s as fractional frame index"}),
+    "first_shadowed_frame": (_CAM, {"units": "frame", "long_name": "first frame whose pixel centre is unlit (-1 never)"}),
+    "arrival_time_half_coverage_s": (_CAM, {"units": "s", "long_name": "median of 16 sub-pixel arrival times"}),
+    "arrival_frame_half_coverage": (_CAM, {"units": "frame", "long_name": "arrival_time_half_coverage_s as frame"}),
+    "subpixel_sky_fraction": (_CAM, {"units": "1", "long_name": "fraction of 16 sub-points that are sky"}),
+    "sky_fraction": (_CAM, {"units": "1", "long_name": "rendered sky fraction of the pixel footprint"}),
+    "depth_z": (_CAM, {"units": "m", "long_name": "camera z of the pixel-centre point"}),
+    "reference_radiance": (_CAM + ("channel",), {"units": "radiance", "long_name": "noise-free radiance of frame 0"}),
+    "times_s": (_TIME, {"units": "s", "long_name": "frame time since frame 0"}),
+    "exposure_gain": (_TIME, {"units": "1", "long_name": "true total exposure gain"}),
+    "shake_dx_px": (_TIME, {"units": "pixel", "long_name": "true shake along columns (content moves +dx)"}),
+    "shake_dy_px": (_TIME, {"units": "pixel", "long_name": "true shake along rows (content moves +dy)"}),
+    "pb_edge_y": (_TIME + ("col",), {"units": "pixel", "long_name": "GT shadow-edge row (pixel-edge coordinates)"}),
+    "pb_n_transitions": (_TIME + ("col",), {"long_name": "lit-above / shadowed-below pairs in the column"}),
+    "pb_front": (_TIME + ("col", "channel"), {"units": "radiance", "long_name": "GT ridge pushbroom (reference radiance at the edge)"}),
+}
+
+
+def _wrong_dims(dataset, required):
+    """Names (with dims) of `required` variables missing from `dataset` or with other dims."""
+    return [f"{name} {dims}" for name, dims in required.items()
+            if name not in dataset or tuple(dataset[name].dims) != dims]
+
+
+def _npz_data_vars(arrays, table):
+    """``{key: (dims, array, attrs)}`` for the keys of `table` present in `arrays`, ndim checked."""
+    data_vars = {}
+    for key, (dims, attrs) in table.items():
+        if key in arrays:
+            value = np.asarray(arrays[key])
+            if value.ndim != len(dims):
+                raise ValueError(f"gt.npz key {key!r} has shape {value.shape}, expected dims {dims}")
+            data_vars[key] = (dims, value, attrs)
+    return data_vars
+
+
+def _as_bool(dataset, names):
+    """`dataset` with the variables `names` (those present) cast to bool."""
+    for name in names:
+        if name in dataset:
+            dataset[name] = dataset[name].astype(bool)
+    return dataset
+
+
+_OUTDOOR_MASKS = ("sky_mask", "never_shadowed", "shadowed_at_start", "always_shadowed", "relit_after_arrival")
+
+
+def check_outdoor_ground_truth(dataset):
+    """Raise ValueError unless `dataset` has the standard outdoor variables with their dims."""
+    problems = _wrong_dims(dataset, OUTDOOR_REQUIRED)
+    if problems:
+        raise ValueError(f"outdoor ground truth lacks (or has wrong dims for): {', '.join(problems)}")
+    return dataset
+
+
+def mitsuba_outdoor_npz_to_dataset(arrays):
+    """Convert the arrays of an outdoor ``gt.npz`` into the standard outdoor GT Dataset.
+
+    Parameters
+    ----------
+    arrays : mapping of str to ndarray
+        E.g. ``numpy.load("gt.npz")`` of ``shared/data/outdoor-dev/dev_ridge``:
+        camera arrays ``(H, W[, 3])`` indexed ``[row, col]``, per-frame arrays
+        ``(T[, W[, 3]])``.
+
+    Returns
+    -------
+    xarray.Dataset
+        Every known key (see ``_OUTDOOR_NPZ_VARS``) with coords ``row``, ``col``,
+        ``time`` (frame index), ``channel``; attr ``definitions`` (JSON) if present.
+    """
+    missing = [k for k in OUTDOOR_REQUIRED if k not in arrays]
+    if missing:
+        raise ValueError(f"outdoor gt.npz arrays lack required keys {missing}")
+    data_vars = _npz_data_vars(arrays, _OUTDOOR_NPZ_VARS)
+    height, width = np.shape(arrays["shadow_class"])
+    coords = {
+        "row": np.arange(height),
+        "col": np.arange(width),
+        "time": ("time", np.arange(np.size(arrays["times_s"])), {"units": "frame"}),
+        "channel": np.array(["R", "G", "B"], dtype=object),
+    }
+    dataset = _as_bool(xr.Dataset(data_vars, coords=coords), _OUTDOOR_MASKS)
+    if "definitions" in arrays:
+        dataset.attrs["definitions"] = str(np.asarray(arrays["definitions"]))
+    return check_outdoor_ground_truth(dataset)
+
+
 def check_ground_truth(dataset):
     """Raise ValueError unless `dataset` has the standard variables with their dims."""
-    problems = [
-        f"{name} {dims}" for name, dims in REQUIRED.items()
-        if name not in dataset or tuple(dataset[name].dims) != dims
-    ]
+    problems = _wrong_dims(dataset, REQUIRED)
     if problems:
         raise ValueError(f"ground truth lacks (or has wrong dims for): {', '.join(problems)}")
     return dataset
@@ -103,13 +221,7 @@ def mitsuba_lab_npz_to_dataset(arrays):
     missing = [k for k in REQUIRED if k not in arrays]
     if missing:
         raise ValueError(f"gt.npz arrays lack required keys {missing}")
-    data_vars = {}
-    for key, (dims, attrs) in _LAB_NPZ_VARS.items():
-        if key in arrays:
-            value = np.asarray(arrays[key])
-            if value.ndim != len(dims):
-                raise ValueError(f"gt.npz key {key!r} has shape {value.shape}, expected dims {dims}")
-            data_vars[key] = (dims, value, attrs)
+    data_vars = _npz_data_vars(arrays, _LAB_NPZ_VARS)
     skipped = sorted(set(arrays) - set(_LAB_NPZ_VARS))
     if skipped:
         log.debug("gt.npz keys not converted: %s", skipped)
@@ -124,10 +236,8 @@ def mitsuba_lab_npz_to_dataset(arrays):
         "xyz": np.array(["x", "y", "z"], dtype=object),
         "cam_axis": np.array(["col", "row"], dtype=object),
     }
-    dataset = xr.Dataset(data_vars, coords=coords)
-    for name in ("lit", "dual_cam_visible", "hit", "dual_hit", "valid_u", "valid_v"):
-        if name in dataset:
-            dataset[name] = dataset[name].astype(bool)
+    dataset = _as_bool(xr.Dataset(data_vars, coords=coords),
+                       ("lit", "dual_cam_visible", "hit", "dual_hit", "valid_u", "valid_v"))
     return check_ground_truth(dataset)
 
 
@@ -142,8 +252,24 @@ def _load_mitsuba_lab_npz(path):
         return mitsuba_lab_npz_to_dataset({k: arrays[k] for k in arrays.files})
 
 
+def _load_mitsuba_outdoor_npz(path):
+    with np.load(path) as arrays:
+        return mitsuba_outdoor_npz_to_dataset({k: arrays[k] for k in arrays.files})
+
+
+def _load_shadowcam_outdoor_nc(path):
+    return _as_bool(_load_shadowcam_nc(path), _OUTDOOR_MASKS)
+
+
 #: ground_truth.format -> loader(path) -> Dataset
-GT_FORMATS = {"shadowcam_nc": _load_shadowcam_nc, "mitsuba_lab_npz": _load_mitsuba_lab_npz}
+GT_FORMATS = {
+    "shadowcam_nc": _load_shadowcam_nc,
+    "mitsuba_lab_npz": _load_mitsuba_lab_npz,
+    "shadowcam_outdoor_nc": _load_shadowcam_outdoor_nc,
+    "mitsuba_outdoor_npz": _load_mitsuba_outdoor_npz,
+}
+#: formats whose standard form is the outdoor one
+OUTDOOR_FORMATS = ("shadowcam_outdoor_nc", "mitsuba_outdoor_npz")
 
 
 def load_ground_truth(manifest):
@@ -158,7 +284,9 @@ def load_ground_truth(manifest):
     Returns
     -------
     xarray.Dataset
-        In memory; attrs ``source_format``, ``source_file`` and ``source_sha256``.
+        In memory, in the lab standard form, or the outdoor one for the
+        formats of :data:`OUTDOOR_FORMATS`; attrs ``source_format``,
+        ``source_file`` and ``source_sha256``.
     """
     from shadowcam.manifest import load_manifest, verify_checksums
 
@@ -176,7 +304,7 @@ def load_ground_truth(manifest):
     checksums = verify_checksums(manifest, ["ground_truth"]) if "ground_truth" in manifest.get("files", {}) else {}
     try:
         dataset = GT_FORMATS[spec["format"]](path)
-        check_ground_truth(dataset)
+        (check_outdoor_ground_truth if spec["format"] in OUTDOOR_FORMATS else check_ground_truth)(dataset)
     except ValueError as exc:
         raise ValueError(f"ground truth {path} (format {spec['format']}): {exc}") from None
     dataset.attrs.update(

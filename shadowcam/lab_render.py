@@ -17,7 +17,8 @@ Offers
 LightPaths : the static light paths of one view (see ``trace_light_paths``).
 trace_light_paths : cast primary and shadow rays once for a camera, light and objects.
 render_image : (rows, cols, 3) image of a view from its light paths.
-sweep_frames : (T, rows, cols, 3) frames of one wire sweep from the light paths.
+sweep_frames : (T, rows, cols, 3) frames of one wire sweep from the light paths
+    (optionally with the wire pushed off its plane per frame: non-planar motion).
 pixel_centre_ground_truth : exact per-pixel GT (P, lit, shadow times, cosines, distances).
 plane_homography : camera (col, row) pixel-centre index -> back-plane (x, y) homography.
 render_reciprocal : the reciprocal render (pinhole at the light, point light at the camera).
@@ -193,7 +194,19 @@ def render_image(paths):
     return _pixel_sums(paths).reshape(*paths.shape, 3).astype(np.float32)
 
 
-def sweep_frames(paths, sweep, mask):
+def _offset_rate(paths, sweep, mask):
+    """Shift of each path's blocked interval, in frames per scene unit of wire offset along
+    the mask normal: the wire at ``p(k) + e n`` blocks path (P, L) when
+    ``|t_c - k - e (n.w) / (v.w)| < half_width`` (``w = normalize(s x d)`` as in
+    ``raycast.wire_occlusion_interval``). Zero for a distant light (n parallel to s)."""
+    seg = paths.light if paths.distant else paths.light - paths.points
+    w = np.cross(seg, sweep.direction)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w /= np.linalg.norm(w, axis=1, keepdims=True)
+        return (w @ mask.normal) / (w @ sweep.velocity)
+
+
+def sweep_frames(paths, sweep, mask, *, path_offsets=None):
     """Frames of one wire sweep.
 
     Frame k shows the wire at ``p(k) = p0 + k v``; a light path is dark in frame k when the
@@ -204,6 +217,11 @@ def sweep_frames(paths, sweep, mask):
     paths : LightPaths
     sweep : WireSweep
     mask : MaskPlane
+    path_offsets : (T,) array_like, optional
+        Non-planar mask motion: in frame k the wire is displaced by ``path_offsets[k]``
+        (scene units) along the mask normal ``n`` (the light's aim direction), i.e. it
+        sits at ``p(k) + path_offsets[k] n``. Exact for an infinite wire (the finite
+        wire's coverage is that of the planar path). None = planar motion.
 
     Returns
     -------
@@ -214,6 +232,14 @@ def sweep_frames(paths, sweep, mask):
     n_pix = paths.shape[0] * paths.shape[1]
     t_c, half = wire_occlusion_interval(paths.points, paths.light, sweep, mask,
                                         distant=paths.distant)
+    reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
+    if path_offsets is not None:
+        offsets = np.asarray(path_offsets, dtype=np.float64)
+        if offsets.shape != (n_frames,) or not np.all(np.isfinite(offsets)):
+            raise ValueError(f"path_offsets: expected {n_frames} finite offsets (one per "
+                             f"frame), got shape {offsets.shape}")
+        return _frames_with_offsets(paths, t_c, half, _offset_rate(paths, sweep, mask),
+                                    offsets, reference)
     with np.errstate(invalid="ignore"):
         first = np.floor(t_c - half) + 1  # strict inequality: open interval
         last = np.ceil(t_c + half) - 1
@@ -224,7 +250,6 @@ def sweep_frames(paths, sweep, mask):
     index = np.concatenate([base + first[keep].astype(np.int64),
                             base + last[keep].astype(np.int64) + 1])
     frames = np.empty((n_frames, n_pix, 3), dtype=np.float32)
-    reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
     for c in range(3):
         w = paths.radiance[keep, c]
         diff = np.bincount(index, weights=np.concatenate([w, -w]),
@@ -232,6 +257,21 @@ def sweep_frames(paths, sweep, mask):
         deficit = np.cumsum(diff.reshape(n_pix, n_frames + 1), axis=1)[:, :n_frames]
         frames[:, :, c] = np.clip(reference[:, c] - deficit.T, 0.0, None)
     return frames.reshape(n_frames, *paths.shape, 3)
+
+
+def _frames_with_offsets(paths, t_c, half, rate, offsets, reference):
+    """Frame by frame: path blocked in frame k when ``|t_c - k - offsets[k] rate| < half``."""
+    n_pix = reference.shape[0]
+    frames = np.empty((len(offsets), n_pix, 3), dtype=np.float32)
+    ok = np.isfinite(t_c) & np.isfinite(rate)
+    t_c, half, rate = t_c[ok], half[ok], rate[ok]
+    pixel, radiance = paths.pixel[ok], paths.radiance[ok]
+    for k, offset in enumerate(offsets):
+        blocked = np.abs(t_c - k - offset * rate) < half
+        for c in range(3):
+            deficit = np.bincount(pixel[blocked], weights=radiance[blocked, c], minlength=n_pix)
+            frames[k, :, c] = np.clip(reference[:, c] - deficit, 0.0, None)
+    return frames.reshape(len(offsets), *paths.shape, 3)
 
 
 def _pixel_centres(camera):
@@ -412,12 +452,14 @@ class CaptureRenderer:
         """Names of the sweeps this capture renders."""
         return tuple(self._paths)
 
-    def frames(self, name):
-        """(T, rows, cols, 3) float32 frames of sweep `name`."""
+    def frames(self, name, *, path_offsets=None):
+        """(T, rows, cols, 3) float32 frames of sweep `name` (see ``sweep_frames`` for
+        `path_offsets`, the non-planar wire motion)."""
         if name not in self._paths:
             raise ValueError(f"name: no sweep {name!r}; available: {self.sweep_names}")
         sweep = self.scene.sweeps[name.removeprefix("cal_")]
-        return sweep_frames(self._paths[name], sweep, self.scene.mask)
+        return sweep_frames(self._paths[name], sweep, self.scene.mask,
+                            path_offsets=path_offsets)
 
 
 def prepare_capture(scene, *, supersample=4, calibration=True):

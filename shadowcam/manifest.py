@@ -13,8 +13,8 @@ known, and provenance. Its structure is fixed by
 * ``sweeps[name]["times_s"]`` -- frame times in seconds (float list, one per file);
 * ``reference_paths`` -- absolute paths of the reference frame(s) (empty if none);
 * ``files`` -- group -> list of paths relative to root of every referenced file;
-  groups are the sweep names, ``reference``, ``timing`` (sidecar), ``ground_truth``
-  and ``calibration_plane`` (mask).
+  groups are the sweep names, ``reference``, ``timing`` (sidecar), ``ground_truth``,
+  ``calibration_plane`` (mask) and ``sky_mask`` (outdoor mask image).
 
 Offers
 ------
@@ -128,7 +128,9 @@ def frame_times(paths, timing, *, root, sweep, sidecar=None):
     paths : sequence of Path
         The sweep's files in frame order.
     timing : mapping
-        The manifest's ``timing`` entry (``source``: rate | filename | metadata | sidecar).
+        The manifest's ``timing`` entry (``source``: rate | filename | metadata |
+        sidecar | auto; auto takes the first of metadata, filename, sidecar
+        that gives a time for every file, see :mod:`shadowcam.frame_times`).
     root : Path
         Dataset root (sidecar keys may be paths relative to it).
     sweep : str
@@ -145,6 +147,20 @@ def frame_times(paths, timing, *, root, sweep, sidecar=None):
         DateTimeOriginal + SubsecTimeOriginal); for ``sidecar`` the listed values.
     """
     source = timing["source"]
+    if source == "auto":
+        from shadowcam.frame_times import auto_candidates
+
+        problems = []
+        for candidate in auto_candidates(timing):
+            try:
+                times = frame_times(paths, candidate, root=root, sweep=sweep, sidecar=sidecar)
+            except ValueError as exc:
+                problems.append(f"{candidate['source']}: {exc}")
+                continue
+            log.info("sweep %s: frame times from %s (timing source auto)", sweep, candidate["source"])
+            return times
+        raise ValueError("timing.source auto found no source with a time for every file ("
+                         + "; ".join(problems) + "); add timing.regex or timing.file/key")
     if source == "rate":
         start, rate = float(timing.get("start_s", 0.0)), float(timing["rate_hz"])
         return [start + k / rate for k in range(len(paths))]
@@ -238,13 +254,16 @@ def _resolve(path, *, strict):
         manifest["reference_paths"] = [str(p) for p in refs]
         files["reference"] = [_rel(root, p) for p in refs]
     timing = manifest.get("timing", {})
-    if timing.get("source") == "sidecar":
+    if timing.get("source") == "sidecar" or (timing.get("source") == "auto" and "file" in timing):
         files["timing"] = [_rel(root, _existing(root, timing["file"], what="timing.file", manifest_path=path))]
     if "ground_truth" in manifest:
         gt_root = root if root is not None else path.parent
         gt = _existing(gt_root, manifest["ground_truth"]["file"], what="ground_truth.file", manifest_path=path)
         if root is not None:
             files["ground_truth"] = [_rel(root, gt)]
+    if "image" in manifest.get("sky_mask", {}):
+        sky = _existing(root, manifest["sky_mask"]["image"], what="sky_mask.image", manifest_path=path)
+        files["sky_mask"] = [_rel(root, sky)]
     if "mask" in manifest.get("calibration_plane", {}):
         mask = _existing(root, manifest["calibration_plane"]["mask"], what="calibration_plane.mask", manifest_path=path)
         files["calibration_plane"] = [_rel(root, mask)]
@@ -259,15 +278,16 @@ def _resolve(path, *, strict):
             f"manifest {path}: file(s) not listed in checksums: {shown}; " + _FIX_CHECKSUMS.format(m=path)
         )
     sidecar = None
-    if timing.get("source") == "sidecar":
+    if "timing" in files:
         side_path = Path(root) / files["timing"][0]
         try:
             side_doc = json.loads(side_path.read_text())
         except json.JSONDecodeError as exc:
             raise ValueError(f"timing sidecar {side_path} is not valid JSON: {exc}") from None
-        if not isinstance(side_doc, dict) or timing["key"] not in side_doc:
-            raise ValueError(f"timing sidecar {side_path} has no key {timing['key']!r} (timing.key)")
-        sidecar = side_doc[timing["key"]]
+        key = timing.get("key", "times_s")
+        if not isinstance(side_doc, dict) or key not in side_doc:
+            raise ValueError(f"timing sidecar {side_path} has no key {key!r} (timing.key)")
+        sidecar = side_doc[key]
     for name, sweep in sweeps.items():
         try:
             sweep["times_s"] = frame_times(

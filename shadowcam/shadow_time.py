@@ -16,6 +16,7 @@ REASONS : flag code -> meaning, for pixels without a reliable time.
 classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
+lit_colour : unshadowed colour per pixel from a summary with channel sums.
 """
 
 import numpy as np
@@ -32,8 +33,9 @@ REASONS = {
     3: "saturated",
     4: "several_minima",
     5: "invalid_input",
+    6: "wide_dip",
 }
-OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT = range(6)
+OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP = range(7)
 
 #: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
 _SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
@@ -221,16 +223,21 @@ def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, fram
     return candidate & (agree >= min_support) & (2 * agree >= total)
 
 
-def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
+def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5,
+                   shadow_ratio=0.1):
     """Detected pixels at a shadow boundary whose lit part is under `min_lit_fraction`.
 
     A pixel straddling the boundary of a cast (scene) shadow dips when the
     mask passes, although its centre is in shadow. Its lit fraction is
     estimated as its level over the brightest detected neighbour of the same
-    colour; only pixels next to an undetected, darker pixel (the shadow side)
-    are tested. For demosaiced RAW, `level` should be each site's own measured
-    channel and `site_colour` its CFA colour: interpolated channels carry
-    light from lit neighbours into shadowed sites.
+    colour; only pixels beside the shadow side are tested: an undetected
+    neighbour, or a same-colour neighbour darker than `shadow_ratio` times
+    the pixel's level (a cast shadow keeps only ambient light, an order of
+    magnitude below direct light, while neighbouring albedos of a texture
+    rarely differ that much). For demosaiced RAW, `level` should be each
+    site's own measured channel and `site_colour` its CFA colour:
+    interpolated channels carry light from lit neighbours into shadowed
+    sites, so those are detected too and only the darkness test finds them.
     """
     same_colour_radius = 1 if site_colour is None else 2
     colour = np.zeros(level.shape, np.int8) if site_colour is None else site_colour
@@ -240,17 +247,28 @@ def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5):
     for dr, dc in _shifts(same_colour_radius):
         same = shifted(colour, dr, dc, -1) == colour
         brightest = np.maximum(brightest, np.where(same, shifted(lit_level, dr, dc, 0.0), 0.0))
-        darker = shifted(level, dr, dc, np.inf) < min_lit_fraction * level
+        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * level
         shadow_side |= (same & darker) | ~shifted(detected, dr, dc, True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
     return detected & shadow_side & (fraction < min_lit_fraction)
 
 
+def _wider_than_window(summary, depth, significant):
+    """The window's first or last sample (when inside the sweep) is still shadowed by more
+    than 3/4 of the dip's depth (and by more than `significant`, capped at 0.9 `depth`):
+    the dip goes on beyond the window (thick wire, area source) and its time would be
+    biased toward the window."""
+    need = np.maximum(0.75 * depth, np.minimum(significant, 0.9 * depth))
+    with np.errstate(invalid="ignore"):
+        return ((summary.lit_level - summary.window[0] > need)
+                | (summary.lit_level - summary.window[-1] > need))
+
+
 def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
                   false_alarm=1e-2, weak_false_alarm=0.5,
-                  min_relative_depth=0.1, min_lit_fraction=0.5, noise_floor=1e-4,
-                  second_dip_ratio=0.5):
+                  min_relative_depth=0.1, min_lit_fraction=0.5, shadow_ratio=0.1,
+                  noise_floor=1e-4, second_dip_ratio=0.5):
     """Decide per pixel whether its dip is a reliable shadow, and why not.
 
     A dip is detected when it is deeper than pure noise gets within the
@@ -277,6 +295,9 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
         Smallest dip depth, as a fraction of the lit level, taken as a shadow.
     min_lit_fraction : float, optional
         Smallest lit fraction of a boundary pixel's footprint.
+    shadow_ratio : float, optional
+        A same-colour neighbour darker than this fraction of a pixel's level
+        is taken as the shadowed side of a cast-shadow boundary.
     noise_floor : float, optional
         Lower bound of the noise (signal units), for noise-free data.
     second_dip_ratio : float, optional
@@ -309,19 +330,21 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     reason[~significant_level] = LOW_CONTRAST
     boundary_level = level if site_level is None else site_level
     partial = _partially_lit(detected, boundary_level, site_colour=site_colour,
-                             min_lit_fraction=min_lit_fraction)
+                             min_lit_fraction=min_lit_fraction, shadow_ratio=shadow_ratio)
     reason[partial] = LOW_CONTRAST
     several = detected & (second_depth >= second_dip_ratio * depth) & (
         second_depth / (noise * _SMOOTHED_NOISE) > z
     )
     reason[(reason == OK) & several] = SEVERAL_MINIMA
+    reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
     if saturated is not None:
         reason[(reason == OK) & saturated] = SATURATED
-    window_invalid = ~np.isfinite(summary.window).all(axis=0)
-    inside = (summary.window_start >= 0) & (
-        summary.window_start + summary.window.shape[0] <= summary.n_frames
-    )
-    broken = (summary.invalid_count > 0) & (window_invalid & inside)
+    # a non-finite sample in the window at a frame inside the sweep (slots outside the
+    # sweep are NaN padding)
+    frame = _window_times(summary)
+    in_sweep = (frame >= 0) & (frame < summary.n_frames)
+    window_invalid = (in_sweep & ~np.isfinite(summary.window)).any(axis=0)
+    broken = (summary.invalid_count > 0) & window_invalid
     broken |= summary.lit_count < 3
     broken |= summary.minimum_frame < 0
     reason[broken] = INVALID_INPUT
@@ -405,33 +428,36 @@ def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progres
     summary : DipSummary
         Of the channel-summed signal.
     lit_image : (H, W, C) float32 ndarray
-        Unshadowed colour per pixel: the channel means scaled by the ratio of
-        the lit level to the mean level (the mask removes light from all
-        channels alike).
+        Unshadowed colour per pixel (see :func:`lit_colour`).
     saturated : (H, W) bool ndarray
     """
-    tracker = DipTracker(shape, half_window=half_window)
-    colour_sum = None
-    saturated = np.zeros(shape, bool)
+    tracker = DipTracker(shape, half_window=half_window, saturation_level=saturation_level)
     for block in blocks:
         block = np.asarray(block, np.float32)
         if block.ndim != 4 or block.shape[1:3] != tuple(shape):
             raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C), got {block.shape}")
-        with np.errstate(invalid="ignore"):
-            saturated |= (block >= saturation_level).any(axis=(0, 3))
-        finite = np.where(np.isfinite(block), block, 0.0)
-        sums = finite.sum(axis=0, dtype=np.float64)
-        colour_sum = sums if colour_sum is None else colour_sum + sums
-        tracker.update(block.sum(axis=3))
+        tracker.update(block)
         if progress is not None:
             progress(tracker.n_frames)
-    summary = tracker.result()
-    if colour_sum is None:
+    if tracker.n_frames == 0:
         raise ValueError("blocks is empty: the sweep has no frames")
+    summary = tracker.result()
+    return summary, lit_colour(summary), summary.saturated
+
+
+def lit_colour(summary):
+    """Unshadowed colour per pixel, ``(H, W, C)`` float32.
+
+    The channel means scaled by the ratio of the lit level to the mean level
+    (the mask removes light from all channels alike).
+    """
+    if summary.channel_sum is None:
+        raise ValueError("summary has no channel sums: feed the tracker (T, H, W, C) blocks")
     with np.errstate(invalid="ignore", divide="ignore"):
-        scale = summary.lit_level / summary.mean_level
-        lit_image = colour_sum / summary.n_frames * scale[..., None]
-    return summary, np.nan_to_num(lit_image, nan=0.0).astype(np.float32), saturated
+        # a pixel with no light at all (mean 0) has no colour, not an infinite one
+        scale = np.where(summary.mean_level > 0, summary.lit_level / summary.mean_level, 0.0)
+        lit_image = summary.channel_sum / summary.n_frames * scale[..., None]
+    return np.nan_to_num(lit_image, nan=0.0).astype(np.float32)
 
 
 def cfa_site_colours(shape, pattern):

@@ -133,3 +133,55 @@ def test_exact_gt_coordinates_give_the_dual_image_floor():
     assert corr["rel_rmse_masked"] < out["rel_rmse_masked"]  # photometry explains part of it
     assert corr["rel_rmse_masked"] < 0.10
     assert out["rel_rmse_whole"] > out["rel_rmse_masked"]  # holes add error
+
+
+def test_calibration_dual_grid_is_compared_like_for_like():
+    # the calibration plane is reached from the mask plane (GT times) by a known
+    # homography; exact times must give exact dual coordinates on the plane-window
+    # grid, and a dual view sampled there must match the reciprocal resampled onto it
+    from shadowcam.dual_coords import apply_homography, dual_coords_calibration
+
+    times_to_plane = np.array([[0.0105, 0.0011, -0.31], [-0.0013, 0.0098, -0.24],
+                               [0.004, -0.003, 1.0]])
+    cam_to_plane = np.array([[0.011, 0.0012, -0.3], [-0.0009, 0.0105, -0.25], [1e-4, 2e-4, 1.0]])
+    rows, cols = 48, 64
+    r, c = np.mgrid[0:rows, 0:cols]
+    plane_xy = apply_homography(cam_to_plane, np.column_stack([c.ravel(), r.ravel()]).astype(float))
+    cal_t = apply_homography(np.linalg.inv(times_to_plane), plane_xy).reshape(rows, cols, 2)
+    scene_t = cal_t + np.random.default_rng(5).uniform(-1.5, 1.5, cal_t.shape)
+    window = (-0.3, -0.25, 0.5, 0.35)
+    u, v, valid, reason, info = dual_coords_calibration(
+        scene_t[..., 0], scene_t[..., 1], cal_t_u=cal_t[..., 0], cal_t_v=cal_t[..., 1],
+        homography=cam_to_plane, dual_shape=(30, 40), plane_window=window,
+        extrapolation_margin=1e9)
+    dual_coords = dual_coords_dataset(u, v, valid, info=info, method="calibration", reason=reason)
+
+    def scene_colour(t_u, t_v):
+        return np.stack([1 + 0.5 * np.sin(t_u / 7) * np.cos(t_v / 9)] * 3, axis=-1)
+
+    n = 96  # reciprocal grid: centre of column i is t_u = i
+    tv, tu = np.mgrid[0:n, 0:n].astype(float)
+    gt = xr.Dataset({
+        "t_u": (("row", "col"), scene_t[..., 0]), "t_v": (("row", "col"), scene_t[..., 1]),
+        "lit": (("row", "col"), np.ones((rows, cols), bool)),
+        "t_cal_u": (("row", "col"), cal_t[..., 0]), "t_cal_v": (("row", "col"), cal_t[..., 1]),
+        "plane_xy": (("row", "col", "plane_axis"), plane_xy.reshape(rows, cols, 2)),
+        "reciprocal": (("v", "u", "channel"), scene_colour(tu, tv)),
+        "dual_cam_visible": (("v", "u"), np.ones((n, n), bool)),
+    })
+    # the dual view a perfect pipeline gives: the scene colour at each grid centre's plane point
+    j, i = np.mgrid[0:30, 0:40].astype(float)
+    x = window[0] + (i + 0.5) * (window[2] - window[0]) / 40
+    y = window[1] + (j + 0.5) * (window[3] - window[1]) / 30
+    t = apply_homography(np.linalg.inv(times_to_plane), np.column_stack([x.ravel(), y.ravel()]))
+    image = scene_colour(t[:, 0], t[:, 1]).reshape(30, 40, 3)
+    dual_view = xr.Dataset({"dual_view": (("v", "u", "channel"), image),
+                            "coverage": (("v", "u"), np.ones((30, 40), bool))})
+    shadow_time = xr.Dataset({"shadow_time": (("sweep", "row", "col"),
+                                              np.moveaxis(scene_t, -1, 0).astype(np.float32))},
+                             coords={"sweep": ["u", "v"]})
+    report = accuracy_report(shadow_time, gt, dual_coords=dual_coords, dual_view=dual_view)
+    assert report["dual_coords"]["coverage"] == 1.0
+    assert report["dual_coords"]["max"] < 1e-3  # float32 coordinates of ~40 px
+    assert report["dual_image"]["n_mask"] > 0.9 * 30 * 40
+    assert report["dual_image"]["rel_rmse_masked"] < 5e-3  # bilinear resampling only

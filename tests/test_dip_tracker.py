@@ -1,9 +1,11 @@
 """Tests of the streaming dip tracker: exact, chunk-independent, bounded state."""
 
+from dataclasses import fields
+
 import numpy as np
 import pytest
 
-from shadowcam.dip_tracker import DipTracker
+from shadowcam.dip_tracker import DipPartial, DipSummary, DipTracker, merge_partials
 
 
 def _sweep(n_frames, dip_frames, shape=(4, 5), level=1.0, depth=0.9, seed=0, noise=0.0):
@@ -96,3 +98,99 @@ def test_rejects_bad_input():
     tracker.result()
     with pytest.raises(ValueError, match="after result"):
         tracker.update(np.zeros((1, 3, 3), np.float32))
+
+
+def _summaries_equal(a, b):
+    for field in fields(DipSummary):
+        x, y = getattr(a, field.name), getattr(b, field.name)
+        if isinstance(x, np.ndarray):
+            assert x.dtype == y.dtype, field.name
+            np.testing.assert_array_equal(x, y, err_msg=field.name, strict=True)
+        else:
+            assert x == y, field.name
+
+
+def _chunked(frames, bounds, *, half_window, block=5):
+    """Partials of the chunks [bounds[i], bounds[i+1]), each fed its padded range in blocks."""
+    n = len(frames)
+    pad = DipTracker.padding(half_window)
+    partials = []
+    for start, stop in zip(bounds[:-1], bounds[1:]):
+        tracker = DipTracker(frames.shape[1:3], half_window=half_window, owned=(start, stop))
+        lo, hi = max(0, start - pad), min(n, stop + pad)
+        for first in range(lo, hi, block):
+            tracker.update(frames[first:min(first + block, hi)], first_index=first)
+        partials.append(tracker.partial())
+    return partials
+
+
+def _hard_sweep(seed=5):
+    """Colour frames with dips at chunk boundaries, second dips, ties, a ramp and NaNs."""
+    frames = _sweep(64, [], shape=(6, 7), noise=0.02, seed=seed)
+    frames[:, 0, 0] = 1.0  # exact ties everywhere
+    frames[19:22, 1] -= 0.8  # dip centred on a boundary at 20
+    frames[30:33, 2] -= 0.7
+    frames[50, 2] -= 0.5  # a second dip
+    frames[:, 3, 3] = np.linspace(1, 0.2, 64)  # a ramp: no second dip
+    frames[0, 4] -= 0.9  # dip at the first frame
+    frames[63, 5] -= 0.9  # and at the last
+    frames[20, 5, 5] = np.nan
+    frames[7, 4, 6] = np.inf
+    rng = np.random.default_rng(seed)
+    tint = rng.uniform(0.2, 0.5, (1, 1, 1, 3)).astype(np.float32)
+    return frames[..., None] * tint
+
+
+@pytest.mark.parametrize("bounds", [
+    [0, 64], [0, 20, 64], [0, 3, 7, 8, 20, 21, 33, 64], list(range(0, 65, 4)), [0, 31, 32, 64],
+])
+def test_merged_chunks_equal_the_single_pass_bit_for_bit(bounds):
+    frames = _hard_sweep()
+    whole = DipTracker(frames.shape[1:3], half_window=3)
+    whole.update(frames)
+    expected = whole.result()
+    # shuffled order: the merge does not depend on it
+    partials = _chunked(frames, bounds, half_window=3)[::-1]
+    _summaries_equal(merge_partials(partials, n_frames=64), expected)
+
+
+def test_second_dip_is_a_local_minimum_a_window_away_and_a_ramp_has_none():
+    frames = _hard_sweep()
+    tracker = DipTracker(frames.shape[1:3], half_window=3)
+    tracker.update(frames)
+    summary = tracker.result()
+    assert np.all(summary.minimum_frame[2] == 31)
+    assert np.all(summary.second_frame[2] == 50)
+    assert summary.second_value[3, 3] == np.inf and summary.minimum_frame[3, 3] == 63
+    np.testing.assert_allclose(summary.channel_sum.sum(axis=2), np.nansum(
+        np.where(np.isfinite(frames), frames, 0), axis=(0, 3)), rtol=1e-6)
+    assert summary.invalid_count[5, 5] == 1 and summary.invalid_count[4, 6] == 1
+
+
+def test_partial_round_trips_through_an_atomic_file(tmp_path):
+    frames = _hard_sweep()
+    partials = _chunked(frames, [0, 25, 64], half_window=2)
+    paths = []
+    for i, part in enumerate(partials):
+        path = tmp_path / f"chunk{i}.npz"
+        part.save(path)
+        paths.append(path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["chunk0.npz", "chunk1.npz"]
+    loaded = [DipPartial.load(p) for p in paths]
+    _summaries_equal(merge_partials(loaded, n_frames=64), merge_partials(partials, n_frames=64))
+
+
+def test_merge_rejects_gaps_and_short_feeds():
+    frames = _hard_sweep()
+    partials = _chunked(frames, [0, 20, 40, 64], half_window=2)
+    with pytest.raises(ValueError, match="tile"):
+        merge_partials([partials[0], partials[2]], n_frames=64)
+    with pytest.raises(ValueError, match="n_frames"):
+        merge_partials(partials, n_frames=70)
+    short = DipTracker(frames.shape[1:3], half_window=2, owned=(0, 20))
+    short.update(frames[:21])
+    with pytest.raises(ValueError, match="fed frames up to"):
+        merge_partials([short.partial(), *partials[1:]], n_frames=64)
+    tracker = DipTracker(frames.shape[1:3], half_window=2, owned=(20, 40))
+    with pytest.raises(ValueError, match="first_index"):
+        tracker.update(frames[20:30], first_index=20)

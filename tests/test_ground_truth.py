@@ -97,3 +97,50 @@ def test_shared_dev_ground_truth_counts(name):
     assert int(np.isfinite(ds["t_u"]).sum()) == 33_522
     assert int(np.isfinite(ds["t_v"]).sum()) == 34_582
     assert int(ds["dual_cam_visible"].sum()) == 5_346
+
+
+def _outdoor_arrays(height=4, width=5, frames=3):
+    arrays = {
+        "shadow_class": np.full((height, width), 3, np.uint8),
+        "sky_mask": np.zeros((height, width), bool),
+        "arrival_time_s": np.full((height, width), 12.5),
+        "arrival_frame": np.full((height, width), 1.25),
+        "first_shadowed_frame": np.full((height, width), 2, np.int32),
+        "relit_after_arrival": np.zeros((height, width), bool),
+        "times_s": np.array([0.0, 10.0, 20.0])[:frames],
+        "pb_edge_y": np.zeros((frames, width), np.float32),
+        "reference_radiance": np.ones((height, width, 3), np.float32),
+    }
+    arrays["shadow_class"][0] = 0
+    arrays["sky_mask"][0] = True
+    return arrays
+
+
+def test_outdoor_npz_and_netcdf_give_the_same_standard_form(tmp_path):
+    from shadowcam.ground_truth import check_outdoor_ground_truth, mitsuba_outdoor_npz_to_dataset
+
+    arrays = _outdoor_arrays()
+    np.savez(tmp_path / "gt.npz", **arrays)
+    from_npz = load_ground_truth(_manifest(tmp_path, "mitsuba_outdoor_npz", "gt.npz"))
+    from_npz.drop_attrs().to_netcdf(tmp_path / "ground_truth.nc", engine="h5netcdf")
+    from_nc = load_ground_truth(_manifest(tmp_path, "shadowcam_outdoor_nc", "ground_truth.nc"))
+    for name in ("shadow_class", "sky_mask", "arrival_time_s", "times_s", "pb_edge_y"):
+        np.testing.assert_array_equal(from_nc[name].values, from_npz[name].values)
+        assert from_nc[name].dims == from_npz[name].dims
+    assert from_nc["sky_mask"].dtype == bool and from_npz["times_s"].dims == ("time",)
+    with pytest.raises(ValueError, match="arrival_time_s"):
+        check_outdoor_ground_truth(from_npz.drop_vars("arrival_time_s"))
+    broken = dict(arrays)
+    del broken["times_s"]
+    with pytest.raises(ValueError, match="times_s"):
+        mitsuba_outdoor_npz_to_dataset(broken)
+
+
+@pytest.mark.skipif(not (SHARED.parent / "outdoor-dev" / "dev_ridge").is_dir(), reason="shared dev data not present")
+def test_dev_ridge_ground_truth_counts():
+    ds = load_ground_truth(REPO / "data_manifest" / "dev_ridge.yaml")
+    assert (ds.sizes["row"], ds.sizes["col"], ds.sizes["time"]) == (128, 192, 120)
+    # counts stated in shared/data/README.md section 2.5
+    counts = np.bincount(ds["shadow_class"].values.ravel(), minlength=4)
+    assert counts.tolist()[0] == 4_921 and counts[1] == 3_775 and counts[3] == 10_429
+    assert int(ds["relit_after_arrival"].sum()) == 131

@@ -243,3 +243,29 @@ def test_render_cli_writes_a_complete_capture(tmp_path):
     bad.write_text("name: bad\nkind: lab\n")
     assert main(["render", "--manifest", str(bad), "--out", str(tmp_path / "x")]) == 2
     assert not (tmp_path / "x").exists()
+
+
+def test_nonplanar_wire_offsets_shift_the_dip_as_central_projection_predicts(centre_capture):
+    """A wire pushed a distance e off its plane (away from the light) at in-plane position s
+    shadows like a planar wire at s h / (h + e): the dip of a pixel with planar GT time t
+    moves to frame c + (t - c)(h + e)/h, c = (T-1)/2 (the frame through M0)."""
+    cap = centre_capture
+    h, c = cap.scene.mask.focal, (T - 1) / 2.0
+    t = cap.ground_truth["t_u"].values
+    planar = cap.frames("u")
+    zero = cap.frames("u", path_offsets=np.zeros(T))
+    np.testing.assert_allclose(zero, planar, rtol=0, atol=1e-6 * planar.max())
+    e = 0.2 * h
+    moved = cap.frames("u", path_offsets=np.full(T, e))
+    intensity, good = _good_dips(moved, t)
+    predicted = c + (t - c) * (h + e) / h
+    far = good & (np.abs(t - c) > 8)  # the shift there exceeds 1.6 frames
+    assert far.sum() > 100
+    removed = intensity.max(0) - intensity  # centroid of the dip: midpoint of dark frames
+    with np.errstate(invalid="ignore"):
+        centroid = (np.arange(T)[:, None, None] * removed).sum(0) / removed.sum(0)
+    err = np.abs(centroid - predicted)[far]
+    assert np.median(err) < 0.3 and np.percentile(err, 95) <= 0.6
+    assert np.median(np.abs(centroid - t)[far]) > 1.5  # it really moved
+    with pytest.raises(ValueError, match="path_offsets"):
+        cap.frames("u", path_offsets=np.zeros(T - 1))

@@ -14,14 +14,15 @@ from shadowcam.shadow_time import (
 
 def wire_sweep(*, shape=(48, 64), n_frames=40, px_per_frame=2.0, width=2.0, t0=6.0,
                tilt=0.3, supersample=8, seed=0, electrons=None, read_noise=0.0,
-               shadowed_box=None):
+               shadowed_box=None, albedo=None):
     """Frames of a wire shadow sweeping a textured plane, with exact shadow times.
 
     The shadow's centre line crosses image point (row y, col x) at time
     ``t0 + (x + tilt * y) / px_per_frame`` (pixel centres at integer + 0.5);
     the shadow is `width` frames wide (hard edged: point light, opaque wire).
     Each pixel integrates ``supersample**2`` points. `shadowed_box` (r0, r1,
-    c0, c1) is a region in a scene object's cast shadow: never lit.
+    c0, c1) is a region in a scene object's cast shadow: never lit. `albedo`
+    (H, W, 3) replaces the default random texture (0.3 to 0.9).
     Returns frames (T, H, W, 3) and the exact time at pixel centres (NaN unlit).
     """
     rng = np.random.default_rng(seed)
@@ -30,7 +31,8 @@ def wire_sweep(*, shape=(48, 64), n_frames=40, px_per_frame=2.0, width=2.0, t0=6
     ys = np.arange(h)[:, None, None, None] + offsets[None, None, :, None]
     xs = np.arange(w)[None, :, None, None] + offsets[None, None, None, :]
     t_sub = t0 + (xs + tilt * ys) / px_per_frame  # (H, W, s, s)
-    albedo = 0.3 + 0.6 * rng.random((h, w, 3))
+    if albedo is None:
+        albedo = 0.3 + 0.6 * rng.random((h, w, 3))
     frames = np.empty((n_frames, h, w, 3), np.float32)
     for k in range(n_frames):
         lit_fraction = (np.abs(k - t_sub) >= width / 2).mean(axis=(2, 3))
@@ -94,6 +96,17 @@ def test_noisy_low_light_12bit_meets_target_and_rejects_unlit():
     interior = result["shadow_time"][r0 + 1:r1 - 1, c0 + 1:c1 - 1]
     assert np.isfinite(interior).mean() < 0.01
     assert set(np.unique(result["reason"][r0 + 1:r1 - 1, c0 + 1:c1 - 1])) <= {LOW_CONTRAST, NEVER_SHADOWED}
+
+
+def test_high_contrast_texture_is_not_taken_for_a_cast_shadow_boundary():
+    # grey albedo log-uniform over 0.1..0.8 per pixel: neighbours differ up to 8x,
+    # but every pixel is fully lit, so every one must get its time
+    rng = np.random.default_rng(11)
+    albedo = np.repeat(0.1 * 8.0 ** rng.random((48, 64, 1)), 3, axis=2)
+    frames, gt = wire_sweep(albedo=albedo)
+    err, coverage = abs_error(run(frames, method="edge_fit"), gt)
+    assert coverage >= 0.99
+    assert np.percentile(err, 95) <= 0.1
 
 
 def test_constant_pixels_are_flagged_without_warnings():

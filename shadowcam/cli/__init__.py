@@ -23,6 +23,14 @@ STEPS = {
     "dual-view": "dual_view",
     "accuracy": "accuracy",
     "report-figures": "report_figures",
+    "evaluate": "evaluate",
+    "plan": "plan",
+    "outdoor-normalise": "outdoor_normalise",
+    "track-edges": "track_edges",
+    "arrival": "arrival",
+    "pushbroom": "pushbroom",
+    "outdoor-accuracy": "outdoor_accuracy",
+    "outdoor-figures": "outdoor_figures",
 }
 
 

@@ -9,6 +9,8 @@
 # has_reference(ds)           capture has an unshadowed reference frame
 # uses_calibration(ds)        calibration sweeps exist and the configured model may use them
 # scene_sweeps(ds)            names of the scene sweeps (u, v)
+# is_outdoor(ds)              manifest kind is outdoor (time-lapse pipeline, workflow/rules/outdoor.smk)
+# outdoor_sweep(ds)           name of the time-lapse sweep of an outdoor dataset
 # get_*                       input / params functions of the rules
 import glob
 import json
@@ -117,8 +119,40 @@ def uses_calibration(ds):
     return has_calibration_sweeps(ds) and dual_model(ds) in ("auto", "calibration")
 
 
+def is_outdoor(ds):
+    """Return True if dataset `ds` is an outdoor time-lapse (manifest ``kind: outdoor``)."""
+    return load_dataset_manifest(ds).get("kind") == "outdoor"
+
+
+def outdoor_sweep(ds):
+    """Return the time-lapse sweep of outdoor dataset `ds`: ``timelapse``, or its only sweep."""
+    if is_synthetic(ds):
+        return "timelapse"
+    sweeps = list(load_dataset_manifest(ds).get("sweeps") or {})
+    if "timelapse" in sweeps or len(sweeps) == 1:
+        return "timelapse" if "timelapse" in sweeps else sweeps[0]
+    raise ValueError(
+        f"{manifest_path(ds)}: an outdoor dataset needs one sweep (preferably named 'timelapse'); "
+        f"found {sweeps or 'none'}"
+    )
+
+
+def outdoor_targets(ds):
+    """Return the final output files of outdoor dataset `ds` (list of str)."""
+    targets = [
+        f"results/{ds}/outdoor/arrival.nc",
+        f"results/{ds}/outdoor/pushbroom.nc",
+        f"results/{ds}/outdoor/figures",
+    ]
+    if has_ground_truth(ds):
+        targets += [f"results/{ds}/outdoor/accuracy.json", f"results/{ds}/outdoor/accuracy.csv"]
+    return targets
+
+
 def dataset_targets(ds):
     """Return the final output files of dataset `ds` (list of str)."""
+    if is_outdoor(ds):
+        return outdoor_targets(ds)
     targets = [
         f"results/{ds}/shadow_time.nc",
         f"results/{ds}/dual_coords.nc",
@@ -237,6 +271,27 @@ def get_dual_coords_params(wildcards):
     return as_json(options)
 
 
+def get_evaluate_params(wildcards):
+    """JSON ``--params`` of ``shadowcam evaluate``: config section ``evaluate``."""
+    return as_json(config["evaluate"])
+
+def get_outdoor_frames(wildcards):
+    """Decoded frame store of the time-lapse sweep of an outdoor dataset."""
+    return f"results/{wildcards.ds}/frames/{outdoor_sweep(wildcards.ds)}.zarr"
+
+
+def get_outdoor_accuracy(wildcards):
+    """Outdoor accuracy report of the dataset, or an empty list if it has no ground truth."""
+    if has_ground_truth(wildcards.ds):
+        return [f"results/{wildcards.ds}/outdoor/accuracy.json"]
+    return []
+
+
+def get_outdoor_accuracy_option(wildcards, input):
+    """``--accuracy PATH`` for the outdoor figures when accuracy was computed, else empty."""
+    return f"--accuracy {input.accuracy}" if input.accuracy else ""
+
+
 # ---------------------------------------------------------------------------------------
 # Time chunks and job resources (decode parts, resources sized from the input).
 #
@@ -251,7 +306,7 @@ def get_dual_coords_params(wildcards):
 # decode_part_ranges(ds, sweep)  [(start, stop), ...] frame range of each decode_part job
 # get_decode_parts, get_part_files, get_part_range, get_chunk_frames   decode rules' inputs/params
 # get_decode_mem_mb, get_decode_runtime, get_shadow_time_mem_mb, get_shadow_time_runtime,
-# get_image_mem_mb, get_render_mem_mb                                   resources (MB, minutes)
+# get_image_mem_mb, get_stream_mem_mb, get_stream_runtime, get_render_mem_mb   resources (MB, minutes)
 
 import math
 from functools import lru_cache
@@ -379,11 +434,30 @@ def get_shadow_time_runtime(wildcards, attempt):
     return attempt * (5 + math.ceil(work * SHADOW_TIME_SECONDS_PER_PIXEL / 60))
 
 
+def first_sweep(ds):
+    """A sweep whose frame size is the dataset's: the time-lapse (outdoor) or u (lab)."""
+    return outdoor_sweep(ds) if is_outdoor(ds) else SCENE_SWEEPS[0]
+
+
 def get_image_mem_mb(wildcards, attempt):
     """Memory of a per-dataset step on whole images (dual coordinates, dual view, accuracy,
-    figures, render): a few hundred bytes per camera pixel per frame-sized map."""
-    rows, cols = frame_shape(wildcards.ds, SCENE_SWEEPS[0])
+    figures, outdoor arrival/pushbroom): ~2 kB per camera pixel of image-sized maps."""
+    rows, cols = frame_shape(wildcards.ds, first_sweep(wildcards.ds))
     return attempt * math.ceil(BASE_MEM_MB + rows * cols * 2000 / 2**20)
+
+
+def get_stream_mem_mb(wildcards, attempt):
+    """Memory of a step streaming a sweep (outdoor passes): image maps plus three read chunks."""
+    sweep = first_sweep(wildcards.ds)
+    chunk = decode_chunk_frames(wildcards.ds, sweep) * _frame_mb(wildcards.ds, sweep)
+    return get_image_mem_mb(wildcards, attempt) + attempt * math.ceil(3 * chunk)
+
+
+def get_stream_runtime(wildcards, attempt):
+    """Minutes of a step streaming a sweep once (outdoor passes), from its pixel-frames."""
+    sweep = first_sweep(wildcards.ds)
+    work = sweep_frame_count(wildcards.ds, sweep) * math.prod(frame_shape(wildcards.ds, sweep))
+    return attempt * (5 + math.ceil(work * SHADOW_TIME_SECONDS_PER_PIXEL / 60))
 
 
 def get_render_mem_mb(wildcards, attempt):

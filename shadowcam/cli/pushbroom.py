@@ -1,0 +1,42 @@
+"""``shadowcam pushbroom``: the ridge pushbroom image from the tracked edges.
+
+Colours of the registered first frame along each frame's edge, stacked over
+time (:mod:`shadowcam.pushbroom`). Writes ``results/<ds>/outdoor/pushbroom.nc``
+and a PNG preview resampled to evenly spaced times (time upward).
+
+Offers
+------
+add_parser : register the step and its options.
+run : assemble and write the pushbroom.
+"""
+
+from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
+from shadowcam.frame_times import median_interval
+from shadowcam.image_io import atomic_path, write_png_preview
+from shadowcam.outdoor_datasets import pushbroom_dataset
+from shadowcam.pushbroom import assemble_pushbroom, resample_uniform_time
+
+
+def add_parser(subparsers, name):
+    """Register ``pushbroom`` on `subparsers`; return its parser."""
+    parser = subparsers.add_parser(name, help="ridge pushbroom from the tracked edges",
+                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
+    parser.add_argument("--edges", required=True, help="results/<ds>/outdoor/edges.nc")
+    parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/outdoor/pushbroom.nc")
+    parser.add_argument("--png", required=True, help="preview PNG (evenly spaced times, time upward)")
+    return parser
+
+
+def run(args):
+    """Assemble the pushbroom and write it with its preview."""
+    photometry = open_dataset(args.photometry)
+    edges = open_dataset(args.edges)
+    time_s = edges["time_s"].values
+    image = assemble_pushbroom(photometry["reference"].values, edges["edge_row"].values)
+    write_dataset(pushbroom_dataset(image, edges["edge_row"].values, time_s), args.out,
+                  config={"colour": "registered first frame"}, checksums=input_checksums(photometry, edges),
+                  step="pushbroom")
+    _, uniform = resample_uniform_time(image, time_s, step_s=median_interval(time_s))
+    with atomic_path(args.png) as tmp:
+        write_png_preview(tmp, uniform[::-1])

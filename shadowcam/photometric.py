@@ -1,0 +1,185 @@
+"""Photometric normalisation of an outdoor time-lapse.
+
+Outdoors the brightness of a frame changes for reasons that are not shadows:
+auto-exposure steps and flicker, and the sunset dimming and reddening of the
+sun and the sky. A pixel's value is modelled as
+
+    Y_k(p) = gain_lit_k * b(p)    while the sun reaches p (lit),
+    Y_k(p) = gain_sky_k * a(p)    once p is in shadow (sky light only),
+
+with ``Y`` the mean of R, G, B. ``gain_lit`` (exposure x sun + sky) is
+estimated per frame on pixels that stay lit, ``gain_sky`` (exposure x sky) on
+pixels that are shadowed in the first frame; exposure metadata, where present,
+only seeds the search. Dividing by ``gain_lit`` keeps lit pixels at their own
+lit level, so the fading light is never taken for a shadow. The per-pixel
+coverage ``(Y - gain_sky a) / (gain_lit b - gain_sky a)`` is then 1 where
+lit, 0 where shadowed and the lit fraction of the footprint in between.
+
+Offers
+------
+luminance : mean of the colour channels, float32.
+exposure_gains : per-frame gain relative to the first frame from exposure times.
+lit_at_start : split the first frame into lit and shadowed pixels (Otsu on log Y).
+estimate_gain : robust gain of a frame relative to the reference on given pixels.
+coverage : per-pixel lit fraction of a frame from its lit and shadow levels.
+"""
+
+import numpy as np
+
+
+def luminance(image):
+    """Return the mean over the last (channel) axis.
+
+    Parameters
+    ----------
+    image : (..., C) ndarray
+        Linear colour image(s).
+
+    Returns
+    -------
+    (...) float32 ndarray
+    """
+    image = np.asarray(image)
+    if image.ndim < 3:
+        raise ValueError(f"image must have a trailing channel axis (H, W, C); got shape {image.shape}")
+    return image.mean(axis=-1, dtype=np.float32)
+
+
+def exposure_gains(exposure_s):
+    """Return per-frame gains relative to the first frame with a known exposure.
+
+    Parameters
+    ----------
+    exposure_s : (T,) array_like
+        Exposure time in seconds per frame, NaN (or <= 0) where unknown.
+
+    Returns
+    -------
+    (T,) float64 ndarray
+        ``exposure_s / exposure_s[first known]``; NaN where unknown (all NaN
+        if no frame has an exposure time).
+    """
+    exposure = np.asarray(exposure_s, dtype=np.float64)
+    if exposure.ndim != 1:
+        raise ValueError(f"exposure_s must be 1-D (one value per frame); got shape {exposure.shape}")
+    known = np.isfinite(exposure) & (exposure > 0)
+    out = np.full(exposure.shape, np.nan)
+    if known.any():
+        out[known] = exposure[known] / exposure[np.argmax(known)]
+    return out
+
+
+def lit_at_start(reference_luma, *, valid):
+    """Split the first frame into sunlit and shadowed pixels.
+
+    Sunlit and sky-lit (shadowed) surfaces differ by a large factor outdoors,
+    so the histogram of ``log Y`` is bimodal; Otsu's threshold separates it.
+
+    Parameters
+    ----------
+    reference_luma : (H, W) ndarray
+        Luminance of the reference (first) frame.
+    valid : (H, W) bool ndarray
+        Pixels to classify (not sky).
+
+    Returns
+    -------
+    lit : (H, W) bool ndarray
+        True where the pixel is sunlit (False outside `valid`).
+    threshold : float
+        The luminance threshold.
+    """
+    luma = np.asarray(reference_luma, dtype=np.float64)
+    valid = np.asarray(valid, dtype=bool)
+    if luma.shape != valid.shape or luma.ndim != 2:
+        raise ValueError(f"reference_luma {luma.shape} and valid {valid.shape} must be the same (H, W) shape")
+    values = np.log(np.maximum(luma[valid], 1e-6))
+    if values.size < 2 or np.ptp(values) == 0:
+        return valid.copy(), 0.0
+    hist, edges = np.histogram(values, bins=256)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    weight0 = np.cumsum(hist)
+    weight1 = weight0[-1] - weight0
+    mean0 = np.cumsum(hist * centres) / np.maximum(weight0, 1)
+    mean1 = (np.sum(hist * centres) - np.cumsum(hist * centres)) / np.maximum(weight1, 1)
+    between = weight0 * weight1 * (mean0 - mean1) ** 2
+    threshold = float(np.exp(centres[np.argmax(between)]))
+    return valid & (luma > threshold), threshold
+
+
+def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, iterations=3):
+    """Robust gain of a frame relative to the reference on pixels that keep their state.
+
+    Parameters
+    ----------
+    luma, reference_luma : (H, W) ndarray
+        Luminance of the (registered) frame and of the reference frame.
+    pixels : (H, W) bool ndarray
+        Candidate pixels (e.g. sunlit in the reference).
+    prior : float, optional
+        Expected gain (previous frame's, or from exposure metadata). If too
+        few pixels lie near it (a global change: cloud, missed exposure
+        step), the search restarts from the 90th percentile of the ratios.
+    min_ratio : float, optional
+        Pixels whose ratio is below ``min_ratio`` times the current estimate
+        are taken as having changed state (newly shadowed) and are ignored.
+    iterations : int, optional
+
+    Returns
+    -------
+    gain : float
+        Median of ``luma / reference_luma`` over the kept pixels (the prior
+        if fewer than 10 pixels remain).
+    kept : int
+        Number of pixels used.
+    """
+    luma = np.asarray(luma, dtype=np.float64)
+    ref = np.asarray(reference_luma, dtype=np.float64)
+    pixels = np.asarray(pixels, dtype=bool)
+    if not (luma.shape == ref.shape == pixels.shape):
+        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and pixels {pixels.shape} must match")
+    if not prior > 0:
+        raise ValueError(f"prior must be positive; got {prior}")
+    use = pixels & (ref > 0)
+    ratio = luma[use] / ref[use]
+    if ratio.size < 10:
+        return float(prior), int(ratio.size)
+    starts = (float(prior), float(np.percentile(ratio, 90)))
+    for start in starts:
+        gain, kept = start, 0
+        for _ in range(iterations):
+            keep = (ratio > min_ratio * gain) & (ratio < gain / min_ratio)
+            kept = int(keep.sum())
+            if kept < 10:
+                break
+            gain = float(np.median(ratio[keep]))
+        if kept >= max(10, 0.05 * ratio.size):
+            return gain, kept
+    return float(prior), kept
+
+
+def coverage(luma, *, lit_level, shadow_level):
+    """Per-pixel lit fraction of the footprint.
+
+    Parameters
+    ----------
+    luma : (H, W) ndarray
+        Luminance of the (registered) frame.
+    lit_level, shadow_level : (H, W) ndarray
+        The pixel's luminance in this frame if fully lit / fully shadowed.
+
+    Returns
+    -------
+    (H, W) float32 ndarray
+        ``(luma - shadow) / (lit - shadow)`` (not clipped); NaN where
+        ``lit <= shadow``.
+    """
+    luma = np.asarray(luma, dtype=np.float32)
+    lit = np.asarray(lit_level, dtype=np.float32)
+    shadow = np.asarray(shadow_level, dtype=np.float32)
+    if not (luma.shape == lit.shape == shadow.shape):
+        raise ValueError(f"luma {luma.shape}, lit_level {lit.shape}, shadow_level {shadow.shape} must match")
+    span = lit - shadow
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(span > 0, (luma - shadow) / span, np.float32(np.nan))
+    return out.astype(np.float32)
