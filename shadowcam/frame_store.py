@@ -23,7 +23,7 @@ write_frames : decode frames one at a time into a sweep store.
 merge_frame_stores : join part stores (consecutive frame ranges) into one sweep store.
 write_reference : decode and average reference frame(s) into a reference store.
 open_frames : open a store lazily (xarray, no dask).
-iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order.
+iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order (optionally a frame range).
 """
 
 import json
@@ -381,7 +381,7 @@ def open_frames(path):
     return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
 
 
-def iter_frame_chunks(dataset, *, chunk_frames=None):
+def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
     """Yield blocks of consecutive frames, reading one chunk at a time.
 
     Parameters
@@ -391,6 +391,9 @@ def iter_frame_chunks(dataset, *, chunk_frames=None):
     chunk_frames : int, optional
         Frames per block; default: the store's time chunk (or about
         :data:`CHUNK_BYTES` for in-memory data).
+    start, stop : int, optional
+        Read only frames ``[start, stop)`` (`stop` clipped to the frame count;
+        default: all).
 
     Yields
     ------
@@ -408,6 +411,10 @@ def iter_frame_chunks(dataset, *, chunk_frames=None):
     chunk_frames = int(chunk_frames)
     if chunk_frames < 1:
         raise ValueError(f"chunk_frames must be >= 1; got {chunk_frames}")
-    for start in range(0, image.sizes["time"], chunk_frames):
-        block = image.isel(time=slice(start, start + chunk_frames)).values
-        yield start, np.asarray(block, dtype=np.float32)
+    n = image.sizes["time"]
+    stop = n if stop is None else min(int(stop), n)
+    if not 0 <= int(start) <= stop:
+        raise ValueError(f"start must be in [0, {stop}] (frames {n}); got start={start}, stop={stop}")
+    for first in range(int(start), stop, chunk_frames):
+        block = image.isel(time=slice(first, min(first + chunk_frames, stop))).values
+        yield first, np.asarray(block, dtype=np.float32)

@@ -1,9 +1,11 @@
-"""Time-chunked decode: part stores joined by ``merge_frame_stores`` equal a single-job decode.
+"""Time chunks: decode parts and shadow-time chunks merge into the single-job results.
 
-Exact ground truth here is the single-job store itself (and the frames' own
+Exact ground truth here is the single-job result itself (and the frames' own
 pixel values): the merged store must hold the same values, coordinates and
-attributes, and even the same compressed chunk files, for any part size.
-Also checked: the workflow splits each sweep into the expected jobs.
+attributes, and even the same compressed chunk files, for any part size; shadow
+times merged from per-chunk dip-tracking partials must equal a single streaming
+pass bit for bit (and the exact shadow passage of a synthetic sweep). Also
+checked: the workflow splits each sweep into the expected jobs.
 """
 
 import json
@@ -16,6 +18,7 @@ import pytest
 import xarray as xr
 import yaml
 from conftest import snakemake, workflow_copy
+from test_decode import write_image
 from test_frame_store import make_frames
 
 from shadowcam.cli import main
@@ -115,7 +118,8 @@ def test_decode_cli_parts_equal_whole_sweep_with_provenance(tmp_path):
 
 
 def test_workflow_splits_sweeps_into_decode_jobs(tmp_path):
-    """Dry run: ceil(frames / (chunk_frames x chunks_per_job)) decode_part jobs per sweep."""
+    """Dry run: ceil(frames / (chunk_frames x chunks_per_job)) decode_part and shadow_time_chunk
+    jobs per sweep."""
     workdir = workflow_copy(tmp_path)
     frames = yaml.safe_load((workdir / "data_manifest" / "synthetic_tiny.yaml").read_text())["synthetic"]["frames"]
     sweeps = 4  # u, v, cal_u, cal_v
@@ -127,5 +131,55 @@ def test_workflow_splits_sweeps_into_decode_jobs(tmp_path):
         assert result.returncode == 0, result.stdout[-3000:]
         stats = result.stdout.split("Job stats:")[1]
         counts = {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", stats, re.M)}
-        assert counts["decode_part"] == sweeps * math.ceil(frames / (chunk_frames * per_job))
+        parts = sweeps * math.ceil(frames / (chunk_frames * per_job))
+        assert counts["decode_part"] == counts["shadow_time_chunk"] == parts
         assert counts["decode"] == sweeps and counts["shadow_time"] == 1
+
+
+def sweep_store(folder, *, frames=23, shape=(6, 20), chunk_frames=4, seed=0):
+    """A sweep whose shadow (2 frames wide) darkens column c in frames c and c + 1 (centre c + 0.5)."""
+    rng = np.random.default_rng(seed)
+    cols = np.arange(shape[1])
+    paths = []
+    folder.mkdir(parents=True)
+    for t in range(frames):
+        # frame t: columns t - 1 and t are dark
+        lit = np.where((cols >= t - 1) & (cols <= t), 0.05, 0.6)
+        image = np.broadcast_to(lit[None, :, None], shape + (3,)) + rng.normal(0, 0.002, shape + (3,))
+        paths.append(write_image(folder / f"{t:04d}.tif", np.round(image * 65535).astype(np.uint16)))
+    return write_frames(paths, folder.parent / f"{folder.name}.zarr", times_s=np.arange(float(frames)),
+                        chunk_frames=chunk_frames)
+
+
+@pytest.mark.parametrize("owned", [[(0, 23)], [(0, 8), (8, 16), (16, 24)], [(0, 5), (5, 23)]])
+def test_shadow_time_from_chunk_partials_equals_single_pass(tmp_path, owned):
+    stores = [sweep_store(tmp_path / sweep, seed=k) for k, sweep in enumerate(("u", "v"))]
+    common = ["--frames", *map(str, stores), "--sweeps", "u", "v", "--method", "dip_centroid"]
+    assert main(["shadow-time", *common, "--out", str(tmp_path / "single.nc")]) == 0
+    partials = {}
+    for store, sweep in zip(stores, ("u", "v")):
+        for start, stop in owned:
+            partials.setdefault(sweep, []).append(str(tmp_path / f"{sweep}.{start}.npz"))
+            assert main(["shadow-time-chunk", "--frames", str(store), "--owned", f"{start}:{stop}",
+                         "--out", partials[sweep][-1]]) == 0
+    assert main(["shadow-time", *common, "--partials", "u", *partials["u"], "--partials", "v", *partials["v"],
+                 "--out", str(tmp_path / "merged.nc")]) == 0
+    with xr.open_dataset(tmp_path / "single.nc", engine="h5netcdf") as a, \
+            xr.open_dataset(tmp_path / "merged.nc", engine="h5netcdf") as b:
+        single, merged = a.load(), b.load()
+    xr.testing.assert_identical(single, merged)  # bit for bit, attrs included
+    # and physically right: the shadow centre passes column c at frame c + 0.5
+    inside = np.arange(2, 19)
+    times = merged["shadow_time"].sel(sweep="u").transpose("row", "col").values[:, inside]
+    np.testing.assert_allclose(times, np.broadcast_to(inside + 0.5, times.shape), atol=0.1)
+
+
+def test_shadow_time_partials_must_cover_every_sweep(tmp_path):
+    store = sweep_store(tmp_path / "u")
+    part = tmp_path / "u.npz"
+    assert main(["shadow-time-chunk", "--frames", str(store), "--owned", "0:23", "--out", str(part)]) == 0
+    base = ["shadow-time", "--frames", str(store), str(store), "--sweeps", "u", "v", "--out", str(tmp_path / "x.nc")]
+    assert main([*base, "--partials", "u", str(part)]) == 2
+    assert main([*base, "--partials", "u", str(part), "--partials", "v"]) == 2
+    assert main(["shadow-time-chunk", "--frames", str(store), "--owned", "5:3", "--out", str(part)]) == 2
+    assert not (tmp_path / "x.nc").exists()

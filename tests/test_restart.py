@@ -3,7 +3,7 @@
 * A decode job killed with SIGKILL leaves only ``<store>.tmp``, which no reader takes
   for a store; rerunning writes the same store as an uninterrupted decode.
 * A join of part stores that fails half-way leaves nothing behind.
-* The workflow (tiny synthetic capture, decoded in 3 parts per sweep) is interrupted
+* The workflow (tiny synthetic capture, decoded and tracked in 2 time chunks per sweep) is interrupted
   twice -- one running decode job is killed, then Snakemake itself with all its jobs --
   and restarted; its frame stores and shadow times equal those of direct, uninterrupted
   ``shadowcam decode`` / ``shadowcam shadow-time`` calls on the same capture.
@@ -28,7 +28,7 @@ from shadowcam.manifest import checksums_for
 
 DS = "synthetic_tiny"
 SWEEPS = ("u", "v", "cal_u", "cal_v")
-PARTS = {"decode": {"chunk_frames": 4, "chunks_per_job": 2}}
+PARTS = {"decode": {"chunk_frames": 6, "chunks_per_job": 2}}
 
 
 def wait_for(predicate, *, timeout=120.0, what="condition"):
@@ -147,7 +147,7 @@ def test_workflow_killed_and_restarted_equals_uninterrupted(tmp_path):
     manifest = workdir / "results" / DS / "capture" / "capture.json"
     shadowcam = str(BIN / "shadowcam")
     for sweep in SWEEPS:
-        subprocess.run([shadowcam, "decode", "--manifest", str(manifest), "--sweep", sweep, "--chunk-frames", "4",
+        subprocess.run([shadowcam, "decode", "--manifest", str(manifest), "--sweep", sweep, "--chunk-frames", "6",
                         "--out", str(reference / f"{sweep}.zarr")], check=True, capture_output=True)
         xr.testing.assert_identical(open_frames(reference / f"{sweep}.zarr").load(),
                                     open_frames(frames / f"{sweep}.zarr").load())

@@ -19,6 +19,7 @@ STEPS = {
     "decode": "decode",
     "merge-frames": "merge_frames",
     "shadow-time": "shadow_time",
+    "shadow-time-chunk": "shadow_time_chunk",
     "dual-coords": "dual_coords",
     "dual-view": "dual_view",
     "accuracy": "accuracy",

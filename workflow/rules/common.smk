@@ -298,14 +298,17 @@ def get_outdoor_accuracy_option(wildcards, input):
 # A sweep of T frames is decoded by ceil(T / F) `decode_part` jobs of F = chunk_frames x
 # decode.chunks_per_job frames each; `decode` joins them (hard links, no copy) into
 # results/{ds}/frames/{sweep}.zarr. Memory of a job is bounded by one time chunk of
-# chunk_frames frames, whatever T and F.
+# chunk_frames frames, whatever T and F. The dips of the same time ranges are tracked
+# by `shadow_time_chunk` jobs whose partials `shadow_time` merges.
 #
 # sweep_frame_count(ds, sweep)   frames of a sweep, known before anything runs
 # frame_shape(ds, sweep)         (rows, cols) of its frames
 # decode_chunk_frames(ds, sweep) store chunk: config decode.chunk_frames, or ~64 MiB (null)
 # decode_part_ranges(ds, sweep)  [(start, stop), ...] frame range of each decode_part job
 # get_decode_parts, get_part_files, get_part_range, get_chunk_frames   decode rules' inputs/params
-# get_decode_mem_mb, get_decode_runtime, get_shadow_time_mem_mb, get_shadow_time_runtime,
+# sweep_partials, get_partials, get_partials_option    shadow-time chunks (same ranges as the decode parts)
+# get_decode_mem_mb, get_decode_runtime, get_shadow_time_mem_mb, get_shadow_time_chunk_mem_mb,
+# get_shadow_time_chunk_runtime,
 # get_image_mem_mb, get_stream_mem_mb, get_stream_runtime, get_render_mem_mb   resources (MB, minutes)
 
 import math
@@ -393,6 +396,22 @@ def get_part_range(wildcards):
     return f"{start}:{stop}"
 
 
+def sweep_partials(ds, sweep):
+    """Dip-tracking partials of a sweep, one per decode part (time chunk), in time order."""
+    count = len(decode_part_ranges(ds, sweep))
+    return [f"results/{ds}/shadow_time/{sweep}.parts/{i:04d}.npz" for i in range(count)]
+
+
+def get_partials(wildcards):
+    """Partials of every sweep of `get_sweeps` (inputs of `shadow_time`)."""
+    return [p for s in get_sweeps(wildcards) for p in sweep_partials(wildcards.ds, s)]
+
+
+def get_partials_option(wildcards, input):
+    """``--partials SWEEP FILE... --partials ...`` of ``shadowcam shadow-time``."""
+    return " ".join(f"--partials {s} " + " ".join(sweep_partials(wildcards.ds, s)) for s in get_sweeps(wildcards))
+
+
 def get_chunk_frames(wildcards):
     """``--chunk-frames`` of a sweep (the same for all its parts)."""
     return decode_chunk_frames(wildcards.ds, wildcards.sweep)
@@ -419,18 +438,24 @@ def get_decode_runtime(wildcards, attempt):
 
 
 def get_shadow_time_mem_mb(wildcards, attempt):
-    """Memory of shadow_time: per-sweep maps of every sweep plus three copies of a read chunk."""
+    """Memory of shadow_time: the merged summaries and per-sweep maps of every sweep."""
     sweeps = get_sweeps(wildcards)
     rows, cols = frame_shape(wildcards.ds, sweeps[0])
-    chunk = max(decode_chunk_frames(wildcards.ds, s) * _frame_mb(wildcards.ds, s) for s in sweeps)
     maps = len(sweeps) * rows * cols * SHADOW_TIME_BYTES_PER_PIXEL / 2**20
-    return attempt * math.ceil(BASE_MEM_MB + 3 * chunk + maps)
+    return attempt * math.ceil(BASE_MEM_MB + maps)
 
 
-def get_shadow_time_runtime(wildcards, attempt):
-    """Minutes of shadow_time, from the pixel-frames it streams."""
-    work = sum(sweep_frame_count(wildcards.ds, s) * math.prod(frame_shape(wildcards.ds, s))
-               for s in get_sweeps(wildcards))
+def get_shadow_time_chunk_mem_mb(wildcards, attempt):
+    """Memory of shadow_time_chunk: a tracker's per-pixel state and three copies of a read chunk."""
+    rows, cols = frame_shape(wildcards.ds, wildcards.sweep)
+    chunk = decode_chunk_frames(wildcards.ds, wildcards.sweep) * _frame_mb(wildcards.ds, wildcards.sweep)
+    return attempt * math.ceil(BASE_MEM_MB + 3 * chunk + rows * cols * SHADOW_TIME_BYTES_PER_PIXEL / 2**20)
+
+
+def get_shadow_time_chunk_runtime(wildcards, attempt):
+    """Minutes of shadow_time_chunk, from the pixel-frames it streams."""
+    start, stop = _part_range(wildcards)
+    work = (stop - start) * math.prod(frame_shape(wildcards.ds, wildcards.sweep))
     return attempt * (5 + math.ceil(work * SHADOW_TIME_SECONDS_PER_PIXEL / 60))
 
 
