@@ -17,13 +17,12 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
-from conftest import snakemake, workflow_copy
+from conftest import snakemake, workflow_copy, write_manifest
 from test_decode import write_image
 from test_frame_store import make_frames
 
 from shadowcam.cli import main
 from shadowcam.frame_store import iter_frame_chunks, merge_frame_stores, open_frames, write_frames
-from shadowcam.manifest import checksums_for
 
 FRAMES = 23  # not a multiple of any part size used below: the last part is short
 
@@ -87,14 +86,16 @@ def test_merge_rejects_gaps_order_and_mixed_chunks(tmp_path):
         write_frames(paths[3:], tmp_path / "d.zarr", times_s=times[3:], chunk_frames=2, first_frame=3)
 
 
+def sweep_manifest(folder, *, rate_hz):
+    """Write `folder`/cap.yaml describing sweep u = `folder`/data/u/*.tif, with checksums."""
+    return write_manifest(folder / "cap.yaml", {
+        "name": "cap", "kind": "lab", "light": "point", "root": "data",
+        "sweeps": {"u": {"files": "u/*.tif", "axis": "u"}}, "timing": {"source": "rate", "rate_hz": rate_hz}})
+
+
 def test_decode_cli_parts_equal_whole_sweep_with_provenance(tmp_path):
     paths, expected = make_frames(tmp_path / "data" / "u", 7, seed=5)
-    doc = {"name": "cap", "kind": "lab", "light": "point", "root": "data",
-           "sweeps": {"u": {"files": "u/*.tif", "axis": "u"}}, "timing": {"source": "rate", "rate_hz": 4.0}}
-    manifest = tmp_path / "cap.yaml"
-    manifest.write_text(yaml.safe_dump(doc))
-    doc["checksums"] = checksums_for(manifest)
-    manifest.write_text(yaml.safe_dump(doc))
+    manifest = sweep_manifest(tmp_path, rate_hz=4.0)
     common = ["--manifest", str(manifest), "--sweep", "u", "--chunk-frames", "2"]
     assert main(["decode", *common, "--out", str(tmp_path / "whole.zarr")]) == 0
     parts = []

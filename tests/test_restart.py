@@ -20,11 +20,11 @@ import pytest
 import xarray as xr
 import yaml
 from conftest import BIN, snakemake, workflow_copy
+from test_chunking import sweep_manifest
 from test_frame_store import make_frames
 
 from shadowcam import frame_store
 from shadowcam.frame_store import merge_frame_stores, open_frames, write_frames
-from shadowcam.manifest import checksums_for
 
 DS = "synthetic_tiny"
 SWEEPS = ("u", "v", "cal_u", "cal_v")
@@ -59,12 +59,7 @@ def group_processes(pgid, *words):
 
 def test_killed_decode_leaves_no_store_and_rerun_is_identical(tmp_path):
     paths, expected = make_frames(tmp_path / "data" / "u", 60, shape=(256, 256, 3))
-    doc = {"name": "cap", "kind": "lab", "light": "point", "root": "data",
-           "sweeps": {"u": {"files": "u/*.tif", "axis": "u"}}, "timing": {"source": "rate", "rate_hz": 1.0}}
-    manifest = tmp_path / "cap.yaml"
-    manifest.write_text(yaml.safe_dump(doc))
-    doc["checksums"] = checksums_for(manifest)
-    manifest.write_text(yaml.safe_dump(doc))
+    manifest = sweep_manifest(tmp_path, rate_hz=1.0)
     out = tmp_path / "u.zarr"
     command = [str(BIN / "shadowcam"), "decode", "--manifest", str(manifest), "--sweep", "u",
                "--chunk-frames", "2", "--out", str(out)]
