@@ -13,11 +13,11 @@
 # polls with `--slurm-status-command squeue`). Idempotent: `start` on a running cluster only
 # waits for the node; `stop` on a stopped one does nothing.
 #
-# Environment: SLURM_CLUSTER_DIR (state, logs, pid files; default /tmp/shadowcam-slurm),
+# Environment: SLURM_CLUSTER_DIR (state, logs, pid files; default /tmp/slurm-shadowcam),
 # SLURM_CLUSTER_PARTITION (default "debug"), SLURM_CLUSTER_INSTALL (0 = never apt-get).
 set -euo pipefail
 
-STATE=${SLURM_CLUSTER_DIR:-/tmp/shadowcam-slurm}
+STATE=${SLURM_CLUSTER_DIR:-/tmp/slurm-shadowcam}
 PARTITION=${SLURM_CLUSTER_PARTITION:-debug}
 CONF_DIR=/etc/slurm
 CONF=$CONF_DIR/slurm.conf
