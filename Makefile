@@ -5,7 +5,7 @@
 # `make bench-outdoor-size` the same stages at a camera's size (24 MP by default), extrapolated.
 # `make bench` prints the speed benchmark (not part of the tests; ~10 min, renders
 # its DNG input once into results/bench/dng and reuses it).
-# Every target installs the package (editable, with test extras) into .venv first.
+# Every target installs the package (editable, with test and SLURM-executor extras) into .venv first.
 
 PYTHON ?= python3
 VENV := .venv
@@ -32,7 +32,7 @@ $(BIN)/python:
 
 # Reinstall only when the package metadata changes.
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[test]"
+	$(BIN)/python -m pip install --quiet -e ".[test,slurm]"
 	touch $(STAMP)
 
 install: $(STAMP)

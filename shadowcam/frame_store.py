@@ -9,14 +9,21 @@ channel)`` (the mean of the reference frames). Stores are written to
 ``<out>.tmp`` and renamed when complete, so an interrupted job never leaves a
 store that looks finished.
 
+A long sweep can be decoded as several *part* stores, one per job, each
+holding a range of frames that starts on a chunk boundary;
+:func:`merge_frame_stores` joins them into the sweep store by hard-linking
+their chunk files (no data copied; the result equals a single-job decode
+bit for bit).
+
 Offers
 ------
 CHUNK_BYTES : target size of one uncompressed time chunk (64 MiB).
 default_chunk_frames : frames per chunk for a frame shape.
 write_frames : decode frames one at a time into a sweep store.
+merge_frame_stores : join part stores (consecutive frame ranges) into one sweep store.
 write_reference : decode and average reference frame(s) into a reference store.
 open_frames : open a store lazily (xarray, no dask).
-iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order.
+iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order (optionally a frame range).
 """
 
 import json
@@ -83,12 +90,13 @@ def _image_attrs():
     return {"long_name": "linear image", "units": "1 (black = 0, white level = 1)"}
 
 
-def _block_dataset(block, start, times_s, exposure_s):
+def _block_dataset(block, start, times_s, exposure_s, *, first_frame=0):
     stop = start + block.shape[0]
+    frames = np.arange(first_frame + start, first_frame + stop, dtype=np.float64)
     return xr.Dataset(
         {"image": (("time", "row", "col", "channel"), block, _image_attrs())},
         coords={
-            "time": ("time", np.arange(start, stop, dtype=np.float64), {"units": "frame", "long_name": "frame index"}),
+            "time": ("time", frames, {"units": "frame", "long_name": "frame index"}),
             "time_s": ("time", np.asarray(times_s[start:stop], dtype=np.float64), {"units": "s", "long_name": "frame time"}),
             "exposure_s": (
                 "time",
@@ -124,7 +132,8 @@ class _AtomicStore:
         return False
 
 
-def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk_frames=None, log_every=25):
+def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk_frames=None,
+                 first_frame=0, log_every=25):
     """Decode frames one at a time into a time-chunked zarr v3 store.
 
     Memory stays bounded by one time chunk whatever the number of frames.
@@ -143,7 +152,14 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
     attrs : mapping, optional
         Extra dataset attrs (e.g. provenance); dict values are stored as JSON.
     chunk_frames : int, optional
-        Frames per time chunk; default: about :data:`CHUNK_BYTES` per chunk.
+        Frames per time chunk; default: about :data:`CHUNK_BYTES` per chunk
+        (at most the number of frames). When given, it is the store's chunk
+        size even if the store holds fewer frames, so that part stores of
+        one sweep share it (see :func:`merge_frame_stores`).
+    first_frame : int, optional
+        Frame index of ``paths[0]`` in the whole sweep (a part store); the
+        ``time`` coordinate counts from it. Must be a multiple of
+        `chunk_frames` so that the part's chunks are chunks of the sweep.
     log_every : int, optional
         Log progress every this many frames.
 
@@ -164,6 +180,12 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
         raise ValueError(f"exposure_s must have one value per frame ({len(paths)}); got shape {exposure.shape}")
     if chunk_frames is not None and int(chunk_frames) < 1:
         raise ValueError(f"chunk_frames must be >= 1; got {chunk_frames}")
+    first_frame = int(first_frame)
+    if first_frame < 0 or (first_frame and (chunk_frames is None or first_frame % int(chunk_frames))):
+        raise ValueError(
+            f"first_frame must be >= 0 and a multiple of chunk_frames (given explicitly); "
+            f"got first_frame={first_frame}, chunk_frames={chunk_frames}"
+        )
     if log_every < 1:
         raise ValueError(f"log_every must be >= 1; got {log_every}")
 
@@ -173,21 +195,21 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
         block, start, written = None, 0, 0
         for k, (path, image, info) in enumerate(iter_frames(paths)):
             if block is None:
-                chunk = min(n, int(chunk_frames) if chunk_frames else default_chunk_frames(image.shape))
-                block = np.empty((chunk,) + image.shape, dtype=np.float32)
+                chunk = int(chunk_frames) if chunk_frames else min(n, default_chunk_frames(image.shape))
+                block = np.empty((min(n, chunk),) + image.shape, dtype=np.float32)
                 store_attrs = {**_decoder_attrs(info), **_json_safe(attrs), "n_frames": n}
             if not exposure_given and info["exposure_s"] is not None:
                 exposure[k] = info["exposure_s"]
             block[k - start] = image
             if k - start + 1 == block.shape[0] or k == n - 1:
-                ds = _block_dataset(block[: k - start + 1], start, times_s, exposure)
+                ds = _block_dataset(block[: k - start + 1], start, times_s, exposure, first_frame=first_frame)
                 ds.attrs.update(store_attrs)  # appends rewrite the group attrs
                 if start == 0:
                     encoding = {
-                        "image": {"chunks": block.shape, "compressors": _COMPRESSORS},
-                        "time": {"chunks": (block.shape[0],)},
-                        "time_s": {"chunks": (block.shape[0],)},
-                        "exposure_s": {"chunks": (block.shape[0],)},
+                        "image": {"chunks": (chunk,) + block.shape[1:], "compressors": _COMPRESSORS},
+                        "time": {"chunks": (chunk,)},
+                        "time_s": {"chunks": (chunk,)},
+                        "exposure_s": {"chunks": (chunk,)},
                     }
                     ds.to_zarr(tmp, mode="w-", zarr_format=3, encoding=encoding, consolidated=False)
                 else:
@@ -198,6 +220,109 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
                 elapsed = _time.perf_counter() - started
                 log.info("decoded %d/%d frames (%.1f frames/s) -> %s", k + 1, n, (k + 1) / max(elapsed, 1e-9), out_path)
     assert written == n
+    return Path(out_path)
+
+
+def _part_layout(path):
+    """(first frame, frame count, chunk frames, frame shape) of a part store."""
+    image = open_frames(path)["image"]
+    if image.dims != ("time", "row", "col", "channel"):
+        raise ValueError(f"parts: {path} is not a sweep store (image dims {image.dims})")
+    times = image["time"].values
+    first = int(times[0]) if times.size else 0
+    if times.size and not np.array_equal(times, np.arange(first, first + times.size)):
+        raise ValueError(f"parts: {path} holds non-consecutive frames")
+    return first, int(times.size), int(image.encoding["chunks"][0]), tuple(image.shape[1:])
+
+
+def _link(source, target):
+    """Hard-link `source` to `target` (copy where the file system cannot link)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        os.link(source, target)
+    except OSError:
+        shutil.copy2(source, target)
+
+
+def _read_json(path):
+    with open(path) as handle:
+        return json.load(handle)
+
+
+def _write_json(path, document):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w") as handle:
+        json.dump(document, handle, indent=2)
+
+
+def merge_frame_stores(parts, out_path, *, attrs=None):
+    """Join part stores of one sweep into a single sweep store, without copying data.
+
+    Each part's compressed chunk files are hard-linked into the new store under
+    their chunk index in the whole sweep, and the array metadata are those of
+    the first part with the time length of the whole sweep. The result reads
+    exactly like a store written by one :func:`write_frames` call over all frames
+    with the same `chunk_frames` (same values, same chunk files). Written to
+    ``<out_path>.tmp`` and renamed when complete.
+
+    Parameters
+    ----------
+    parts : sequence of str or Path
+        Part stores from :func:`write_frames` (with ``first_frame``), in time
+        order: the first starts at frame 0, each starts where the previous
+        ends, all share the chunk size and frame shape.
+    out_path : str or Path
+        Sweep store to create (``*.zarr``); replaced if it exists.
+    attrs : mapping, optional
+        Dataset attrs to set or replace (e.g. the merged provenance); ``n_frames``
+        is set to the total. Other attrs are the first part's.
+
+    Returns
+    -------
+    Path
+        `out_path`.
+    """
+    parts = [Path(p) for p in parts]
+    if not parts:
+        raise ValueError("parts must list at least one part store")
+    layouts = [_part_layout(p) for p in parts]
+    chunk, shape = layouts[0][2], layouts[0][3]
+    expected = 0
+    for path, (first, count, part_chunk, part_shape) in zip(parts, layouts):
+        if part_chunk != chunk or part_shape != shape:
+            raise ValueError(
+                f"parts: {path} has chunks of {part_chunk} frames of {part_shape} but {parts[0]} has "
+                f"{chunk} of {shape}; decode every part with the same --chunk-frames"
+            )
+        if first != expected or first % chunk:
+            raise ValueError(
+                f"parts: {path} starts at frame {first}, expected {expected} (on a multiple of "
+                f"{chunk}); list the parts in time order without gaps"
+            )
+        expected += count
+    total = expected
+    with _AtomicStore(out_path) as tmp:
+        group = _read_json(parts[0] / "zarr.json")
+        group["attributes"] = {**group.get("attributes", {}), **_json_safe(attrs), "n_frames": total}
+        _write_json(tmp / "zarr.json", group)
+        for meta_path in sorted(parts[0].glob("*/zarr.json")):
+            name = meta_path.parent.name
+            meta = _read_json(meta_path)
+            encoding = meta.get("chunk_key_encoding", {})
+            if encoding.get("name") != "default" or encoding.get("configuration", {}).get("separator") != "/":
+                raise ValueError(f"parts: {meta_path} uses chunk key encoding {encoding}; expected default '/'")
+            along_time = (meta.get("dimension_names") or [None])[0] == "time"
+            if along_time:
+                meta["shape"][0] = total
+            _write_json(tmp / name / "zarr.json", meta)
+            for path, (first, *_rest) in zip(parts if along_time else parts[:1], layouts):
+                offset = first // chunk if along_time else 0
+                for source in sorted((path / name / "c").rglob("*")):
+                    if source.is_file():
+                        key = source.relative_to(path / name / "c").parts
+                        index = (str(int(key[0]) + offset),) + key[1:]
+                        _link(source, tmp.joinpath(name, "c", *index))
+    log.info("merged %d part store(s), %d frames -> %s", len(parts), total, out_path)
     return Path(out_path)
 
 
@@ -256,7 +381,7 @@ def open_frames(path):
     return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
 
 
-def iter_frame_chunks(dataset, *, chunk_frames=None):
+def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
     """Yield blocks of consecutive frames, reading one chunk at a time.
 
     Parameters
@@ -266,6 +391,9 @@ def iter_frame_chunks(dataset, *, chunk_frames=None):
     chunk_frames : int, optional
         Frames per block; default: the store's time chunk (or about
         :data:`CHUNK_BYTES` for in-memory data).
+    start, stop : int, optional
+        Read only frames ``[start, stop)`` (`stop` clipped to the frame count;
+        default: all).
 
     Yields
     ------
@@ -283,6 +411,10 @@ def iter_frame_chunks(dataset, *, chunk_frames=None):
     chunk_frames = int(chunk_frames)
     if chunk_frames < 1:
         raise ValueError(f"chunk_frames must be >= 1; got {chunk_frames}")
-    for start in range(0, image.sizes["time"], chunk_frames):
-        block = image.isel(time=slice(start, start + chunk_frames)).values
-        yield start, np.asarray(block, dtype=np.float32)
+    n = image.sizes["time"]
+    stop = n if stop is None else min(int(stop), n)
+    if not 0 <= int(start) <= stop:
+        raise ValueError(f"start must be in [0, {stop}] (frames {n}); got start={start}, stop={stop}")
+    for first in range(int(start), stop, chunk_frames):
+        block = image.isel(time=slice(first, min(first + chunk_frames, stop))).values
+        yield first, np.asarray(block, dtype=np.float32)

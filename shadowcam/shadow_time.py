@@ -17,8 +17,8 @@ classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 lit_colour : unshadowed colour per pixel from a summary with channel sums.
-sweep_shadow_times : shadow times of one sweep from streamed frame blocks.
-summary_shadow_times : shadow times of one sweep from its (possibly merged) summary.
+sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
+summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
 """
 
 import numpy as np
@@ -577,25 +577,28 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
 
 def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
                          classify_params=None):
-    """Shadow times of one sweep from its :class:`DipSummary` (with channel sums).
+    """Shadow times of one sweep from its tracked :class:`DipSummary`.
+
+    The second half of :func:`sweep_shadow_times`, for a summary obtained
+    otherwise, e.g. :func:`shadowcam.dip_tracker.merge_partials` of time chunks
+    tracked in separate jobs (the result is then the same bit for bit).
 
     Parameters
     ----------
     summary : DipSummary
-        Of a tracker fed ``(T, H, W, C)`` frames (whole sweep, or merged chunks).
+        With channel sums (the tracker was fed ``(T, H, W, C)`` blocks).
     method, cfa_pattern, method_params, classify_params
         As :func:`sweep_shadow_times`.
 
     Returns
     -------
-    dict
-        As :func:`sweep_shadow_times`.
+    results : dict of (H, W) ndarrays
+        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
     """
     lit_image = lit_colour(summary)
-    shape = lit_image.shape[:2]
     classify_params = dict(classify_params or {})
     if cfa_pattern:
-        colour = cfa_site_colours(shape, cfa_pattern)
+        colour = cfa_site_colours(summary.lit_level.shape, cfa_pattern)
         classify_params.update(
             site_colour=colour,
             site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],

@@ -7,6 +7,7 @@ workflow_copy(dest) : copy the workflow (Snakefile, rules, schemas, config, prof
     synthetic manifests) into `dest` so that it runs in a scratch working directory.
 snakemake(args, cwd) : run the snakemake of this interpreter's environment, with the
     environment's ``bin`` (the ``shadowcam`` command) first on PATH.
+write_manifest(path, doc) : write a capture manifest with the checksums of its files.
 """
 
 import os
@@ -14,6 +15,8 @@ import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+import yaml
 
 REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
@@ -44,3 +47,13 @@ def snakemake(args, cwd, *, timeout=600):
         [str(BIN / "snakemake"), *args], cwd=cwd, env=env, timeout=timeout,
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )
+
+
+def write_manifest(path, doc):
+    """Write manifest `doc` (a dict) to `path` with a ``checksums`` block of its files; return `path`."""
+    from shadowcam.manifest import checksums_for
+
+    path = Path(path)
+    path.write_text(yaml.safe_dump(doc))
+    path.write_text(yaml.safe_dump({**doc, "checksums": checksums_for(path)}))
+    return path

@@ -4,10 +4,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
+from conftest import write_manifest
 
 from shadowcam.ground_truth import REQUIRED, check_ground_truth, load_ground_truth, mitsuba_lab_npz_to_dataset
-from shadowcam.manifest import checksums_for
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = Path("/work/shared/data/lab-dev")
@@ -51,11 +50,7 @@ def _manifest(tmp_path, fmt, file):
     doc = {"name": "g", "kind": "lab", "light": "point", "root": ".", "sweeps": {"u": {"files": "u.png"}},
            "timing": {"source": "rate", "rate_hz": 1.0}, "ground_truth": {"format": fmt, "file": file}}
     (tmp_path / "u.png").write_bytes(b"")  # a sweep file (not decoded here)
-    path = tmp_path / "g.yaml"
-    path.write_text(yaml.safe_dump(doc))
-    doc["checksums"] = checksums_for(path)
-    path.write_text(yaml.safe_dump(doc))
-    return path
+    return write_manifest(tmp_path / "g.yaml", doc)
 
 
 def test_load_lab_npz_via_manifest_verifies_checksum(tmp_path):

@@ -17,7 +17,9 @@ STEPS = {
     "render": "render",
     "checksum": "checksum",
     "decode": "decode",
+    "merge-frames": "merge_frames",
     "shadow-time": "shadow_time",
+    "shadow-time-chunk": "shadow_time_chunk",
     "dual-coords": "dual_coords",
     "dual-view": "dual_view",
     "accuracy": "accuracy",
@@ -38,13 +40,19 @@ STEPS = {
 }
 
 
-def build_parser():
-    """Return the top-level argument parser with every available step."""
+def build_parser(steps=None):
+    """Return the top-level argument parser with every available step (or only `steps`).
+
+    A job runs one step, so :func:`main` registers only that one: importing every
+    step's libraries (plotting, compiled kernels, ...) would add seconds to each job.
+    """
     parser = argparse.ArgumentParser(prog="shadowcam", description=__doc__)
     parser.add_argument("--version", action="version", version=__version__)
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     subparsers = parser.add_subparsers(dest="step", required=True, metavar="STEP")
     for name, module_name in STEPS.items():
+        if steps is not None and name not in steps:
+            continue
         try:
             module = importlib.import_module(f"shadowcam.cli.{module_name}")
         except ModuleNotFoundError as exc:
@@ -58,7 +66,9 @@ def build_parser():
 
 def main(argv=None):
     """Entry point of the ``shadowcam`` command."""
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    positional = [a for a in argv if not a.startswith("-")][:1]
+    parser = build_parser(positional if positional and positional[0] in STEPS else None)
     args = parser.parse_args(argv)
     logging.basicConfig(
         level=logging.DEBUG if args.verbose else logging.INFO,

@@ -19,6 +19,9 @@ rule accuracy:
         ),
     params:
         manifest=get_capture_manifest,
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
     log:
         "logs/{ds}/accuracy.log",
     benchmark:

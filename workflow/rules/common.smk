@@ -14,10 +14,16 @@
 # get_*                       input / params functions of the rules
 import glob
 import json
+import math
 import os
+from functools import lru_cache
 from pathlib import Path
 
 import yaml
+
+from shadowcam.decode import frame_info
+from shadowcam.frame_store import default_chunk_frames
+from shadowcam.manifest import natural_key
 
 SCENE_SWEEPS = ("u", "v")
 CALIBRATION_SWEEPS = ("cal_u", "cal_v")
@@ -313,7 +319,6 @@ def get_methods_params(wildcards):
 # frames; job memory and run time are sized from the frame size (header of the first
 # frame) with per-megapixel figures measured by `make bench-outdoor-size`.
 
-_OUTDOOR_FRAME_CACHE = {}
 #: measured peak RSS per megapixel of frame (MB/MP) and fixed part (MB), with margin
 OUTDOOR_MEM_MB = {"normalise": (400, 85), "track": (400, 100), "per_pixel": (400, 70)}
 #: measured seconds per frame and megapixel on one core (x3 margin in outdoor_runtime)
@@ -321,17 +326,13 @@ OUTDOOR_S_PER_MP_FRAME = {"normalise": 0.25, "track": 0.35, "per_pixel": 0.05}
 
 
 def outdoor_frame_layout(ds):
-    """Return ``(n_frames, megapixels)`` of the time-lapse of `ds` ((None, None) if rendered)."""
-    if ds not in _OUTDOOR_FRAME_CACHE:
-        if is_synthetic(ds):
-            _OUTDOOR_FRAME_CACHE[ds] = (None, None)
-        else:
-            from shadowcam.decode import frame_info
-
-            files = capture_files(ds, outdoor_sweep(ds))[1:]
-            info = frame_info(files[0])
-            _OUTDOOR_FRAME_CACHE[ds] = (len(files), info["height"] * info["width"] / 1e6)
-    return _OUTDOOR_FRAME_CACHE[ds]
+    """Return ``(n_frames, megapixels)`` of the time-lapse of `ds` ((None, None) if rendered:
+    the frames kept after dropped ones are known only once rendered)."""
+    if is_synthetic(ds):
+        return None, None
+    sweep = outdoor_sweep(ds)
+    rows, cols = frame_shape(ds, sweep)
+    return sweep_frame_count(ds, sweep), rows * cols / 1e6
 
 
 def outdoor_parts(ds):
@@ -382,3 +383,196 @@ def outdoor_runtime(stage):
         return max(10, int(3 * seconds / 60) + 1)
 
     return runtime
+
+
+# ---------------------------------------------------------------------------------------
+# Time chunks and job resources (decode parts, resources sized from the input).
+#
+# A sweep of T frames is decoded by ceil(T / F) `decode_part` jobs of F = chunk_frames x
+# decode.chunks_per_job frames each; `decode` joins them (hard links, no copy) into
+# results/{ds}/frames/{sweep}.zarr. Memory of a job is bounded by one time chunk of
+# chunk_frames frames, whatever T and F. The dips of the same time ranges are tracked
+# by `shadow_time_chunk` jobs whose partials `shadow_time` merges.
+#
+# sweep_frame_count(ds, sweep)   frames of a sweep, known before anything runs
+# frame_shape(ds, sweep)         (rows, cols) of its frames
+# decode_chunk_frames(ds, sweep) store chunk: config decode.chunk_frames, or ~64 MiB (null)
+# decode_part_ranges(ds, sweep)  [(start, stop), ...] frame range of each decode_part job
+# get_decode_parts, get_part_files, get_part_range, get_chunk_frames   decode rules' inputs/params
+# sweep_partials, get_partials, get_partials_option    shadow-time chunks (same ranges as the decode parts)
+# get_decode_mem_mb, get_decode_runtime, get_shadow_time_mem_mb, get_shadow_time_chunk_mem_mb,
+# get_shadow_time_chunk_runtime,
+# get_image_mem_mb, get_stream_mem_mb, get_stream_runtime, get_render_mem_mb   resources (MB, minutes)
+
+
+wildcard_constraints:
+    part=r"\d{4}",
+
+#: per-pixel seconds of decoding one frame (rawpy + demosaic + zstd write, ~3x the
+#: measured 24 MP lossless-JPEG DNG cost), used to size `runtime`
+DECODE_SECONDS_PER_PIXEL = 2e-7
+#: per-pixel seconds of streaming one frame through shadow time (zarr read + tracker)
+SHADOW_TIME_SECONDS_PER_PIXEL = 5e-8
+#: bytes per camera pixel held by the shadow-time step per sweep (tracker window and
+#: sums, per-sweep result maps, classification temporaries)
+SHADOW_TIME_BYTES_PER_PIXEL = 600
+#: memory of a Python process with the shadowcam imports loaded
+BASE_MEM_MB = 500
+
+
+def sweep_files(ds, sweep):
+    """Frame files of a sweep of user data in frame order (natural sort, as the manifest)."""
+    return sorted(capture_files(ds, sweep)[1:], key=natural_key)
+
+
+def sweep_frame_count(ds, sweep):
+    """Number of frames of `sweep` of `ds` (int), known when the DAG is built."""
+    if is_synthetic(ds):
+        return int(load_dataset_manifest(ds)["synthetic"]["frames"])
+    return len(sweep_files(ds, sweep))
+
+
+@lru_cache(maxsize=None)
+def frame_shape(ds, sweep):
+    """(rows, cols) of the frames of `sweep` (the manifest, or the first file's header)."""
+    if is_synthetic(ds):
+        synthetic = load_dataset_manifest(ds)["synthetic"]
+        return int(synthetic["height"]), int(synthetic["width"])
+    info = frame_info(sweep_files(ds, sweep)[0])
+    return int(info["height"]), int(info["width"])
+
+
+def decode_chunk_frames(ds, sweep):
+    """Frames per store chunk: config decode.chunk_frames, or ~64 MiB of float32 RGB if null."""
+    configured = config["decode"]["chunk_frames"]
+    return int(configured) if configured else default_chunk_frames(frame_shape(ds, sweep) + (3,))
+
+
+def decode_part_ranges(ds, sweep):
+    """Frame ranges [(start, stop), ...] of the decode_part jobs of a sweep."""
+    total = sweep_frame_count(ds, sweep)
+    step = decode_chunk_frames(ds, sweep) * int(config["decode"]["chunks_per_job"])
+    return [(start, min(start + step, total)) for start in range(0, total, step)]
+
+
+def _part_range(wildcards):
+    ranges = decode_part_ranges(wildcards.ds, wildcards.sweep)
+    index = int(wildcards.part)
+    if index >= len(ranges):
+        raise ValueError(f"{wildcards.ds} sweep {wildcards.sweep} has {len(ranges)} parts, no part {index}")
+    return ranges[index]
+
+
+def get_decode_parts(wildcards):
+    """Part stores of a sweep, in time order (inputs of `decode`)."""
+    count = len(decode_part_ranges(wildcards.ds, wildcards.sweep))
+    return [f"results/{wildcards.ds}/frames/{wildcards.sweep}.parts/{i:04d}.zarr" for i in range(count)]
+
+
+def get_part_files(wildcards):
+    """Files one decode_part job reads: the rendered capture, or the manifest and its frames."""
+    if is_synthetic(wildcards.ds):
+        return capture_files(wildcards.ds, wildcards.sweep)
+    start, stop = _part_range(wildcards)
+    return [manifest_path(wildcards.ds)] + sweep_files(wildcards.ds, wildcards.sweep)[start:stop]
+
+
+def get_part_range(wildcards):
+    """``START:STOP`` of ``shadowcam decode --frames`` for one part."""
+    start, stop = _part_range(wildcards)
+    return f"{start}:{stop}"
+
+
+def sweep_partials(ds, sweep):
+    """Dip-tracking partials of a sweep, one per decode part (time chunk), in time order."""
+    count = len(decode_part_ranges(ds, sweep))
+    return [f"results/{ds}/shadow_time/{sweep}.parts/{i:04d}.npz" for i in range(count)]
+
+
+def get_partials(wildcards):
+    """Partials of every sweep of `get_sweeps` (inputs of `shadow_time`)."""
+    return [p for s in get_sweeps(wildcards) for p in sweep_partials(wildcards.ds, s)]
+
+
+def get_partials_option(wildcards, input):
+    """``--partials SWEEP FILE... --partials ...`` of ``shadowcam shadow-time``."""
+    return " ".join(f"--partials {s} " + " ".join(sweep_partials(wildcards.ds, s)) for s in get_sweeps(wildcards))
+
+
+def get_chunk_frames(wildcards):
+    """``--chunk-frames`` of a sweep (the same for all its parts)."""
+    return decode_chunk_frames(wildcards.ds, wildcards.sweep)
+
+
+def _frame_mb(ds, sweep):
+    rows, cols = frame_shape(ds, sweep)
+    return rows * cols * 3 * 4 / 2**20
+
+
+def get_decode_mem_mb(wildcards, attempt):
+    """Memory of a decode_part job: two copies of a time chunk and a few frames of decoder
+    buffers (float32 RGB), doubled on a retry."""
+    frame = _frame_mb(wildcards.ds, wildcards.sweep)
+    chunk = decode_chunk_frames(wildcards.ds, wildcards.sweep)
+    return attempt * math.ceil(BASE_MEM_MB + (2 * chunk + 4) * frame)
+
+
+def get_decode_runtime(wildcards, attempt):
+    """Minutes of a decode_part job, from its frame and pixel count."""
+    start, stop = _part_range(wildcards)
+    rows, cols = frame_shape(wildcards.ds, wildcards.sweep)
+    return attempt * (5 + math.ceil((stop - start) * rows * cols * DECODE_SECONDS_PER_PIXEL / 60))
+
+
+def get_shadow_time_mem_mb(wildcards, attempt):
+    """Memory of shadow_time: the merged summaries and per-sweep maps of every sweep."""
+    sweeps = get_sweeps(wildcards)
+    rows, cols = frame_shape(wildcards.ds, sweeps[0])
+    maps = len(sweeps) * rows * cols * SHADOW_TIME_BYTES_PER_PIXEL / 2**20
+    return attempt * math.ceil(BASE_MEM_MB + maps)
+
+
+def get_shadow_time_chunk_mem_mb(wildcards, attempt):
+    """Memory of shadow_time_chunk: a tracker's per-pixel state and three copies of a read chunk."""
+    rows, cols = frame_shape(wildcards.ds, wildcards.sweep)
+    chunk = decode_chunk_frames(wildcards.ds, wildcards.sweep) * _frame_mb(wildcards.ds, wildcards.sweep)
+    return attempt * math.ceil(BASE_MEM_MB + 3 * chunk + rows * cols * SHADOW_TIME_BYTES_PER_PIXEL / 2**20)
+
+
+def get_shadow_time_chunk_runtime(wildcards, attempt):
+    """Minutes of shadow_time_chunk, from the pixel-frames it streams."""
+    start, stop = _part_range(wildcards)
+    work = (stop - start) * math.prod(frame_shape(wildcards.ds, wildcards.sweep))
+    return attempt * (5 + math.ceil(work * SHADOW_TIME_SECONDS_PER_PIXEL / 60))
+
+
+def first_sweep(ds):
+    """A sweep whose frame size is the dataset's: the time-lapse (outdoor) or u (lab)."""
+    return outdoor_sweep(ds) if is_outdoor(ds) else SCENE_SWEEPS[0]
+
+
+def get_image_mem_mb(wildcards, attempt):
+    """Memory of a per-dataset step on whole images (dual coordinates, dual view, accuracy,
+    figures, outdoor arrival/pushbroom): ~2 kB per camera pixel of image-sized maps."""
+    rows, cols = frame_shape(wildcards.ds, first_sweep(wildcards.ds))
+    return attempt * math.ceil(BASE_MEM_MB + rows * cols * 2000 / 2**20)
+
+
+def get_stream_mem_mb(wildcards, attempt):
+    """Memory of a step streaming a sweep (outdoor passes): image maps plus three read chunks."""
+    sweep = first_sweep(wildcards.ds)
+    chunk = decode_chunk_frames(wildcards.ds, sweep) * _frame_mb(wildcards.ds, sweep)
+    return get_image_mem_mb(wildcards, attempt) + attempt * math.ceil(3 * chunk)
+
+
+def get_stream_runtime(wildcards, attempt):
+    """Minutes of a step streaming a sweep once (outdoor passes), from its pixel-frames."""
+    sweep = first_sweep(wildcards.ds)
+    work = sweep_frame_count(wildcards.ds, sweep) * math.prod(frame_shape(wildcards.ds, sweep))
+    return attempt * (5 + math.ceil(work * SHADOW_TIME_SECONDS_PER_PIXEL / 60))
+
+
+def get_render_mem_mb(wildcards, attempt):
+    """Memory of render: the renderer holds one sweep's float32 RGB frames (plus scene maps)."""
+    frames = sweep_frame_count(wildcards.ds, SCENE_SWEEPS[0])
+    return attempt * math.ceil(get_image_mem_mb(wildcards, 1) + 3 * frames * _frame_mb(wildcards.ds, SCENE_SWEEPS[0]))

@@ -1,18 +1,44 @@
 # Stage: decode each sweep once into a time-chunked zarr frame store, and the
 # unshadowed reference frame (when the capture has one) into its own store.
+# A sweep is decoded in time parts, one job each (decode_part: frames START:STOP into
+# a part store); `decode` joins the parts by hard-linking their chunk files, so the
+# sweep store equals a single-job decode bit for bit. Part sizes: common.smk.
 
 # reference.zarr is a single image, not a sweep: decode_reference makes it.
 ruleorder: decode_reference > decode
 
 
-rule decode:
+rule decode_part:
     input:
-        get_raw_files,
+        get_part_files,
     output:
-        directory("results/{ds}/frames/{sweep}.zarr"),
+        temp(directory("results/{ds}/frames/{sweep}.parts/{part}.zarr")),
     params:
         manifest=get_capture_manifest,
-        chunk_frames=config["decode"]["chunk_frames"],
+        chunk_frames=get_chunk_frames,
+        frames=get_part_range,
+    resources:
+        mem_mb=get_decode_mem_mb,
+        runtime=get_decode_runtime,
+    log:
+        "logs/{ds}/decode_{sweep}_part{part}.log",
+    benchmark:
+        "benchmarks/{ds}/decode_{sweep}_part{part}.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    shell:
+        "shadowcam decode --manifest {params.manifest} --sweep {wildcards.sweep}"
+        " --chunk-frames {params.chunk_frames} --frames {params.frames} --out {output} > {log} 2>&1"
+
+
+rule decode:
+    input:
+        get_decode_parts,
+    output:
+        directory("results/{ds}/frames/{sweep}.zarr"),
+    resources:
+        mem_mb=1024,
+        runtime=10,
     log:
         "logs/{ds}/decode_{sweep}.log",
     benchmark:
@@ -20,8 +46,7 @@ rule decode:
     conda:
         "../envs/shadowcam.yaml"
     shell:
-        "shadowcam decode --manifest {params.manifest} --sweep {wildcards.sweep}"
-        " --chunk-frames {params.chunk_frames} --out {output} > {log} 2>&1"
+        "shadowcam merge-frames --parts {input} --out {output} > {log} 2>&1"
 
 
 rule decode_reference:
@@ -31,6 +56,9 @@ rule decode_reference:
         directory("results/{ds}/frames/reference.zarr"),
     params:
         manifest=get_capture_manifest,
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=10,
     log:
         "logs/{ds}/decode_reference.log",
     benchmark:

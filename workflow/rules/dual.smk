@@ -12,6 +12,9 @@ rule dual_coords:
         manifest=get_capture_manifest,
         model=get_dual_model,
         options=get_dual_coords_params,
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
     log:
         "logs/{ds}/dual_coords.log",
     benchmark:
@@ -36,6 +39,9 @@ rule dual_view:
         reference=get_reference_option,
         method=config["dual_view"]["method"],
         options=as_json(config["dual_view"]["params"]),
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
     log:
         "logs/{ds}/dual_view.log",
     benchmark:

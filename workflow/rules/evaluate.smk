@@ -16,6 +16,9 @@ rule evaluate:
         ),
     params:
         study=get_evaluate_params,
+    resources:
+        mem_mb=4096,
+        runtime=60,
     log:
         "logs/evaluate/evaluate.log",
     benchmark:

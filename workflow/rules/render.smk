@@ -7,6 +7,9 @@ rule render:
         "data_manifest/{ds}.yaml",
     output:
         directory("results/{ds}/capture"),
+    resources:
+        mem_mb=get_render_mem_mb,
+        runtime=30,
     log:
         "logs/{ds}/render.log",
     benchmark:

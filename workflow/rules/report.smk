@@ -22,6 +22,9 @@ rule report_figures:
         manifest=get_capture_manifest,
         reference=get_reference_option,
         accuracy=get_accuracy_option,
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
     log:
         "logs/{ds}/report_figures.log",
     benchmark:

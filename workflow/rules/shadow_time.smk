@@ -1,15 +1,46 @@
 # Stage: per-pixel shadow time of every sweep the dataset needs, in one dataset.
+# The dips are tracked per time chunk (shadow_time_chunk, one job per sweep and decode
+# part; DipTracker owning frames START:STOP, fed half a window more on each side), and
+# shadow_time merges the partials (bit for bit the single-pass result), then classifies
+# and times every pixel.
+
+
+rule shadow_time_chunk:
+    input:
+        frames="results/{ds}/frames/{sweep}.zarr",
+    output:
+        temp("results/{ds}/shadow_time/{sweep}.parts/{part}.npz"),
+    params:
+        owned=get_part_range,
+        options=as_json(config["shadow_time"]["params"]),
+    resources:
+        mem_mb=get_shadow_time_chunk_mem_mb,
+        runtime=get_shadow_time_chunk_runtime,
+    log:
+        "logs/{ds}/shadow_time_{sweep}_part{part}.log",
+    benchmark:
+        "benchmarks/{ds}/shadow_time_{sweep}_part{part}.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    shell:
+        "shadowcam shadow-time-chunk --frames {input.frames} --owned {params.owned}"
+        " --params {params.options:q} --out {output} > {log} 2>&1"
 
 
 rule shadow_time:
     input:
         frames=get_frames,
+        partials=get_partials,
     output:
         "results/{ds}/shadow_time.nc",
     params:
         sweeps=get_sweeps,
+        partials=get_partials_option,
         method=config["shadow_time"]["method"],
         options=as_json(config["shadow_time"]["params"]),
+    resources:
+        mem_mb=get_shadow_time_mem_mb,
+        runtime=15,
     log:
         "logs/{ds}/shadow_time.log",
     benchmark:
@@ -17,5 +48,5 @@ rule shadow_time:
     conda:
         "../envs/shadowcam.yaml"
     shell:
-        "shadowcam shadow-time --frames {input.frames} --sweeps {params.sweeps}"
+        "shadowcam shadow-time --frames {input.frames} --sweeps {params.sweeps} {params.partials}"
         " --method {params.method} --params {params.options:q} --out {output} > {log} 2>&1"

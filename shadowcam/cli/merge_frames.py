@@ -1,0 +1,40 @@
+"""``shadowcam merge-frames``: join the part stores of one sweep into its frame store.
+
+The parts come from ``shadowcam decode --frames START:STOP`` (one job each);
+their chunk files are hard-linked, not copied (``shadowcam.frame_store``), and
+the provenance lists the checksums of every part's input files, so the store
+equals a single-job decode of the whole sweep.
+
+Offers
+------
+add_parser : register the step and its options.
+run : merge the parts.
+"""
+
+import json
+
+import xarray as xr
+
+from shadowcam.frame_store import merge_frame_stores, open_frames
+from shadowcam.provenance import attach_provenance
+
+
+def add_parser(subparsers, name):
+    """Register ``merge-frames`` on `subparsers`; return its parser."""
+    parser = subparsers.add_parser(name, help="join part stores of a sweep into one frame store",
+                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser.add_argument("--parts", nargs="+", required=True, help="part stores in time order")
+    parser.add_argument("--out", required=True, help="output store, e.g. results/<ds>/frames/u.zarr")
+    return parser
+
+
+def run(args):
+    """Merge ``args.parts`` into ``args.out`` with the provenance of the whole sweep."""
+    checksums, first_attrs = {}, None
+    for path in args.parts:
+        attrs = open_frames(path).attrs
+        first_attrs = first_attrs or attrs
+        checksums.update(json.loads(attrs.get("input_checksums", "{}")))
+    provenance = attach_provenance(xr.Dataset(), config=json.loads(first_attrs.get("config", "{}")),
+                                   input_checksums=checksums, step=first_attrs.get("step", "decode")).attrs
+    merge_frame_stores(args.parts, args.out, attrs=provenance)
