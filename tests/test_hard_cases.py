@@ -83,8 +83,9 @@ def test_low_light_12bit_times_are_right_or_flagged(electrons, seed, method):
     check_invariants(result, 40)
     err = np.abs(result["shadow_time"] - centres)[np.isfinite(result["shadow_time"])]
     # a gross error (a noise dip taken for the shadow) only at about the designed
-    # false-alarm rate (1e-2 per pixel): <= 3 of 64 pixels
-    assert (err > 3.0).sum() <= 3
+    # false-alarm rate (1e-2 per pixel): 0.64 expected of 64 pixels (measured 0.5-1.0 per
+    # method over 100 seeds at 15 e-); a Poisson count of mean 1 reaches 7 with p < 1e-4
+    assert (err > 3.0).sum() <= 6
     if electrons >= 400:
         assert np.all(err < 1.0)
         assert (result["reason"] == OK).mean() > 0.9

@@ -406,7 +406,9 @@ def outdoor_runtime(stage):
 
 
 wildcard_constraints:
-    part=r"\d{4}",
+    # decode_part / shadow_time_chunk parts (0000, 0001, ...) and the outdoor
+    # first-pass time parts (START-STOP, STOP may be "end")
+    part=r"\d{4}|\d+-(?:\d+|end)",
 
 #: per-pixel seconds of decoding one frame (rawpy + demosaic + zstd write, ~3x the
 #: measured 24 MP lossless-JPEG DNG cost), used to size `runtime`
