@@ -12,7 +12,8 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 SNAKEMAKE := $(BIN)/snakemake
-DATASET ?= synthetic_lab
+# the embedded default: a rendered lab capture and a rendered sunset time-lapse (comma-separated)
+DATASET ?= synthetic_lab,synthetic_ridge
 
 OUTDOOR ?= dev_ridge
 BENCH_ARGS ?=
@@ -41,8 +42,8 @@ demo: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(SNAKEMAKE) --profile profiles/local --config datasets=[$(DATASET)]
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(SNAKEMAKE) --profile profiles/local --config datasets=[$(DATASET)] --report results/report.html
 	@echo
-	@echo "Results of $(DATASET):  $(CURDIR)/results/$(DATASET)/"
-	@echo "HTML report:           $(CURDIR)/results/report.html"
+	@for ds in $$(echo $(DATASET) | tr ',' ' '); do echo "Results of $$ds:  $(CURDIR)/results/$$ds/"; done
+	@echo "HTML report:  $(CURDIR)/results/report.html"
 
 test: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/pytest -q
