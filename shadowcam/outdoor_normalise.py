@@ -33,8 +33,8 @@ aligned_luminance : one frame's registered luminance from the pass's results.
 import numpy as np
 
 from shadowcam.photometric import estimate_gain, lit_at_start, luminance
-from shadowcam.registration import (apply_shift, block_all, block_mean, registration_factor,
-                                    shift_lucas_kanade_LucasKanade1981, static_weight)
+from shadowcam.registration import (apply_shift, block_all, block_mean, pyramid_levels, registration_factor,
+                                    shift_coarse_to_fine, static_weight)
 from shadowcam.sky_mask import auto_sky_mask
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
@@ -58,6 +58,11 @@ class SequenceNormaliser:
         (:func:`shadowcam.registration.block_mean`) to at most this many pixels
         on the longer side; the shift is scaled back and the per-pixel levels
         stay at full resolution. Frames this small or smaller are not reduced.
+    registration_levels : int, optional
+        Coarser levels (factor 2 each) of the coarse-to-fine registration on the
+        reduced frames (:func:`shadowcam.registration.shift_coarse_to_fine`): a
+        shake of up to about ``4 * 2**levels`` reduced pixels from the previous
+        frame's is recovered; fewer levels on small frames.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).
@@ -73,12 +78,14 @@ class SequenceNormaliser:
     """
 
     def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
-                 reference=None, first_index=0, record_from=0):
+                 registration_levels=2, reference=None, first_index=0, record_from=0):
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
         self._registration_size = int(registration_size)
         registration_factor((1, 1), max_size=self._registration_size)  # validates the option
+        self._registration_levels = int(registration_levels)
+        pyramid_levels((1, 1), levels=self._registration_levels)  # validates the option
         self._k, self.record_from = int(first_index), int(record_from)
         if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
             raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
@@ -140,7 +147,8 @@ class SequenceNormaliser:
             small = block_mean(raw, factor)
             rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
             weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid)
-            shift, _ = shift_lucas_kanade_LucasKanade1981(small, ref, weight=weight, initial=last_shift / factor)
+            shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
+                                            levels=self._registration_levels)
             shift = shift * factor
             luma = apply_shift(raw, shift)
             del raw, small

@@ -101,3 +101,17 @@ def test_parts_must_cover_the_frames_and_warm_up():
         normalise_part(iter(scene["frames"][3:8]), start=4, stop=8, reference=scene["frames"][0])
     with pytest.raises(ValueError, match="reference"):
         normalise_part(iter(scene["frames"][2:8]), start=4, stop=8)
+
+
+def test_large_shake_on_reduced_frames_is_recovered_coarse_to_fine():
+    reference = _texture()
+    reference[400:] *= 0.1  # a static shadow below row 400: the rest is lit
+    rgb = np.stack([reference, 0.9 * reference, 0.7 * reference], axis=-1)
+    shake = np.array([[0.0, 0.0], [8.4, -11.3], [-3.1, 2.7], [6.5, 9.2]])  # rows, cols; 14-18 px jumps
+    frames = [apply_shift(rgb, -s) for s in shake]  # content moves by +shake
+    options = dict(sky=np.zeros(reference.shape, bool), registration_size=320)  # factor 2
+    result = normalise_frames(iter(frames), registration_levels=2, **options)
+    # pixels of the full frames; ~0.03 reduced px on this texture (block means alias its finest scale)
+    np.testing.assert_allclose(result["shift"], shake, atol=0.1)
+    single = normalise_frames(iter(frames), registration_levels=0, **options)
+    assert np.abs(single["shift"] - shake).max() > 5  # one level: out of range
