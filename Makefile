@@ -77,7 +77,9 @@ bench-outdoor-size: $(STAMP)
 	done
 	$(BIN)/shadowcam bench-report --benchmarks $(BENCH_DIR)/benchmarks/bench$(BENCH_FRAMES) \
 	  --frames $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/frames/timelapse.zarr \
-	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 ))
+	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 )) \
+	  --photometry $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/outdoor/photometry.nc \
+	  --shake $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/timestamps.json
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint
