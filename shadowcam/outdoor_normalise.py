@@ -66,6 +66,13 @@ class SequenceNormaliser:
         reduced frames (:func:`shadowcam.registration.shift_coarse_to_fine`): a
         shake of up to about ``4 * 2**levels`` reduced pixels from the previous
         frame's is recovered; fewer levels on small frames.
+    registration_margin : int, optional
+        Pixels of the reduced frames left out around the moving shadow edge
+        (:func:`shadowcam.registration.static_weight` ``margin``): the band-pass
+        response of a moved edge reaches about twice its outer scale (6) beyond
+        the edge's own width, so a soft edge (penumbra, optics blur, upsampling)
+        needs 6 plus its width in reduced pixels, or the shift is biased
+        along the edge's motion.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).
@@ -81,13 +88,16 @@ class SequenceNormaliser:
     """
 
     def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
-                 registration_levels=2, reference=None, first_index=0, record_from=0):
+                 registration_levels=2, registration_margin=6, reference=None, first_index=0, record_from=0):
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
         self._registration_size = int(registration_size)
         registration_factor((1, 1), max_size=self._registration_size)  # validates the option
         self._registration_levels = int(registration_levels)
+        self._registration_margin = int(registration_margin)
+        if self._registration_margin < 1:
+            raise ValueError(f"registration_margin must be >= 1 pixel; got {registration_margin}")
         pyramid_levels((1, 1), levels=self._registration_levels)  # validates the option
         self._k, self.record_from = int(first_index), int(record_from)
         if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
@@ -149,7 +159,8 @@ class SequenceNormaliser:
             factor, ref = self.factor, self._small_reference
             small = block_mean(raw, factor)
             rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
-            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid)
+            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
+                                   margin=self._registration_margin)
             shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
                                             levels=self._registration_levels)
             shift = shift * factor

@@ -11,6 +11,8 @@
   the part datasets one at a time, gives :func:`merge_parts`'s result bit for bit.
 * A shake of 14-18 px between frames (7-9 px on the reduced frames, beyond one
   Lucas-Kanade level) is recovered coarse to fine.
+* A soft shadow edge (8 px ramp) biases the shift along its motion unless the mask margin
+  around it covers its width (6 + 8 px); a static camera then registers to 0.
 """
 
 import cv2
@@ -145,3 +147,17 @@ def test_merge_step_reads_the_part_datasets_and_equals_merge_parts(tmp_path):
     # a missing part is refused (exit status 2, the CLI's input error)
     assert main(["outdoor-merge-photometry", "--parts", paths[0], paths[2], "--out", str(tmp_path / "gap.nc")]) == 2
     assert not (tmp_path / "gap.nc").exists()
+
+
+def test_soft_shadow_edge_needs_a_margin_of_its_width():
+    # a scene upsampled 8x: the moving shadow edge is an 8 px ramp, the camera does not move
+    scene = make_timelapse(n_frames=8, seed=2, speed=1.0)
+    factor = 8
+    frames = [cv2.resize(f, (64 * factor, 64 * factor), interpolation=cv2.INTER_LINEAR) for f in scene["frames"]]
+    sky = np.repeat(np.repeat(scene["sky"], factor, axis=0), factor, axis=1)
+    sharp = normalise_frames(iter(frames), sky=sky)  # margin 6: for a sharp edge
+    soft = normalise_frames(iter(frames), sky=sky, registration_margin=6 + factor)
+    assert np.abs(sharp["shift"][:, 0]).max() > 0.1  # the edge's motion leaks into the shift (rows)
+    np.testing.assert_allclose(soft["shift"], 0, atol=0.01)  # pixels; the true shift is 0
+    with pytest.raises(ValueError, match="registration_margin"):
+        normalise_frames(iter(frames), registration_margin=0)

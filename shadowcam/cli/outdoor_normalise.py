@@ -36,7 +36,7 @@ def add_parser(subparsers, name):
     parser.add_argument("--frames", required=True, help="frame store of the time-lapse sweep")
     parser.add_argument("--params", default="{}",
                         help="JSON: sky_params (automatic sky mask options), registration_size, registration_levels, "
-                             "overlap (parts)")
+                             "registration_margin, overlap (parts)")
     parser.add_argument("--part", default=None, help="START:STOP: process only these frames (a time part)")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/outdoor/photometry.nc")
     return parser
@@ -69,7 +69,8 @@ def parse_part(text, n_frames):
 
 def run(args):
     """Run the first outdoor pass (or one time part of it) and write the dataset."""
-    params = parse_params(args.params, allowed={"sky_params", "registration_size", "registration_levels", "overlap"})
+    params = parse_params(args.params, allowed={"sky_params", "registration_size", "registration_levels",
+                                                "registration_margin", "overlap"})
     manifest = load_manifest(args.manifest)
     frames = open_frames(args.frames)
     shape = (frames.sizes["row"], frames.sizes["col"])
@@ -81,7 +82,8 @@ def run(args):
             exposure = None
     options = dict(sky=sky, exposure_gain=exposure, sky_params=params.get("sky_params"),
                    registration_size=params.get("registration_size", 1536),
-                   registration_levels=params.get("registration_levels", 2))
+                   registration_levels=params.get("registration_levels", 2),
+                   registration_margin=params.get("registration_margin", 6))
     config = {"manifest": manifest["name"], "sky_source": sky_source, **params}
     time_s = frames["time_s"].values
     if args.part is None:
