@@ -25,6 +25,9 @@ BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
 # frames per chunk of the decoded store: one 24 MP frame is 288 MB of float32 RGB, and the
 # streaming passes hold one chunk, so the default 16 would cost 4.6 GB per job
 BENCH_CHUNK ?= 1
+# the sample's shadow edge is a ramp as wide as its upsampling (6000 / 192 = 31 px, ~8 px at the
+# registration's factor 4): mask margin around it 6 + 8 reduced pixels (outdoor.normalise.registration_margin)
+BENCH_MARGIN ?= 14
 
 .PHONY: demo test lint install clean bench bench-outdoor bench-outdoor-size
 
@@ -68,7 +71,7 @@ bench: $(STAMP)
 bench-outdoor-size: $(STAMP)
 	rm -rf $(BENCH_DIR) && mkdir -p $(BENCH_DIR)/data_manifest
 	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
-	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART)}\n' > $(BENCH_DIR)/bench.yaml
+	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), normalise: {registration_margin: $(BENCH_MARGIN)}}\n' > $(BENCH_DIR)/bench.yaml
 	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
 	  $(BIN)/shadowcam outdoor-sample --source data_manifest/dev_ridge.yaml --size $(BENCH_SIZE) --frames $$n \
 	    --name bench$$n --outdir $(BENCH_DIR)/data/bench$$n --manifest-out $(BENCH_DIR)/data_manifest/bench$$n.yaml \
@@ -78,7 +81,9 @@ bench-outdoor-size: $(STAMP)
 	done
 	$(BIN)/shadowcam bench-report --benchmarks $(BENCH_DIR)/benchmarks/bench$(BENCH_FRAMES) \
 	  --frames $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/frames/timelapse.zarr \
-	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 ))
+	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 )) \
+	  --photometry $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/outdoor/photometry.nc \
+	  --shake $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/timestamps.json
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint

@@ -19,6 +19,7 @@ false_arrivals : arrivals where the GT has none, per GT class.
 edge_errors : tracked edge rows against the GT edge rows.
 map_to_truth_camera : a map in the first frame's coordinates resampled into the GT camera's.
 edges_to_truth_camera : per-column edge rows of the first frame's coordinates in the GT camera's.
+registration_errors : estimated shifts (relative to frame 0) against the recorded shake.
 """
 
 import numpy as np
@@ -263,3 +264,33 @@ def edges_to_truth_camera(edge_row, *, shift_row, shift_col):
         out = np.where(frac == 0, lo, np.where(frac == 1, hi, (1 - frac) * lo + frac * hi))
     out[:, (cols < 0) | (cols > width - 1)] = np.nan
     return out - shift_row
+
+
+def registration_errors(shift_row, shift_col, *, shake_dy, shake_dx):
+    """Error statistics of the estimated shifts against the recorded camera shake.
+
+    Parameters
+    ----------
+    shift_row, shift_col : (T,) ndarray
+        Estimated content shift of each frame relative to frame 0, pixels.
+    shake_dy, shake_dx : (T,) ndarray
+        Recorded shake (content moves by ``+dx`` cols, ``+dy`` rows) relative to
+        the unshaken camera; frame 0's is subtracted.
+
+    Returns
+    -------
+    dict
+        ``rms_row_px``, ``rms_col_px``, ``rms_px`` (both axes), ``max_abs_px``, and
+        ``true_max_px`` (largest true shake relative to frame 0, for scale).
+    """
+    arrays = [np.asarray(a, dtype=np.float64) for a in (shift_row, shift_col, shake_dy, shake_dx)]
+    if len({a.shape for a in arrays}) != 1 or arrays[0].ndim != 1:
+        raise ValueError(f"shift_row, shift_col, shake_dy and shake_dx must be (T,) of one length; got "
+                         f"{[a.shape for a in arrays]}")
+    true_row, true_col = arrays[2] - arrays[2][0], arrays[3] - arrays[3][0]
+    d_row, d_col = arrays[0] - true_row, arrays[1] - true_col
+    return {"rms_row_px": float(np.sqrt(np.mean(d_row**2))),
+            "rms_col_px": float(np.sqrt(np.mean(d_col**2))),
+            "rms_px": float(np.sqrt(np.mean(d_row**2 + d_col**2))),
+            "max_abs_px": float(np.max(np.abs(np.r_[d_row, d_col]))),
+            "true_max_px": float(np.max(np.hypot(true_row, true_col)))}

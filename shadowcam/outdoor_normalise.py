@@ -27,18 +27,21 @@ normalise_frames : run it over an iterable of frames (one job).
 normalise_part : run it over one time part (with warm-up frames before it).
 part_frames : the frames a time part reads.
 merge_parts : merge the parts' results (concatenation and per-pixel minimum).
+PartMerger : the same, one part at a time (memory independent of the number of parts).
 aligned_luminance : one frame's registered luminance from the pass's results.
 """
 
 import numpy as np
 
 from shadowcam.photometric import estimate_gain, lit_at_start, luminance
-from shadowcam.registration import (apply_shift, block_all, block_mean, registration_factor,
-                                    shift_lucas_kanade_LucasKanade1981, static_weight)
+from shadowcam.registration import (apply_shift, block_all, block_mean, pyramid_levels, registration_factor,
+                                    shift_coarse_to_fine, static_weight)
 from shadowcam.sky_mask import auto_sky_mask
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
+#: per-frame results of the pass, concatenated over time parts
+_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit")
 
 
 class SequenceNormaliser:
@@ -58,6 +61,18 @@ class SequenceNormaliser:
         (:func:`shadowcam.registration.block_mean`) to at most this many pixels
         on the longer side; the shift is scaled back and the per-pixel levels
         stay at full resolution. Frames this small or smaller are not reduced.
+    registration_levels : int, optional
+        Coarser levels (factor 2 each) of the coarse-to-fine registration on the
+        reduced frames (:func:`shadowcam.registration.shift_coarse_to_fine`): a
+        shake of up to about ``4 * 2**levels`` reduced pixels from the previous
+        frame's is recovered; fewer levels on small frames.
+    registration_margin : int, optional
+        Pixels of the reduced frames left out around the moving shadow edge
+        (:func:`shadowcam.registration.static_weight` ``margin``): the band-pass
+        response of a moved edge reaches about twice its outer scale (6) beyond
+        the edge's own width, so a soft edge (penumbra, optics blur, upsampling)
+        needs 6 plus its width in reduced pixels, or the shift is biased
+        along the edge's motion.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).
@@ -73,12 +88,17 @@ class SequenceNormaliser:
     """
 
     def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
-                 reference=None, first_index=0, record_from=0):
+                 registration_levels=2, registration_margin=6, reference=None, first_index=0, record_from=0):
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
         self._registration_size = int(registration_size)
         registration_factor((1, 1), max_size=self._registration_size)  # validates the option
+        self._registration_levels = int(registration_levels)
+        self._registration_margin = int(registration_margin)
+        if self._registration_margin < 1:
+            raise ValueError(f"registration_margin must be >= 1 pixel; got {registration_margin}")
+        pyramid_levels((1, 1), levels=self._registration_levels)  # validates the option
         self._k, self.record_from = int(first_index), int(record_from)
         if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
             raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
@@ -139,8 +159,10 @@ class SequenceNormaliser:
             factor, ref = self.factor, self._small_reference
             small = block_mean(raw, factor)
             rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
-            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid)
-            shift, _ = shift_lucas_kanade_LucasKanade1981(small, ref, weight=weight, initial=last_shift / factor)
+            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
+                                   margin=self._registration_margin)
+            shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
+                                            levels=self._registration_levels)
             shift = shift * factor
             luma = apply_shift(raw, shift)
             del raw, small
@@ -192,6 +214,62 @@ class SequenceNormaliser:
         return merge_parts([self.partial()])
 
 
+class PartMerger:
+    """Merge the time parts of the first pass one at a time (exactly: concatenation and minimum).
+
+    State: the per-frame curves, the running per-pixel minimum and frame 0's
+    arrays (a few ``(H, W)`` arrays), whatever the number of parts; a part can be
+    released once added.
+    """
+
+    def __init__(self):
+        self._curves = {key: [] for key in _CURVES}
+        self._shadow_min = self._sky = self._lit = self._reference = None
+        self._next = 0
+
+    def add(self, part):
+        """Add the next part (:meth:`SequenceNormaliser.partial`; parts in time order from frame 0)."""
+        if part["first_frame"] != self._next:
+            raise ValueError(f"parts must cover consecutive frames from 0; a part starts at frame "
+                             f"{part['first_frame']}, expected {self._next}")
+        self._next += len(part["gain_lit"])
+        for key in _CURVES:
+            self._curves[key].append(np.asarray(part[key]))
+        if self._shadow_min is None:
+            self._shadow_min = np.array(part["shadow_min"], dtype=np.float32)
+            self._sky, self._lit = np.asarray(part["sky"], dtype=bool), np.asarray(part["lit_at_start"], dtype=bool)
+        else:
+            np.minimum(self._shadow_min, part["shadow_min"], out=self._shadow_min)
+        if self._reference is None and part.get("reference") is not None:
+            self._reference = part["reference"]
+
+    def result(self):
+        """Return the merged result (a dict; see :func:`normalise_frames`)."""
+        if self._shadow_min is None:
+            raise ValueError("parts must hold at least one part")
+        if self._next < 3:
+            raise ValueError(f"an outdoor time-lapse needs at least 3 frames; got {self._next}")
+        if self._reference is None:
+            raise ValueError("no part holds the reference frame (frame 0)")
+        sky, lit, shadow_min = self._sky, self._lit, self._shadow_min
+        ref = luminance(self._reference)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            contrast = np.where(ref > 0, shadow_min / ref, np.inf)
+        shadowed = lit & (contrast < SHADOWED_CONTRAST)
+        ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
+        shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
+        lit_level = np.where(lit, ref, shadow_min / ratio)
+        return {
+            **{key: np.concatenate(values) for key, values in self._curves.items()},
+            "sky": sky,
+            "lit_at_start": lit,
+            "lit_level": lit_level.astype(np.float32),
+            "shadow_level": shadow_level.astype(np.float32),
+            "shadow_ratio": ratio,
+            "reference": self._reference,
+        }
+
+
 def merge_parts(parts):
     """Merge the results of time parts of the first pass (exactly: concatenation and minimum).
 
@@ -199,48 +277,18 @@ def merge_parts(parts):
     ----------
     parts : sequence of dict
         :meth:`SequenceNormaliser.partial` of consecutive parts covering frames
-        ``0 .. T-1`` (any order; ``reference`` is needed in one of them).
+        ``0 .. T-1`` (any order; ``reference`` is needed in one of them). To
+        hold one part at a time, feed :class:`PartMerger` instead.
 
     Returns
     -------
     dict
         As :func:`normalise_frames`.
     """
-    parts = sorted(parts, key=lambda part: part["first_frame"])
-    if not parts:
-        raise ValueError("parts must hold at least one part")
-    expected = 0
-    for part in parts:
-        if part["first_frame"] != expected:
-            raise ValueError(f"parts must cover consecutive frames from 0; a part starts at frame "
-                             f"{part['first_frame']}, expected {expected}")
-        expected += len(part["gain_lit"])
-    if expected < 3:
-        raise ValueError(f"an outdoor time-lapse needs at least 3 frames; got {expected}")
-    reference = next((part["reference"] for part in parts if part.get("reference") is not None), None)
-    if reference is None:
-        raise ValueError("no part holds the reference frame (frame 0)")
-    shadow_min = parts[0]["shadow_min"].copy()
-    for part in parts[1:]:
-        np.minimum(shadow_min, part["shadow_min"], out=shadow_min)
-    sky, lit = np.asarray(parts[0]["sky"], dtype=bool), np.asarray(parts[0]["lit_at_start"], dtype=bool)
-    ref = luminance(reference)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        contrast = np.where(ref > 0, shadow_min / ref, np.inf)
-    shadowed = lit & (contrast < SHADOWED_CONTRAST)
-    ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
-    shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
-    lit_level = np.where(lit, ref, shadow_min / ratio)
-    joined = {key: np.concatenate([part[key] for part in parts]) for key in ("shift", "gain_lit", "gain_sky", "kept_lit")}
-    return {
-        **joined,
-        "sky": sky,
-        "lit_at_start": lit,
-        "lit_level": lit_level.astype(np.float32),
-        "shadow_level": shadow_level.astype(np.float32),
-        "shadow_ratio": ratio,
-        "reference": reference,
-    }
+    merger = PartMerger()
+    for part in sorted(parts, key=lambda part: part["first_frame"]):
+        merger.add(part)
+    return merger.result()
 
 
 def normalise_frames(frames, **options):

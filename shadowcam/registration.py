@@ -1,8 +1,8 @@
 """Sub-pixel registration of time-lapse frames to a reference frame.
 
-Camera shake in a time-lapse is a small translation (about a pixel). The
-shift is estimated by Lucas-Kanade (Gauss-Newton) on band-passed log
-luminance, which removes exposure and slow shading changes; pixels whose
+Camera shake in a time-lapse is a small translation (about a pixel; a few
+pixels at tens of megapixels). The shift is estimated by Lucas-Kanade
+(Gauss-Newton) on band-passed log luminance, which removes exposure and slow shading changes; pixels whose
 illumination state changed since the reference (the moving shadow: a large
 log-ratio step) are left out, because a moving shadow edge would otherwise be
 taken for camera motion (phase correlation fails on this: the shadow edge is
@@ -13,12 +13,21 @@ satisfies ``frame(r, c) = reference(r - shift_row, c - shift_col)``;
 :func:`apply_shift` samples the frame at ``(r + shift_row, c + shift_col)``
 to align it with the reference.
 
+Range: one Lucas-Kanade level converges from a start within a few pixels of
+the band-pass scale and rejects a solution more than ``max_shift`` (5) pixels
+from its start. :func:`shift_coarse_to_fine` first solves on ``2**levels``-times
+reduced images (block means) and refines level by level, so the range grows
+to about ``4 * 2**levels`` pixels (measured on a multi-scale texture: one level
+recovers 4 px, not 6; two coarser levels 16 px, not 24).
+
 Offers
 ------
 REGISTRATION_METHODS : method name -> estimator.
 bandpass_log : band-passed log luminance used for matching.
 static_weight : weight mask of pixels whose illumination state did not change.
 shift_lucas_kanade_LucasKanade1981 : translation by iterative least squares.
+shift_coarse_to_fine : the same on a pyramid of block means, coarse levels first (large shifts).
+pyramid_levels : number of coarser levels an image of a given shape supports.
 apply_shift : resample an image so that it aligns with the reference.
 registration_factor : integer downsampling factor that brings a frame to a working size.
 block_mean : mean over factor x factor blocks (area downsampling; a shift scales by 1/factor).
@@ -253,5 +262,127 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     return shift, residual
 
 
+def pyramid_levels(shape, *, levels, min_size=64):
+    """Number of coarser levels (factor 2 each) of :func:`shift_coarse_to_fine` for `shape`.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)`` of the images.
+    levels : int
+        Coarser levels wanted (>= 0).
+    min_size : int, optional
+        A level is used only if its shorter side keeps at least this many pixels
+        (enough texture outside the masked shadow edge and border).
+
+    Returns
+    -------
+    int
+        ``0 .. levels``.
+    """
+    if int(levels) < 0:
+        raise ValueError(f"levels (registration_levels) must be >= 0; got {levels}")
+    shorter = min(int(s) for s in shape[:2])
+    used = 0
+    while used < int(levels) and shorter // 2 ** (used + 1) >= int(min_size):
+        used += 1
+    return used
+
+
+def _border(shift):
+    """Border, pixels, where an image resampled at `shift` replicates its edge (plus 4)."""
+    return int(np.ceil(np.max(np.abs(shift)))) + 4
+
+
+def _border_weight(weight, border):
+    """`weight` with a border of `border` pixels set to zero (a copy)."""
+    weight = np.array(weight, dtype=np.float32)
+    weight[:border], weight[weight.shape[0] - border:] = 0, 0
+    weight[:, :border], weight[:, weight.shape[1] - border:] = 0, 0
+    return weight
+
+
+def shift_coarse_to_fine(luma, reference_luma, *, weight=None, initial=(0.0, 0.0), levels=2, min_size=64,
+                         agree=0.5, **options):
+    """Estimate a translation that may be large, coarse levels first.
+
+    Each coarser level halves the images (:func:`block_mean`; the weight is kept
+    where the whole 2 x 2 block is weighted, :func:`block_all`). Lucas-Kanade
+    runs on the coarsest level from ``initial / 2**levels``; its result, doubled,
+    starts the next coarser-but-one level, and so on (a level whose estimate
+    fails passes its own start on). On the full images Lucas-Kanade runs from
+    `initial` and, if the coarse levels ended more than `agree` pixels away,
+    also from their estimate; that second solution is kept only if it is
+    another one (more than `agree` pixels away) with a lower residual
+    (a coarse level with few usable pixels, e.g. when the shadow covers most
+    of a small frame, can drift, and must not override a good start). Pixels
+    within ``ceil(|start|) + 4`` of the border are left out at every level (the
+    resampled frame replicates its edge there).
+
+    Parameters
+    ----------
+    luma, reference_luma : (H, W) ndarray
+    weight : (H, W) ndarray, optional
+        Per-pixel weights (e.g. :func:`static_weight`); default: all pixels.
+    initial : (2,) array_like, optional
+        Starting ``(shift_row, shift_col)`` in pixels of the full images.
+    levels : int, optional
+        Coarser levels (0: plain :func:`shift_lucas_kanade_LucasKanade1981`);
+        fewer where an image would become smaller than `min_size`
+        (:func:`pyramid_levels`).
+    min_size : int, optional
+        Shorter side, pixels, of the coarsest level.
+    agree : float, optional
+        Pixels (full images): a coarse estimate this close to `initial` is
+        within reach of the search from `initial`, which is then the only one;
+        solutions this close are the same.
+    **options
+        Keyword options of :func:`shift_lucas_kanade_LucasKanade1981` (``max_iter``,
+        ``tol``, ``min_weight``, ``max_shift``), used at every level.
+
+    Returns
+    -------
+    shift : (2,) float64 ndarray
+        ``(shift_row, shift_col)`` in pixels of the full images; `initial`
+        when every search on the full images failed.
+    residual : float
+        Of the full images (see :func:`shift_lucas_kanade_LucasKanade1981`); NaN on failure.
+    """
+    luma = np.asarray(luma, dtype=np.float32)
+    ref = np.asarray(reference_luma, dtype=np.float32)
+    if luma.ndim != 2 or luma.shape != ref.shape:
+        raise ValueError(f"luma {luma.shape} and reference_luma {ref.shape} must be the same (H, W) shape")
+    if weight is None:
+        weight = np.ones(luma.shape, dtype=np.float32)
+    weight = np.asarray(weight, dtype=np.float32)
+    if weight.shape != luma.shape:
+        raise ValueError(f"weight {weight.shape} must match luma {luma.shape}")
+    n_levels = pyramid_levels(luma.shape, levels=levels, min_size=min_size)
+    start = np.asarray(initial, dtype=np.float64).copy()
+    coarse = start
+    if n_levels:
+        frame, reference, mask = luma, ref, weight
+        pyramid = []
+        for _ in range(n_levels):
+            frame, reference = block_mean(frame, 2), block_mean(reference, 2)
+            mask = block_all(mask > 0, 2).astype(np.float32)
+            pyramid.append((frame, reference, mask))
+        coarse = start / 2 ** n_levels
+        for frame, reference, mask in pyramid[::-1]:
+            coarse, _ = shift_lucas_kanade_LucasKanade1981(frame, reference, weight=_border_weight(mask, _border(coarse)),
+                                                           initial=coarse, **options)
+            coarse = coarse * 2
+    shift, residual = shift_lucas_kanade_LucasKanade1981(luma, ref, weight=_border_weight(weight, _border(start)),
+                                                         initial=start, **options)
+    if np.max(np.abs(coarse - start)) > agree:
+        guided, guided_residual = shift_lucas_kanade_LucasKanade1981(
+            luma, ref, weight=_border_weight(weight, _border(coarse)), initial=coarse, **options)
+        # the guided search counts only if it found another solution, and a better one
+        other = not np.isfinite(residual) or np.max(np.abs(guided - shift)) > agree
+        if np.isfinite(guided_residual) and other and not guided_residual >= residual:
+            shift, residual = guided, guided_residual
+    return shift, residual
+
+
 #: method name -> estimator(luma, reference_luma, **options) -> (shift, residual)
-REGISTRATION_METHODS = {"lucas_kanade": shift_lucas_kanade_LucasKanade1981}
+REGISTRATION_METHODS = {"lucas_kanade": shift_lucas_kanade_LucasKanade1981, "coarse_to_fine": shift_coarse_to_fine}

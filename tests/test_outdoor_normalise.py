@@ -7,14 +7,23 @@
   single job within the registration's stopping tolerance (1e-3 px): the searches of a part
   start from the exposure metadata and zero shift instead of the previous frame's values
   and converge to the same solution within that tolerance; a part that starts at frame 0
-  is the single job, bit for bit.
+  is the single job, bit for bit. The merge step (``outdoor-merge-photometry``), reading
+  the part datasets one at a time, gives :func:`merge_parts`'s result bit for bit.
+* A shake of 14-18 px between frames (7-9 px on the reduced frames, beyond one
+  Lucas-Kanade level) is recovered coarse to fine.
+* A soft shadow edge (8 px ramp) biases the shift along its motion unless the mask margin
+  around it covers its width (6 + 8 px); a static camera then registers to 0.
 """
 
 import cv2
 import numpy as np
 import pytest
+import xarray as xr
 
 from outdoor_scene import make_timelapse
+from shadowcam.cli import main
+from shadowcam.image_io import write_netcdf
+from shadowcam.outdoor_datasets import photometry_part_dataset
 from shadowcam.outdoor_normalise import merge_parts, normalise_frames, normalise_part, part_frames
 from shadowcam.registration import (apply_shift, block_all, block_mean, registration_factor,
                                     shift_lucas_kanade_LucasKanade1981)
@@ -101,3 +110,54 @@ def test_parts_must_cover_the_frames_and_warm_up():
         normalise_part(iter(scene["frames"][3:8]), start=4, stop=8, reference=scene["frames"][0])
     with pytest.raises(ValueError, match="reference"):
         normalise_part(iter(scene["frames"][2:8]), start=4, stop=8)
+
+
+def test_large_shake_on_reduced_frames_is_recovered_coarse_to_fine():
+    reference = _texture()
+    reference[400:] *= 0.1  # a static shadow below row 400: the rest is lit
+    rgb = np.stack([reference, 0.9 * reference, 0.7 * reference], axis=-1)
+    shake = np.array([[0.0, 0.0], [8.4, -11.3], [-3.1, 2.7], [6.5, 9.2]])  # rows, cols; 14-18 px jumps
+    frames = [apply_shift(rgb, -s) for s in shake]  # content moves by +shake
+    options = dict(sky=np.zeros(reference.shape, bool), registration_size=320)  # factor 2
+    result = normalise_frames(iter(frames), registration_levels=2, **options)
+    # pixels of the full frames; ~0.03 reduced px on this texture (block means alias its finest scale)
+    np.testing.assert_allclose(result["shift"], shake, atol=0.1)
+    single = normalise_frames(iter(frames), registration_levels=0, **options)
+    assert np.abs(single["shift"] - shake).max() > 5  # one level: out of range
+
+
+def test_merge_step_reads_the_part_datasets_and_equals_merge_parts(tmp_path):
+    scene = make_timelapse(seed=5, n_frames=14, **NUISANCES)
+    frames, time_s = scene["frames"], scene["time_s"]
+    parts = _parts(frames, 5)
+    paths = []
+    for part in parts[::-1]:  # any order on the command line
+        first, count = part["first_frame"], len(part["gain_lit"])
+        path = tmp_path / f"{first}.nc"
+        write_netcdf(photometry_part_dataset(part, time_s[first:first + count]), path)
+        paths.append(str(path))
+    main(["outdoor-merge-photometry", "--parts", *paths, "--out", str(tmp_path / "photometry.nc")])
+    expected = merge_parts(parts)
+    with xr.open_dataset(tmp_path / "photometry.nc", engine="h5netcdf") as merged:
+        np.testing.assert_array_equal(merged["shift_row"].values, expected["shift"][:, 0])
+        np.testing.assert_array_equal(merged["gain"].values, expected["gain_lit"])
+        np.testing.assert_array_equal(merged["time_s"].values, time_s)
+        np.testing.assert_array_equal(merged["shadow_level"].values, expected["shadow_level"])
+        np.testing.assert_array_equal(merged["lit_level"].values, expected["lit_level"])
+    # a missing part is refused (exit status 2, the CLI's input error)
+    assert main(["outdoor-merge-photometry", "--parts", paths[0], paths[2], "--out", str(tmp_path / "gap.nc")]) == 2
+    assert not (tmp_path / "gap.nc").exists()
+
+
+def test_soft_shadow_edge_needs_a_margin_of_its_width():
+    # a scene upsampled 8x: the moving shadow edge is an 8 px ramp, the camera does not move
+    scene = make_timelapse(n_frames=8, seed=2, speed=1.0)
+    factor = 8
+    frames = [cv2.resize(f, (64 * factor, 64 * factor), interpolation=cv2.INTER_LINEAR) for f in scene["frames"]]
+    sky = np.repeat(np.repeat(scene["sky"], factor, axis=0), factor, axis=1)
+    sharp = normalise_frames(iter(frames), sky=sky)  # margin 6: for a sharp edge
+    soft = normalise_frames(iter(frames), sky=sky, registration_margin=6 + factor)
+    assert np.abs(sharp["shift"][:, 0]).max() > 0.1  # the edge's motion leaks into the shift (rows)
+    np.testing.assert_allclose(soft["shift"], 0, atol=0.01)  # pixels; the true shift is 0
+    with pytest.raises(ValueError, match="registration_margin"):
+        normalise_frames(iter(frames), registration_margin=0)

@@ -8,7 +8,9 @@ cores: every stage is taken as linear in the number of frames (fixed costs inclu
 in the per-frame rate, so an overestimate for short runs), stages run as several
 jobs divide by the cores, and memory is the peak per job (it does not grow with the
 number of frames: compare two runs with ``--compare``) times the jobs that run at
-once. Disk: the decoded frame store per frame.
+once. Disk: the decoded frame store per frame. With ``--photometry`` and ``--shake``
+(a sample's sidecar, ``shadowcam outdoor-sample``) it also prints the registration
+error at that size against the applied shake.
 
 Offers
 ------
@@ -18,10 +20,13 @@ run : print the table.
 """
 
 import csv
+import json
 import re
 from pathlib import Path
 
+from shadowcam.cli.outdoor_io import open_dataset
 from shadowcam.frame_store import open_frames
+from shadowcam.outdoor_accuracy import registration_errors
 
 
 def add_parser(subparsers, name):
@@ -34,6 +39,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--compare-frames", type=int, default=None, help="number of frames of the --compare run")
     parser.add_argument("--extrapolate", type=int, default=1000, help="frames to extrapolate to")
     parser.add_argument("--cores", type=int, default=2, help="cores (jobs side by side) of the target machine")
+    parser.add_argument("--photometry", default=None, help="the run's results/<ds>/outdoor/photometry.nc (estimated shifts)")
+    parser.add_argument("--shake", default=None, help="sidecar JSON with the applied shake_dx_px, shake_dy_px")
     return parser
 
 
@@ -93,3 +100,11 @@ def run(args):
           f"(parted stages {args.cores} jobs side by side, the others one job), peak memory "
           f"{peak_parallel / 1024:.1f} GB (largest job x jobs side by side), decoded store "
           f"{store * args.extrapolate / 1e9:.0f} GB ({store / 1e6:.0f} MB/frame)")
+    if args.photometry and args.shake:
+        photometry = open_dataset(args.photometry)
+        shake = json.loads(Path(args.shake).read_text())
+        errors = registration_errors(photometry["shift_row"].values, photometry["shift_col"].values,
+                                     shake_dy=shake["shake_dy_px"], shake_dx=shake["shake_dx_px"])
+        print(f"registration at {frames.sizes['col']}x{frames.sizes['row']} against the applied shake "
+              f"(up to {errors['true_max_px']:.2f} px from frame 0): rms {errors['rms_px']:.3f} px "
+              f"(rows {errors['rms_row_px']:.3f}, cols {errors['rms_col_px']:.3f}), max {errors['max_abs_px']:.3f} px")

@@ -27,7 +27,7 @@ from shadowcam.image_io import atomic_path
 from shadowcam.manifest import load_manifest
 from shadowcam.outdoor_accuracy import (
     NaiveBaseline, TARGETS, edge_errors, edges_to_truth_camera, evaluate_arrivals, false_arrivals,
-    map_to_truth_camera,
+    map_to_truth_camera, registration_errors,
 )
 
 log = logging.getLogger(__name__)
@@ -101,11 +101,9 @@ def run(args):
                                "median_rel_error": float(np.median(rel)) if rel.size else float("nan"),
                                "p95_rel_error": float(np.percentile(rel, 95)) if rel.size else float("nan")}
     if "shake_dy_px" in truth and truth["shake_dy_px"].size == time_s.size:
-        d_row = photometry["shift_row"].values - (truth["shake_dy_px"].values - truth["shake_dy_px"].values[0])
-        d_col = photometry["shift_col"].values - (truth["shake_dx_px"].values - truth["shake_dx_px"].values[0])
-        report["registration"] = {"rms_row_px": float(np.sqrt(np.mean(d_row**2))),
-                                  "rms_col_px": float(np.sqrt(np.mean(d_col**2))),
-                                  "max_abs_px": float(np.max(np.abs(np.r_[d_row, d_col])))}
+        report["registration"] = registration_errors(photometry["shift_row"].values, photometry["shift_col"].values,
+                                                     shake_dy=truth["shake_dy_px"].values,
+                                                     shake_dx=truth["shake_dx_px"].values)
     report["dataset"] = manifest["name"]
     with atomic_path(args.out_json) as tmp:
         tmp.write_text(report_to_json(report))

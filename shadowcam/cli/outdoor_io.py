@@ -6,6 +6,7 @@ iter_frames : the frames of a frame store one at a time, read chunk by chunk.
 input_checksums : merged ``input_checksums`` provenance of input datasets.
 write_dataset : attach provenance and write a dataset as netCDF, atomically.
 open_dataset : open a netCDF dataset written by a previous step (loaded).
+read_attrs : its global attributes only (data not loaded).
 """
 
 import json
@@ -48,10 +49,20 @@ def write_dataset(dataset, path, *, config, checksums, step):
     return dataset
 
 
-def open_dataset(path):
-    """Open and load a netCDF dataset of a previous step; ValueError if missing."""
+def _existing(path):
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"input dataset {path} does not exist; run the step that makes it first")
-    with xr.open_dataset(path, engine="h5netcdf") as source:
+    return path
+
+
+def read_attrs(path):
+    """Return the global attributes (dict) of a netCDF dataset of a previous step, data not loaded."""
+    with xr.open_dataset(_existing(path), engine="h5netcdf") as source:
+        return dict(source.attrs)
+
+
+def open_dataset(path):
+    """Open and load a netCDF dataset of a previous step; ValueError if missing."""
+    with xr.open_dataset(_existing(path), engine="h5netcdf") as source:
         return source.load()

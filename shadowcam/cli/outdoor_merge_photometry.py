@@ -2,8 +2,10 @@
 
 Reads the part datasets written by ``shadowcam outdoor-normalise --part``,
 concatenates the per-frame shifts and gains and takes the per-pixel minimum
-(:func:`shadowcam.outdoor_normalise.merge_parts`), then derives the lit and
-shadow levels as the single job does. Writes ``results/<ds>/outdoor/photometry.nc``.
+(:class:`shadowcam.outdoor_normalise.PartMerger`), then derives the lit and
+shadow levels as the single job does. Parts are read one at a time (ordered by
+their ``first_frame`` attribute, read without loading the data), so memory does
+not grow with their number. Writes ``results/<ds>/outdoor/photometry.nc``.
 
 Offers
 ------
@@ -13,9 +15,9 @@ run : merge and write the photometry dataset.
 
 import numpy as np
 
-from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
+from shadowcam.cli.outdoor_io import input_checksums, open_dataset, read_attrs, write_dataset
 from shadowcam.outdoor_datasets import photometry_dataset, photometry_part_arrays
-from shadowcam.outdoor_normalise import merge_parts
+from shadowcam.outdoor_normalise import PartMerger
 
 
 def add_parser(subparsers, name):
@@ -29,14 +31,20 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Merge the parts and write the photometry dataset."""
-    parts = sorted((open_dataset(path) for path in args.parts), key=lambda ds: int(ds.attrs["first_frame"]))
-    merged = merge_parts([photometry_part_arrays(ds) for ds in parts])
-    time_s = np.concatenate([ds["time_s"].values for ds in parts])
-    exposure = np.concatenate([ds["exposure_gain"].values for ds in parts])
-    sky_source = parts[0].attrs["sky_source"]
-    dataset = photometry_dataset(merged, time_s, exposure_gain=None if np.isnan(exposure).all() else exposure,
-                                 sky_source=sky_source)
-    config = {"parts": [[int(ds.attrs["first_frame"]), int(ds.attrs["first_frame"]) + ds.sizes["time"]]
-                        for ds in parts]}
-    write_dataset(dataset, args.out, config=config, checksums=input_checksums(*parts),
-                  step="outdoor-merge-photometry")
+    paths = sorted(args.parts, key=lambda path: int(read_attrs(path)["first_frame"]))
+    merger = PartMerger()
+    time_s, exposure, ranges, checksums, sky_source = [], [], [], {}, None
+    for path in paths:
+        part = open_dataset(path)
+        merger.add(photometry_part_arrays(part))
+        time_s.append(part["time_s"].values)
+        exposure.append(part["exposure_gain"].values)
+        first = int(part.attrs["first_frame"])
+        ranges.append([first, first + part.sizes["time"]])
+        checksums.update(input_checksums(part))
+        sky_source = sky_source or part.attrs["sky_source"]
+        del part
+    time_s, exposure = np.concatenate(time_s), np.concatenate(exposure)
+    dataset = photometry_dataset(merger.result(), time_s,
+                                 exposure_gain=None if np.isnan(exposure).all() else exposure, sky_source=sky_source)
+    write_dataset(dataset, args.out, config={"parts": ranges}, checksums=checksums, step="outdoor-merge-photometry")

@@ -35,7 +35,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--manifest", required=True, help="capture description (sky_mask, exposure keys)")
     parser.add_argument("--frames", required=True, help="frame store of the time-lapse sweep")
     parser.add_argument("--params", default="{}",
-                        help="JSON: sky_params (automatic sky mask options), registration_size, overlap (parts)")
+                        help="JSON: sky_params (automatic sky mask options), registration_size, registration_levels, "
+                             "registration_margin, overlap (parts)")
     parser.add_argument("--part", default=None, help="START:STOP: process only these frames (a time part)")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/outdoor/photometry.nc")
     return parser
@@ -68,7 +69,8 @@ def parse_part(text, n_frames):
 
 def run(args):
     """Run the first outdoor pass (or one time part of it) and write the dataset."""
-    params = parse_params(args.params, allowed={"sky_params", "registration_size", "overlap"})
+    params = parse_params(args.params, allowed={"sky_params", "registration_size", "registration_levels",
+                                                "registration_margin", "overlap"})
     manifest = load_manifest(args.manifest)
     frames = open_frames(args.frames)
     shape = (frames.sizes["row"], frames.sizes["col"])
@@ -79,7 +81,9 @@ def run(args):
         if not np.isfinite(exposure).any():
             exposure = None
     options = dict(sky=sky, exposure_gain=exposure, sky_params=params.get("sky_params"),
-                   registration_size=params.get("registration_size", 1536))
+                   registration_size=params.get("registration_size", 1536),
+                   registration_levels=params.get("registration_levels", 2),
+                   registration_margin=params.get("registration_margin", 6))
     config = {"manifest": manifest["name"], "sky_source": sky_source, **params}
     time_s = frames["time_s"].values
     if args.part is None:

@@ -1,10 +1,15 @@
 """``shadowcam outdoor-sample``: a real-size RAW time-lapse sample and its manifest.
 
-Upsamples consecutive frames of a small outdoor capture (e.g. dev_ridge) to a
-camera's size, adds full-resolution sensor noise and writes 14-bit RGGB DNGs
-(:mod:`shadowcam.outdoor_sample`, :mod:`shadowcam.raw_writer`), a timestamps
-sidecar and a checksummed ``kind: outdoor`` manifest, for the throughput and
-memory benchmark (``make bench-outdoor-size``). No ground truth at that size.
+Steadies consecutive frames of a small outdoor capture (e.g. dev_ridge; its
+recorded shake from the ground truth undone), upsamples them to a camera's
+size, shakes them by a seeded realistic amount (``--shake-px``, sub-pixel to
+2 px), adds full-resolution sensor noise and writes 14-bit RGGB DNGs
+(:mod:`shadowcam.outdoor_sample`, :mod:`shadowcam.raw_writer`), a sidecar with
+the frame times and the applied shake (``timestamps.json``: ``times_s``,
+``shake_dx_px``, ``shake_dy_px``) and a checksummed ``kind: outdoor`` manifest,
+for the throughput and memory benchmark (``make bench-outdoor-size``), which
+also measures the registration against the recorded shake. No arrival-time
+ground truth at that size.
 
 Offers
 ------
@@ -21,8 +26,9 @@ import numpy as np
 import yaml
 
 from shadowcam.decode import read_frame
+from shadowcam.ground_truth import load_ground_truth
 from shadowcam.manifest import checksums_for, load_manifest
-from shadowcam.outdoor_sample import parse_size, sample_mosaic, upsample_frame
+from shadowcam.outdoor_sample import parse_size, sample_mosaic, sample_shake, steady_frame, upsample_frame
 from shadowcam.raw_writer import write_dng
 from shadowcam.sensor import SensorModel, exposure_scale
 
@@ -38,7 +44,9 @@ def add_parser(subparsers, name):
     parser.add_argument("--frames", type=int, default=16, help="number of frames")
     parser.add_argument("--first", type=int, default=40, help="first source frame used")
     parser.add_argument("--bit-depth", type=int, default=14, help="sensor bit depth")
-    parser.add_argument("--seed", type=int, default=0, help="noise seed")
+    parser.add_argument("--seed", type=int, default=0, help="noise and shake seed")
+    parser.add_argument("--shake-px", type=float, default=2.0,
+                        help="largest camera shake of the sample, pixels (0: none; default 2)")
     parser.add_argument("--name", required=True, help="dataset name")
     parser.add_argument("--outdir", required=True, help="directory of the frames (root of the new dataset)")
     parser.add_argument("--manifest-out", required=True, help="manifest to write, e.g. <workdir>/data_manifest/<name>.yaml")
@@ -58,27 +66,37 @@ def run(args):
                          "take at least 3 inside it")
     times = np.asarray(sweep["times_s"][args.first:stop], dtype=np.float64)
     times -= times[0]
+    source_dx, source_dy = _source_shake(source, args.first, stop)
+    shake_dx, shake_dy = sample_shake(args.frames, seed=args.seed, max_px=args.shake_px)
     sensor = SensorModel(bit_depth=args.bit_depth, black_level=512, gain=1.0, read_noise=3.0)
-    first = read_frame(sweep["paths"][args.first])
-    scale = exposure_scale(upsample_frame(first, rows=rows, cols=cols), sensor=sensor, target_fraction=0.7)
+
+    def steady(k):
+        return steady_frame(read_frame(sweep["paths"][args.first + k]), dx=source_dx[k], dy=source_dy[k])
+
+    scale = exposure_scale(upsample_frame(steady(0), rows=rows, cols=cols), sensor=sensor, target_fraction=0.7)
     outdir = Path(args.outdir)
     (outdir / "frames").mkdir(parents=True, exist_ok=True)
     start_time = datetime.datetime(2026, 1, 15, 16, 0, 0)
     names = []
-    for k, path in enumerate(sweep["paths"][args.first:stop]):
-        raw = sample_mosaic(read_frame(path), rows=rows, cols=cols, sensor=sensor, scale=scale, seed=[args.seed, k])
+    for k in range(args.frames):
+        raw = sample_mosaic(steady(k), rows=rows, cols=cols, sensor=sensor, scale=scale, seed=[args.seed, k],
+                            shake=(shake_dx[k], shake_dy[k]))
         name = f"frames/{k:06d}.dng"
         write_dng(outdir / name, raw, bit_depth=sensor.bit_depth, black_level=sensor.black_level,
                   capture_time=start_time + datetime.timedelta(seconds=float(times[k])))
         names.append(name)
-        log.info("wrote %s (%d/%d)", name, k + 1, args.frames)
-    (outdir / "timestamps.json").write_text(json.dumps({"units": "s", "times_s": times.tolist(), "files": names}))
+        log.info("wrote %s (%d/%d), shake dx %+.3f dy %+.3f px", name, k + 1, args.frames, shake_dx[k], shake_dy[k])
+    sidecar = {"units": "s", "times_s": times.tolist(), "files": names,
+               "shake_dx_px": shake_dx.tolist(), "shake_dy_px": shake_dy.tolist(),
+               "shake_convention": "frame(u, v) = image(u - dx, v - dy): content moves by +dx (cols), +dy (rows)"}
+    (outdir / "timestamps.json").write_text(json.dumps(sidecar))
     manifest = {
         "name": args.name,
         "kind": "outdoor",
         "description": f"{args.frames} frames of {source['name']} (from frame {args.first}) upsampled to "
-                       f"{cols}x{rows}, {args.bit_depth}-bit RGGB DNG with full-resolution sensor noise "
-                       "(benchmark sample, no ground truth)",
+                       f"{cols}x{rows}, {args.bit_depth}-bit RGGB DNG with full-resolution sensor noise, "
+                       f"source shake undone, camera shake <= {args.shake_px:g} px applied (timestamps.json: "
+                       "shake_dx_px, shake_dy_px) (benchmark sample, no arrival-time ground truth)",
         "light": "distant",
         "root": str(outdir.resolve()),
         "sweeps": {"timelapse": {"files": "frames/*.dng"}},
@@ -92,3 +110,13 @@ def run(args):
     manifest["checksums"] = checksums_for(out)
     out.write_text(yaml.safe_dump(manifest, sort_keys=False))
     print(out)
+
+
+def _source_shake(source, first, stop):
+    """Recorded shake ``(dx, dy)`` of the source frames ``first .. stop - 1`` (zeros if unknown)."""
+    if "ground_truth" in source:
+        truth = load_ground_truth(source)
+        if "shake_dx_px" in truth:
+            return truth["shake_dx_px"].values[first:stop], truth["shake_dy_px"].values[first:stop]
+    log.warning("source %s records no shake: its shake (if any) is upsampled with the frames", source["name"])
+    return np.zeros(stop - first), np.zeros(stop - first)
