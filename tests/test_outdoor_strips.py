@@ -97,3 +97,29 @@ def test_strips_of_dev_ridge_equal_the_single_job():
     assert np.isfinite(single["edge_row"]).sum() > 20000
     for n_strips in (2, 3):
         _assert_identical(merge_strips(_strips(frames, photometry, time_s, n_strips, guard=0)), single)
+
+
+@pytest.mark.skipif(not DATA.is_dir(), reason="shared dev data not present")
+def test_workflow_strips_give_the_same_edges_nc_as_one_job(tmp_path):
+    import xarray as xr
+    import yaml
+
+    from conftest import snakemake, workflow_copy
+
+    workdir = workflow_copy(tmp_path / "wf")
+    manifest = yaml.safe_load((REPO / "data_manifest" / "dev_ridge.yaml").read_text())
+    manifest["root"] = str(DATA)
+    (workdir / "data_manifest" / "dev_ridge.yaml").write_text(yaml.safe_dump(manifest))
+    edges = workdir / "results" / "dev_ridge" / "outdoor" / "edges.nc"
+    loaded = {}
+    for count in (3, 1):  # 1 reruns track_edges alone (its strips input and params changed)
+        (workdir / "strips.yaml").write_text(yaml.safe_dump({"outdoor": {"edge_strips": count}}))
+        result = snakemake(["--cores", "2", str(edges.relative_to(workdir)), "--configfile", "config/config.yaml",
+                            "strips.yaml", "--config", "datasets=[dev_ridge]"], workdir)
+        assert result.returncode == 0, result.stdout[-3000:]
+        with xr.open_dataset(edges, engine="h5netcdf") as dataset:
+            loaded[count] = dataset.load()
+    strip_logs = sorted((workdir / "logs" / "dev_ridge").glob("track_edges_strip*.log"))
+    assert len(strip_logs) == 3 and not list(edges.parent.glob("edges.strips/*.npz"))  # temporary
+    for name, variable in loaded[1].data_vars.items():
+        assert np.array_equal(loaded[3][name].values, variable.values, equal_nan=variable.dtype.kind == "f"), name
