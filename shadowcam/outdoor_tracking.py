@@ -12,6 +12,12 @@ The lit level of each pixel follows slow shading changes (the sun moves) while
 the pixel is fully lit and well above the edge. Memory is a few ``(H, W)``
 arrays plus the ``(T, W)`` edges.
 
+Every step but the frame differencing's widening (``margin`` columns) and the
+registration shift (:func:`shadowcam.translation.translate_cubic_Keys1981`,
+whose bits do not depend on where the frame is cut) works column by column,
+so column strips of the frames can be tracked as separate jobs and merged
+exactly (:mod:`shadowcam.outdoor_strips`).
+
 Offers
 ------
 EdgeTracker : the streaming pass; :meth:`update` per frame, :meth:`result`.
@@ -23,8 +29,8 @@ import numpy as np
 from shadowcam.arrival import CoverageCrossing
 from shadowcam.edge_tracking import column_edges
 from shadowcam.frame_difference import difference_band
-from shadowcam.outdoor_normalise import aligned_luminance
-from shadowcam.photometric import coverage
+from shadowcam.photometric import coverage, luminance
+from shadowcam.translation import translate_cubic_Keys1981
 
 
 class EdgeTracker:
@@ -48,10 +54,14 @@ class EdgeTracker:
         Weight of the current frame in the running lit level (0 = fixed).
     update_distance : float, optional
         The lit level is updated only this many rows or more above the edge.
+    count_cols : (2,) tuple of int, optional
+        Columns ``[c0, c1)`` of the frames over which :attr:`band_count` (pixels in
+        the band, per frame) and :attr:`valid_count` (valid pixels) are counted
+        (default all): the exact partial sums of ``band_fraction`` for a column strip.
     """
 
     def __init__(self, photometry, time_s, *, half_window=3, min_drop=0.2, margin=2, max_step=3.0,
-                 lit_update=0.3, update_distance=4.0):
+                 lit_update=0.3, update_distance=4.0, count_cols=None):
         self.shift = np.asarray(photometry["shift"], dtype=np.float64)
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
@@ -76,6 +86,12 @@ class EdgeTracker:
         self.confidence = np.zeros((n_frames, width), dtype=np.float32)
         self.n_transitions = np.zeros((n_frames, width), dtype=np.int16)
         self.band_fraction = np.zeros(n_frames, dtype=np.float32)
+        c0, c1 = (0, width) if count_cols is None else (int(c) for c in count_cols)
+        if not 0 <= c0 < c1 <= width:
+            raise ValueError(f"count_cols must be (c0, c1) with 0 <= c0 < c1 <= {width}; got {count_cols}")
+        self._counted = np.s_[:, c0:c1]
+        self.band_count = np.zeros(n_frames, dtype=np.int64)
+        self.valid_count = int(self.valid[self._counted].sum())
         self.crossing = CoverageCrossing((height, width), eligible=self.lit_at_start & self.valid)
         self._previous = None
         self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
@@ -87,13 +103,14 @@ class EdgeTracker:
         k = self._k
         if k >= self.time_s.size:
             raise ValueError(f"more frames than frame times ({self.time_s.size})")
-        luma = aligned_luminance(frame, self.shift[k]) / np.float32(self.gain_lit[k])
+        luma = translate_cubic_Keys1981(luminance(frame), self.shift[k]) / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
         band = None
         if self._previous is not None:
             band = difference_band(self._previous, cover, valid=self.valid, **self.band_options)
             self.band_fraction[k] = band[self.valid].mean() if self.valid.any() else 0.0
+            self.band_count[k] = np.count_nonzero(band[self._counted] & self.valid[self._counted])
         self.edge_row[k], self.confidence[k], self.n_transitions[k] = column_edges(
             cover, valid=self.valid, band=band, previous=self._last_edge if k else None, **self.options)
         found = np.isfinite(self.edge_row[k])

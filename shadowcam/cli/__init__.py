@@ -29,6 +29,7 @@ STEPS = {
     "outdoor-normalise": "outdoor_normalise",
     "outdoor-merge-photometry": "outdoor_merge_photometry",
     "track-edges": "track_edges",
+    "track-edges-strip": "track_edges_strip",
     "arrival": "arrival",
     "pushbroom": "pushbroom",
     "outdoor-accuracy": "outdoor_accuracy",

@@ -4,7 +4,9 @@ Second streaming pass (:mod:`shadowcam.outdoor_tracking`): coverage, frame
 differencing, sub-pixel column edges with confidence, and the per-pixel
 coverage crossing; then keyframes and interpolation in seconds of the edges
 of unreliable frames (:mod:`shadowcam.keyframes`). Writes
-``results/<ds>/outdoor/edges.nc``.
+``results/<ds>/outdoor/edges.nc``. With ``--strips`` the pass is not run here:
+the column strips of ``shadowcam track-edges-strip`` jobs are merged
+(:func:`shadowcam.outdoor_strips.merge_strips`, equal to one job bit for bit).
 
 Offers
 ------
@@ -20,6 +22,7 @@ from shadowcam.frame_store import open_frames
 from shadowcam.frame_times import find_gaps, median_interval
 from shadowcam.keyframes import interpolate_edges, select_keyframes
 from shadowcam.outdoor_datasets import edges_dataset, photometry_arrays
+from shadowcam.outdoor_strips import merge_strips
 from shadowcam.outdoor_tracking import track_frames
 
 TRACK_OPTIONS = {"half_window", "min_drop", "margin", "max_step", "lit_update", "update_distance"}
@@ -34,6 +37,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
     parser.add_argument("--params", default="{}",
                         help=f"JSON: {', '.join(sorted(TRACK_OPTIONS | KEYFRAME_OPTIONS))}")
+    parser.add_argument("--strips", nargs="+", metavar="NPZ",
+                        help="column strips of track-edges-strip to merge instead of tracking here")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/outdoor/edges.nc")
     return parser
 
@@ -45,8 +50,16 @@ def run(args):
     photometry = open_dataset(args.photometry)
     arrays = photometry_arrays(photometry)
     time_s = frames["time_s"].values
-    tracked = track_frames(iter_frames(frames), arrays, time_s,
-                           **{k: v for k, v in params.items() if k in TRACK_OPTIONS})
+    if args.strips:
+        from shadowcam.cli.track_edges_strip import load_strip  # (imports this module)
+
+        tracked = merge_strips([load_strip(path) for path in args.strips])
+        if tracked["edge_row"].shape != (time_s.size, frames.sizes["col"]):
+            raise ValueError(f"--strips {args.strips[0]} ...: shape {tracked['edge_row'].shape} does not "
+                             f"match the frames {args.frames}; rerun track-edges-strip")
+    else:
+        tracked = track_frames(iter_frames(frames), arrays, time_s,
+                               **{k: v for k, v in params.items() if k in TRACK_OPTIONS})
     key_options = {k: v for k, v in params.items() if k in KEYFRAME_OPTIONS}
     is_keyframe = select_keyframes(tracked["confidence"], tracked["edge_row"], **key_options)
     edge_row, interpolated = interpolate_edges(

@@ -316,13 +316,14 @@ def get_methods_params(wildcards):
 
 # --- Outdoor time parts and job sizes (rules in workflow/rules/outdoor.smk) ---
 # The first outdoor pass runs as one job per time part of config outdoor.part_frames
-# frames; job memory and run time are sized from the frame size (header of the first
+# frames, the second (edge tracking) as one job per column strip of config
+# outdoor.edge_strips (merged exactly by track_edges); job memory and run time are sized from the frame size (header of the first
 # frame) with per-megapixel figures measured by `make bench-outdoor-size`.
 
 #: measured peak RSS per megapixel of frame (MB/MP) and fixed part (MB), with margin
-OUTDOOR_MEM_MB = {"normalise": (400, 85), "track": (400, 100), "per_pixel": (400, 70)}
+OUTDOOR_MEM_MB = {"normalise": (400, 85), "track": (400, 100), "track_strip": (400, 100), "per_pixel": (400, 70)}
 #: measured seconds per frame and megapixel on one core (x3 margin in outdoor_runtime)
-OUTDOOR_S_PER_MP_FRAME = {"normalise": 0.25, "track": 0.35, "per_pixel": 0.05}
+OUTDOOR_S_PER_MP_FRAME = {"normalise": 0.25, "track": 0.35, "track_strip": 0.35, "per_pixel": 0.05}
 
 
 def outdoor_frame_layout(ds):
@@ -363,13 +364,52 @@ def _outdoor_frames_in_job(wildcards, stage):
     return n_frames or 1000
 
 
+def edge_strip_count():
+    """Column strips of the edge-tracking pass (config outdoor.edge_strips; 1 = one job)."""
+    return int(config["outdoor"]["edge_strips"])
+
+
+def get_edge_strips(wildcards):
+    """Strip files of the edge-tracking pass merged by track_edges (none for one job)."""
+    count = edge_strip_count()
+    if count <= 1:
+        return []
+    return [f"results/{wildcards.ds}/outdoor/edges.strips/{index}.npz" for index in range(count)]
+
+
+def get_edge_strips_option(wildcards, input):
+    """``--strips FILES`` of track-edges when the pass ran in strips, else empty."""
+    return "--strips " + " ".join(input.strips) if input.strips else ""
+
+
+def get_edge_strip_arg(wildcards):
+    """``--strip I/N`` value of strip job `wildcards.strip`."""
+    return f"{wildcards.strip}/{edge_strip_count()}"
+
+
+def _outdoor_megapixels(wildcards, stage):
+    """Megapixels an outdoor job of `stage` reads per frame: a strip reads its columns plus
+    a halo (~16 columns each side: shift + cubic taps + band widening + guard)."""
+    megapixels = outdoor_frame_layout(wildcards.ds)[1] or 24.0
+    if stage != "track_strip":
+        return megapixels
+    ds = wildcards.ds
+    width = None if is_synthetic(ds) else frame_shape(ds, outdoor_sweep(ds))[1]
+    halo_share = 2 * 16 / width if width else 0.1
+    return megapixels * min(1.0, 1 / edge_strip_count() + halo_share)
+
+
+def _outdoor_stage(stage):
+    """The merge of strips (track_edges with edge_strips > 1) only handles (T, W) curves and maps."""
+    return "per_pixel" if stage == "track" and edge_strip_count() > 1 else stage
+
+
 def outdoor_mem_mb(stage):
     """Resource function: MB of memory of an outdoor job of `stage`, from the frame size."""
 
     def mem_mb(wildcards):
-        megapixels = outdoor_frame_layout(wildcards.ds)[1] or 24.0
-        fixed, per_mp = OUTDOOR_MEM_MB[stage]
-        return int(fixed + per_mp * megapixels)
+        fixed, per_mp = OUTDOOR_MEM_MB[_outdoor_stage(stage)]
+        return int(fixed + per_mp * _outdoor_megapixels(wildcards, stage))
 
     return mem_mb
 
@@ -378,8 +418,8 @@ def outdoor_runtime(stage):
     """Resource function: minutes of an outdoor job of `stage` (3x the measured rate, >= 10)."""
 
     def runtime(wildcards):
-        megapixels = outdoor_frame_layout(wildcards.ds)[1] or 24.0
-        seconds = OUTDOOR_S_PER_MP_FRAME[stage] * megapixels * _outdoor_frames_in_job(wildcards, stage)
+        megapixels = _outdoor_megapixels(wildcards, stage)
+        seconds = OUTDOOR_S_PER_MP_FRAME[_outdoor_stage(stage)] * megapixels * _outdoor_frames_in_job(wildcards, stage)
         return max(10, int(3 * seconds / 60) + 1)
 
     return runtime

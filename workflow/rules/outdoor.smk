@@ -1,6 +1,7 @@
 # Stages of an outdoor time-lapse (manifest kind: outdoor): registration and
 # photometric normalisation (one job per time part of config outdoor.part_frames
-# frames, then an exact merge), shadow-edge tracking with keyframe interpolation,
+# frames, then an exact merge), shadow-edge tracking with keyframe interpolation
+# (one job per column strip of config outdoor.edge_strips, merged exactly),
 # the per-pixel arrival-time map, the ridge pushbroom, accuracy (datasets with
 # ground truth) and the report figures (paper Fig. 18). The frames come from
 # the shared `decode` rule (results/{ds}/frames/<sweep>.zarr).
@@ -16,6 +17,8 @@ rule outdoor_normalise_part:
         manifest=get_capture_manifest,
         part=get_outdoor_part_range,
         options=as_json(config["outdoor"]["normalise"]),
+    wildcard_constraints:
+        part=r"\d+-(\d+|end)",  # START-STOP, not the 4-digit decode parts of common.smk
     resources:
         mem_mb=outdoor_mem_mb("normalise"),
         runtime=outdoor_runtime("normalise"),
@@ -50,14 +53,42 @@ rule outdoor_normalise:
         "shadowcam outdoor-merge-photometry --parts {input} --out {output} > {log} 2>&1"
 
 
-rule track_edges:
+rule track_edges_strip:
     input:
         frames=get_outdoor_frames,
         photometry="results/{ds}/outdoor/photometry.nc",
     output:
+        temp("results/{ds}/outdoor/edges.strips/{strip}.npz"),
+    params:
+        strip=get_edge_strip_arg,
+        options=as_json(config["outdoor"]["track_edges"]),
+    wildcard_constraints:
+        strip=r"\d+",
+    resources:
+        mem_mb=outdoor_mem_mb("track_strip"),
+        runtime=outdoor_runtime("track_strip"),
+    threads: 1
+    log:
+        "logs/{ds}/track_edges_strip{strip}.log",
+    benchmark:
+        "benchmarks/{ds}/track_edges_strip{strip}.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    shell:
+        "shadowcam track-edges-strip --frames {input.frames} --photometry {input.photometry}"
+        " --strip {params.strip} --params {params.options:q} --out {output} > {log} 2>&1"
+
+
+rule track_edges:
+    input:
+        frames=get_outdoor_frames,
+        photometry="results/{ds}/outdoor/photometry.nc",
+        strips=get_edge_strips,
+    output:
         "results/{ds}/outdoor/edges.nc",
     params:
         options=as_json(config["outdoor"]["track_edges"]),
+        strips=get_edge_strips_option,
     resources:
         mem_mb=outdoor_mem_mb("track"),
         runtime=outdoor_runtime("track"),
@@ -70,7 +101,7 @@ rule track_edges:
         "../envs/shadowcam.yaml"
     shell:
         "shadowcam track-edges --frames {input.frames} --photometry {input.photometry}"
-        " --params {params.options:q} --out {output} > {log} 2>&1"
+        " {params.strips} --params {params.options:q} --out {output} > {log} 2>&1"
 
 
 rule arrival:
