@@ -446,9 +446,9 @@ def outdoor_runtime(stage):
 
 
 wildcard_constraints:
-    # decode_part / shadow_time_chunk parts (0000, 0001, ...) and the outdoor
-    # first-pass time parts (START-STOP, STOP may be "end")
-    part=r"\d{4}|\d+-(?:\d+|end)",
+    # decode_part / shadow_time_chunk parts (0000, 0001, ...); the outdoor first-pass
+    # time parts (START-STOP) set their own constraint in outdoor.smk
+    part=r"\d{4}",
 
 #: per-pixel seconds of decoding one frame (rawpy + demosaic + zstd write, ~3x the
 #: measured 24 MP lossless-JPEG DNG cost), used to size `runtime`
