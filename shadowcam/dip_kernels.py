@@ -85,21 +85,48 @@ def _is_candidate(smooth, p, slots, row, centre, end, half_window, worst):
     """Whether frame `centre` of pixel `p` is a local minimum deeper than `worst`.
 
     `slots[row, e]` is the ring slot of frame ``centre - half_window - 1 + e``;
-    the smoothed values of frames ``centre +- half_window`` must be in `smooth`.
-    A local minimum is smaller than every smoothed value in the ``half_window``
-    frames before it and not larger than those after it (ties go to the
-    earlier frame).
+    the smoothed values of frames ``centre - half_window - 1 .. centre + half_window``
+    must be in `smooth`. A local minimum is not larger than any smoothed value
+    within ``half_window`` frames and, among the run of equal values around it
+    (a flat minimum, seen within the window), is its middle frame (the later
+    one of an even run). An equal value before the run, or a run reaching past
+    the window's start, makes it no minimum (ties go to the earlier dip); a run
+    longer than the window thus has one minimum, ``half_window`` frames after
+    its first frame.
     """
     h = half_window
     s = smooth[p, slots[row, h + 1]]
     if not s < worst:  # also rejects NaN
         return False
+    first = centre  # the run of values equal to s, within the window
+    open_run = True
     for d in range(1, h + 1):
-        if centre + d < end and smooth[p, slots[row, h + 1 + d]] < s:
+        if centre - d < 0:
+            break
+        v = smooth[p, slots[row, h + 1 - d]]
+        if v < s:
             return False
-        if centre - d >= 0 and smooth[p, slots[row, h + 1 - d]] <= s:
+        if v == s:
+            if not open_run:
+                return False
+            first = centre - d
+        else:
+            open_run = False
+    if open_run and first == centre - h and centre - h - 1 >= 0 and smooth[p, slots[row, 0]] == s:
+        return False  # the run starts before the window: an earlier frame is its minimum
+    last = centre
+    open_run = True
+    for d in range(1, h + 1):
+        if centre + d >= end:
+            break
+        v = smooth[p, slots[row, h + 1 + d]]
+        if v < s:
             return False
-    return True
+        if v == s and open_run:
+            last = centre + d
+        elif v != s:
+            open_run = False
+    return centre == (first + last + 1) // 2
 
 
 @nb.njit(cache=True)
@@ -172,7 +199,8 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
                 x += v1
             if n_c > 2:
                 x += v2
-            raw[p, slots[t, r - 1]] = x
+            # non-finite samples (also -inf) never take part in the minimum search
+            raw[p, slots[t, r - 1]] = x if np.isfinite(x) else np.float32(np.nan)
             if j >= 1:
                 _smooth_into(raw, smooth, p, slots, t, r - 2, j - 1, j + 1)
             if start <= j < stop:

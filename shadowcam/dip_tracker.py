@@ -9,13 +9,14 @@ time, and each pixel keeps only
   :mod:`shadowcam.dip_kernels`), from which the unshadowed level and the
   noise are computed with the dip removed;
 * its deepest local minima of the temporally [1, 2, 1]-smoothed signal (a
-  local minimum is below every smoothed value within ``half_window`` frames;
-  ties go to the earlier frame), and the raw window of ``2 * half_window + 1``
-  samples around the deepest one.
+  local minimum is not above any smoothed value within ``half_window``
+  frames and is the middle of a flat minimum; ties between separate dips go
+  to the earlier one; non-finite samples take no part), and the raw window of
+  ``2 * half_window + 1`` samples around the deepest one.
 
 The deepest minimum is the deepest smoothed value of the sweep; the second
-dip is the deepest local minimum at least one window (``2 * half_window + 1``
-frames) away from it. Memory is ``O(H * W * window)``, independent of the
+dip is the deepest other local minimum (more than ``half_window`` frames
+away from it: a second dip inside the window is seen too). Memory is ``O(H * W * window)``, independent of the
 number of frames.
 
 Time chunks: a tracker built with ``owned=(start, stop)`` is fed the frames
@@ -57,8 +58,8 @@ class DipSummary:
     minimum_value : (H, W) float32 ndarray
         Smoothed signal at `minimum_frame`.
     second_value : (H, W) float32 ndarray
-        Deepest smoothed local minimum at least one window away from
-        `minimum_frame` (``+inf`` when none).
+        Deepest other smoothed local minimum (more than ``half_window``
+        frames from `minimum_frame`) (``+inf`` when none).
     second_frame : (H, W) int64 ndarray
         Frame of `second_value` (negative when none).
     lit_level : (H, W) float64 ndarray
@@ -227,8 +228,12 @@ class DipTracker:
 
     @staticmethod
     def padding(half_window):
-        """Frames needed on each side of an owned time chunk: ``half_window + 1``."""
-        return int(half_window) + 1
+        """Frames needed on each side of an owned time chunk: ``half_window + 2``.
+
+        A centre's test reads the smoothed values from ``half_window + 1`` frames
+        before it (one raw frame more) to ``half_window`` after it (one more).
+        """
+        return int(half_window) + 2
 
     @property
     def n_frames(self):
@@ -288,7 +293,7 @@ class DipTracker:
         if self._partial is None:
             start, stop = self.owned
             end = self._next
-            first = max(end - self.half_window - 1, start)
+            first = max(end - self.half_window - 1, start)  # centres not yet tested
             _k.finish_centres(first, min(stop, end), end, self.half_window, self._raw, self._smooth,
                               self._top_value, self._top_frame, self._window)
             h, w = self.shape
@@ -374,7 +379,7 @@ def merge_partials(partials, *, n_frames):
     pick = first[..., None]
     minimum_value = np.take_along_axis(values, pick, -1)[..., 0]
     minimum_frame = np.where(found, np.take_along_axis(frames, pick, -1)[..., 0], -1)
-    far = np.abs(frames - minimum_frame[..., None]) >= k
+    far = np.abs(frames - minimum_frame[..., None]) > h
     second, has_second = _lexicographic_min(values, frames, finite & far & found[..., None])
     second_value = np.where(has_second, np.take_along_axis(values, second[..., None], -1)[..., 0], np.inf)
     second_frame = np.where(has_second, np.take_along_axis(frames, second[..., None], -1)[..., 0], -(k + 1))
