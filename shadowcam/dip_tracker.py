@@ -212,11 +212,12 @@ class DipTracker:
         p = self.shape[0] * self.shape[1]
         self._first = max(0, start - self.padding(h))
         self._next = self._first
-        self._raw = np.full((p, k + 2), np.nan, np.float32)
-        self._smooth = np.full((p, k + 2), np.nan, np.float32)
-        self._top_value = np.full((p, _k.TOP), np.inf, np.float32)
-        self._top_frame = np.full((p, _k.TOP), -1, np.int64)
-        self._window = np.full((p, k), np.nan, np.float32)
+        # pixel-minor state (see dip_kernels.track_block)
+        self._raw = np.full((k + 2, p), np.nan, np.float32)
+        self._smooth = np.full((k + 2, p), np.nan, np.float32)
+        self._top_value = np.full((_k.TOP, p), np.inf, np.float32)
+        self._top_frame = np.full((_k.TOP, p), -1, np.int64)
+        self._window = np.full((k, p), np.nan, np.float32)
         self._signal_sum = np.zeros(p, np.int64)
         self._square_hi = np.zeros(p, np.float64)
         self._square_lo = np.zeros(p, np.float64)
@@ -274,9 +275,9 @@ class DipTracker:
         if n_c > 3:
             raise ValueError(f"block must have at most 3 channels, got {n_c}")
         if self._channel_sum is None:
-            self._channel_sum = np.zeros((self._raw.shape[0], n_c), np.int64)
-        elif self._channel_sum.shape[1] != n_c:
-            raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[1]}")
+            self._channel_sum = np.zeros((n_c, self._raw.shape[1]), np.int64)
+        elif self._channel_sum.shape[0] != n_c:
+            raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[0]}")
         flat = np.ascontiguousarray(block).reshape(block.shape[0], -1, n_c)
         _k.track_block(flat, first, *self.owned, self.half_window, np.float32(self.saturation_level),
                        self._raw, self._smooth, self._top_value, self._top_frame, self._window, self._signal_sum,
@@ -297,14 +298,18 @@ class DipTracker:
             _k.finish_centres(first, min(stop, end), end, self.half_window, self._raw, self._smooth,
                               self._top_value, self._top_frame, self._window)
             h, w = self.shape
-            channels = self._channel_sum if self._channel_sum is not None else np.zeros((h * w, 0), np.int64)
+            channels = self._channel_sum if self._channel_sum is not None else np.zeros((0, h * w), np.int64)
+
+            def pixel_major(state):
+                return np.ascontiguousarray(state.T).reshape(h, w, -1)
+
             self._partial = DipPartial(
                 start=start, stop=max(min(stop, end), start), end=end, half_window=self.half_window,
-                top_value=self._top_value.reshape(h, w, -1), top_frame=self._top_frame.reshape(h, w, -1),
-                window=self._window.reshape(h, w, -1), signal_sum=self._signal_sum.reshape(h, w),
+                top_value=pixel_major(self._top_value), top_frame=pixel_major(self._top_frame),
+                window=pixel_major(self._window), signal_sum=self._signal_sum.reshape(h, w),
                 square_hi=self._square_hi.reshape(h, w), square_lo=self._square_lo.reshape(h, w),
                 count=self._count.reshape(h, w), invalid=self._invalid.reshape(h, w),
-                channel_sum=channels.reshape(h, w, -1), saturated=self._saturated.reshape(h, w),
+                channel_sum=pixel_major(channels), saturated=self._saturated.reshape(h, w),
             )
             self._raw = self._smooth = None
         return self._partial
