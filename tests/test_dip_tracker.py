@@ -214,3 +214,21 @@ def test_merge_rejects_gaps_and_short_feeds():
     tracker = DipTracker(frames.shape[1:3], half_window=2, owned=(20, 40))
     with pytest.raises(ValueError, match="first_index"):
         tracker.update(frames[20:30], first_index=20)
+
+
+@pytest.mark.parametrize("scale", [1.0, 3e5])  # 3e5: above 2**17, summed one sample at a time
+@pytest.mark.parametrize("block", [7, 40])
+def test_fixed_point_sums_are_exact_for_small_and_large_samples(scale, block):
+    from shadowcam.dip_kernels import quantise_sum
+
+    rng = np.random.default_rng(7)
+    frames = (rng.random((70, 3, 5, 3)) * scale).astype(np.float32)
+    frames[5, 1, 2, 1] = np.nan
+    tracker = DipTracker(frames.shape[1:3], half_window=2)
+    for start in range(0, 70, block):
+        tracker.update(frames[start:start + block])
+    partial = tracker.partial()
+    signal = frames[..., 0] + frames[..., 1] + frames[..., 2]  # float32, in channel order
+    np.testing.assert_array_equal(partial.signal_sum, quantise_sum(signal).sum(axis=0))
+    np.testing.assert_array_equal(partial.channel_sum, quantise_sum(frames).sum(axis=0))
+    np.testing.assert_array_equal(partial.count, np.isfinite(signal).sum(axis=0))
