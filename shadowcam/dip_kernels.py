@@ -261,16 +261,22 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
             t_flush = t + 1
         centre = j - h - 1
         if centre >= start and centre >= 0 and centre < stop:
-            cslot, lslot, rslot = (np.uint64(centre % r), np.uint64((centre - 1) % r),
-                                   np.uint64((centre + 1) % r))
+            # necessary conditions, vectorised: below the current 5th candidate and not
+            # above any smoothed value within h frames (NaN, also frames before the
+            # sequence or the chunk, decide nothing)
+            cslot = np.uint64(centre % r)
             worst = np.uint64(TOP - 1)
-            hits = 0
             for q in range(m):
                 p = u0 + np.uint64(q)
-                # necessary conditions first: below the current 5th candidate and not
-                # above either neighbour (NaN neighbours decide nothing)
-                sc = smooth[cslot, p]
-                hit[q] = (sc < top_value[worst, p]) & (not smooth[lslot, p] < sc) & (not smooth[rslot, p] < sc)
+                hit[q] = smooth[cslot, p] < top_value[worst, p]
+            for d in range(1, h + 1):
+                lslot, rslot = np.uint64((centre - d) % r), np.uint64((centre + d) % r)
+                for q in range(m):
+                    p = u0 + np.uint64(q)
+                    sc = smooth[cslot, p]
+                    hit[q] &= (not smooth[lslot, p] < sc) & (not smooth[rslot, p] < sc)
+            hits = 0
+            for q in range(m):
                 hits += hit[q]
             if hits:
                 for q in range(m):
