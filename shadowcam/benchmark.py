@@ -22,6 +22,7 @@ write_sweep_dngs : render a scene to DNG files (cached by parameters).
 decode_floor_seconds : wall time to decode files with nothing else, in parallel.
 numpy_pass_seconds : wall time of one numpy pass over an array.
 stage_seconds : wall time of the shadow-time stage on in-memory frames.
+tracking_cpu_ns : CPU time per pixel-frame of the tracker on one core (robust to load).
 end_to_end : run the file pipeline in a fresh process; wall time and peak memory.
 run_benchmark : all of the above, as a dict of figures.
 format_report : the figures as printable text.
@@ -220,6 +221,36 @@ def stage_seconds(frames, *, block_frames=16, method="edge_fit", repeats=2):
     return track_best, finish_best
 
 
+def tracking_cpu_ns(frames, *, block_frames=16, repeats=2):
+    """CPU time per pixel-frame of the tracker on one thread, in ns (best of `repeats`).
+
+    CPU time of this process, not wall time: other jobs on a shared machine
+    change it much less (they still share caches and memory bandwidth).
+
+    Parameters
+    ----------
+    frames : (T, H, W, C) float32 ndarray
+    """
+    import numba
+
+    from shadowcam.dip_tracker import DipTracker
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        best = np.inf
+        for _ in range(repeats):
+            start = time.process_time()
+            tracker = DipTracker(frames.shape[1:3])
+            for i in range(0, len(frames), block_frames):
+                tracker.update(frames[i:i + block_frames])
+            tracker.partial()
+            best = min(best, time.process_time() - start)
+    finally:
+        numba.set_num_threads(threads)
+    return best / (frames.shape[0] * frames.shape[1] * frames.shape[2]) * 1e9
+
+
 _END_TO_END = """
 import json, resource, sys, time
 import numpy as np
@@ -320,6 +351,7 @@ def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=2
     frames = np.stack([read_frame(p)[rows, cols] for p in paths[middle:middle + stage_frames]])
     tracking, finishing = stage_seconds(frames)
     numpy_pass = numpy_pass_seconds(frames)
+    figures["tracking_cpu_ns"] = tracking_cpu_ns(frames)
     crop = frames.shape[1] * frames.shape[2]
     figures.update(
         stage_frames=stage_frames,
@@ -354,6 +386,8 @@ def format_report(figures):
         f"  tracking           {f['stage_tracking_mpfs']:8.1f} M pixel-frames/s",
         f"  one numpy pass     {f['numpy_pass_mpfs']:8.1f} M pixel-frames/s over the same bytes",
         f"  ratio to numpy pass    {f['ratio_to_numpy_pass']:.3f}   (aim >= 0.25)",
+        f"  tracker CPU time   {f['tracking_cpu_ns']:8.1f} ns per pixel-frame on one thread"
+        " (process CPU time: less sensitive to other jobs)",
         f"  classify + time (once per sweep, scaled to the full image) {f['stage_finish_s']:.2f} s;"
         f" whole stage at {f['n_frames']} frames {f['stage_with_finish_mpfs_at_n']:.1f} M pixel-frames/s",
         "",

@@ -66,75 +66,222 @@ def _fixed(x):
 
 
 @nb.njit(cache=True, inline="always")
-def _smooth_into(raw, smooth, p, slots, row, e, i, end):
-    """Store the [1, 2, 1]/4 smoothing of pixel `p`'s frame `i` (ring slot ``slots[row, e]``).
+def _smooth_frame(raw, smooth, p, i, end):
+    """Store the [1, 2, 1]/4 smoothing of pixel `p`'s frame `i` (ring slot ``i % r``).
 
     Neighbours outside ``[0, end)`` are replaced by frame `i` itself.
     """
-    mid = raw[p, slots[row, e]]
-    prev = raw[p, slots[row, e - 1]] if i >= 1 else mid
-    nxt = raw[p, slots[row, e + 1]] if i + 1 < end else mid
+    r = raw.shape[0]
+    mid = raw[i % r, p]
+    prev = raw[(i - 1) % r, p] if i >= 1 else mid
+    nxt = raw[(i + 1) % r, p] if i + 1 < end else mid
     s = mid * _HALF
     s += _QUARTER * prev
     s += _QUARTER * nxt
-    smooth[p, slots[row, e]] = s
+    smooth[i % r, p] = s
 
 
 @nb.njit(cache=True)
-def _is_candidate(smooth, p, slots, row, centre, end, half_window, worst):
+def _is_candidate(smooth, p, centre, end, half_window, worst):
     """Whether frame `centre` of pixel `p` is a local minimum deeper than `worst`.
 
-    `slots[row, e]` is the ring slot of frame ``centre - half_window - 1 + e``;
-    the smoothed values of frames ``centre +- half_window`` must be in `smooth`.
-    A local minimum is smaller than every smoothed value in the ``half_window``
-    frames before it and not larger than those after it (ties go to the
-    earlier frame).
+    The ring `smooth` ``(r, P)`` must hold the smoothed values of frames
+    ``centre - half_window - 1 .. centre + half_window`` (slot ``frame % r``).
+    A local minimum is not larger than any smoothed value within
+    ``half_window`` frames and, among the run of equal values around it (a
+    flat minimum, seen within the window), is its middle frame (the later one
+    of an even run). An equal value before the run, or a run reaching past
+    the window's start, makes it no minimum (ties go to the earlier dip); a
+    run longer than the window thus has one minimum, ``half_window`` frames
+    after its first frame.
     """
+    r = smooth.shape[0]
     h = half_window
-    s = smooth[p, slots[row, h + 1]]
+    s = smooth[centre % r, p]
     if not s < worst:  # also rejects NaN
         return False
+    first = centre  # the run of values equal to s, within the window
+    open_run = True
     for d in range(1, h + 1):
-        if centre + d < end and smooth[p, slots[row, h + 1 + d]] < s:
+        if centre - d < 0:
+            break
+        v = smooth[(centre - d) % r, p]
+        if v < s:
             return False
-        if centre - d >= 0 and smooth[p, slots[row, h + 1 - d]] <= s:
+        if v == s:
+            if not open_run:
+                return False
+            first = centre - d
+        else:
+            open_run = False
+    if open_run and first == centre - h and centre - h - 1 >= 0 and smooth[(centre - h - 1) % r, p] == s:
+        return False  # the run starts before the window: an earlier frame is its minimum
+    last = centre
+    open_run = True
+    for d in range(1, h + 1):
+        if centre + d >= end:
+            break
+        v = smooth[(centre + d) % r, p]
+        if v < s:
             return False
-    return True
+        if v == s and open_run:
+            last = centre + d
+        elif v != s:
+            open_run = False
+    return centre == (first + last + 1) // 2
 
 
 @nb.njit(cache=True)
-def _insert(raw, smooth, p, slots, row, centre, end, half_window, top_value, top_frame, window):
-    """Insert local minimum `centre` into pixel `p`'s sorted list; copy its raw window if deepest."""
+def _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window):
+    """Insert frame `centre` among pixel `p`'s deepest local minima if it is one.
+
+    The sorted lists are ``(TOP, P)``; the raw window ``(K, P)`` is copied when
+    the centre becomes the deepest.
+    """
+    if not _is_candidate(smooth, p, centre, end, half_window, top_value[TOP - 1, p]):
+        return
+    r = raw.shape[0]
     h = half_window
-    s = smooth[p, slots[row, h + 1]]
+    s = smooth[centre % r, p]
     pos = TOP - 1
-    while pos > 0 and s < top_value[p, pos - 1]:
-        top_value[p, pos] = top_value[p, pos - 1]
-        top_frame[p, pos] = top_frame[p, pos - 1]
+    while pos > 0 and s < top_value[pos - 1, p]:
+        top_value[pos, p] = top_value[pos - 1, p]
+        top_frame[pos, p] = top_frame[pos - 1, p]
         pos -= 1
-    top_value[p, pos] = s
-    top_frame[p, pos] = centre
+    top_value[pos, p] = s
+    top_frame[pos, p] = centre
     if pos == 0:
         for q in range(2 * h + 1):
             f = centre - h + q
-            window[p, q] = raw[p, slots[row, q + 1]] if 0 <= f < end else np.nan
+            window[q, p] = raw[f % r, p] if 0 <= f < end else np.nan
 
 
-@nb.njit(cache=True, inline="always")
-def _consider(raw, smooth, p, slots, row, centre, end, half_window, top_value, top_frame, window):
-    """Insert frame `centre` among pixel `p`'s deepest local minima if it is one."""
-    if _is_candidate(smooth, p, slots, row, centre, end, half_window, top_value[p, TOP - 1]):
-        _insert(raw, smooth, p, slots, row, centre, end, half_window, top_value, top_frame, window)
+#: pixels per tile: the tile's rings and sums stay in cache while a block streams through
+TILE = 1024
+#: frames summed in float64 before the sums move to int64 (exact for |sample| < 2**17)
+_FLUSH = 16
+_EXACT_BELOW = 2.0**17
 
 
 @nb.njit(cache=True)
-def _slot_table(first_centre, n_centres, r):
-    """Ring slots of frames ``centre - h - 1 .. centre + h + 1`` for consecutive centres."""
-    table = np.empty((n_centres, r), np.int64)
-    for t in range(n_centres):
-        for e in range(r):
-            table[t, e] = (first_centre + t - (r - 1) // 2 + e) % r
-    return table
+def _exact_sums(block, t0, t1, p0, p1, signal_sum, channel_sum):
+    """Fixed-point sums of frames ``t0 .. t1 - 1`` of a tile, one sample at a time."""
+    n_c = block.shape[2]
+    for p in range(p0, p1):
+        for t in range(t0, t1):
+            x = block[t, p, 0]
+            for c in range(1, n_c):
+                x += block[t, p, c]
+            if np.isfinite(x):
+                signal_sum[p] += _fixed(np.float64(x))
+            for c in range(n_c):
+                v = block[t, p, c]
+                if np.isfinite(v):
+                    channel_sum[c, p] += _fixed(np.float64(v))
+
+
+@nb.njit(cache=True)
+def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation_level,
+                raw, smooth, top_value, top_frame, window, signal_sum, square_hi, square_lo,
+                count, invalid, channel_sum, saturated):
+    """:func:`track_block` for pixels ``p0 .. p1 - 1``.
+
+    A serial function so that its pixel loops vectorise; pixel indices are
+    unsigned (numba's negative-index wrap-around blocks vectorisation).
+    """
+    n_t, n_c = block.shape[0], block.shape[2]
+    r = raw.shape[0]
+    h = half_window
+    m = p1 - p0
+    u0 = np.uint64(p0)
+    acc = np.zeros(m)
+    cacc = np.zeros((n_c, m))
+    hit = np.zeros(m, np.uint8)
+    t_flush = 0
+    big = 0
+    for t in range(n_t):
+        j = first_index + t
+        slot = np.uint64(j % r)
+        owned = start <= j < stop
+        for q in range(m):
+            p = u0 + np.uint64(q)
+            x = block[t, p, 0]
+            if n_c > 1:
+                x += block[t, p, 1]
+            if n_c > 2:
+                x += block[t, p, 2]
+            raw[slot, p] = x if x - x == 0 else np.float32(np.nan)
+        if j >= 1:  # smoothing of frame j - 1 (as _smooth_frame, slots hoisted)
+            before = np.uint64((j - 2) % r if j >= 2 else (j - 1) % r)
+            middle = np.uint64((j - 1) % r)
+            for q in range(m):
+                p = u0 + np.uint64(q)
+                sm = raw[middle, p] * _HALF
+                sm += _QUARTER * raw[before, p]
+                sm += _QUARTER * raw[slot, p]
+                smooth[middle, p] = sm
+        if owned:
+            for q in range(m):
+                p = u0 + np.uint64(q)
+                x = raw[slot, p]
+                ok = x == x
+                xd = np.float64(x) if ok else 0.0
+                big += abs(xd) >= _EXACT_BELOW
+                acc[q] += (xd * SUM_SCALE + _ROUND) - _ROUND
+                sq = xd * xd
+                hi = (sq + _SQ_HI) - _SQ_HI
+                square_hi[p] += hi
+                square_lo[p] += ((sq - hi) + _SQ_LO) - _SQ_LO
+                count[p] += ok
+                invalid[p] += not ok
+            for c in range(n_c):
+                for q in range(m):
+                    p = u0 + np.uint64(q)
+                    v = block[t, p, c]
+                    # +inf is corrupt input (counted above), not a clipped channel
+                    saturated[p] |= (v >= saturation_level) & (v < np.inf)
+                    vd = np.float64(v) if v - v == 0 else 0.0
+                    big += abs(vd) >= _EXACT_BELOW
+                    cacc[c, q] += (vd * SUM_SCALE + _ROUND) - _ROUND
+            if t + 1 == n_t or j + 1 == stop or t + 1 - t_flush == _FLUSH:
+                if big:  # float64 sums may have rounded: redo these frames exactly
+                    _exact_sums(block, t_flush, t + 1, p0, p1, signal_sum, channel_sum)
+                else:
+                    for q in range(m):
+                        p = u0 + np.uint64(q)
+                        signal_sum[p] += np.int64(acc[q])
+                    for c in range(n_c):
+                        for q in range(m):
+                            channel_sum[c, u0 + np.uint64(q)] += np.int64(cacc[c, q])
+                acc[:] = 0.0
+                cacc[:] = 0.0
+                big = 0
+                t_flush = t + 1
+        else:
+            t_flush = t + 1
+        centre = j - h - 1
+        if centre >= start and centre >= 0 and centre < stop:
+            # necessary conditions, vectorised: below the current 5th candidate and not
+            # above any smoothed value within h frames (NaN, also frames before the
+            # sequence or the chunk, decide nothing)
+            cslot = np.uint64(centre % r)
+            worst = np.uint64(TOP - 1)
+            for q in range(m):
+                p = u0 + np.uint64(q)
+                hit[q] = smooth[cslot, p] < top_value[worst, p]
+            for d in range(1, h + 1):
+                lslot, rslot = np.uint64((centre - d) % r), np.uint64((centre + d) % r)
+                for q in range(m):
+                    p = u0 + np.uint64(q)
+                    sc = smooth[cslot, p]
+                    hit[q] &= (not smooth[lslot, p] < sc) & (not smooth[rslot, p] < sc)
+            hits = 0
+            for q in range(m):
+                hits += hit[q]
+            if hits:
+                for q in range(m):
+                    if hit[q]:
+                        _consider(raw, smooth, p0 + q, centre, j + 1, h, top_value, top_frame, window)
 
 
 @nb.njit(cache=True, parallel=True)
@@ -143,73 +290,27 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
                 count, invalid, channel_sum, saturated):
     """Feed frames ``first_index + t`` of `block` ``(T, P, C)`` float32 (C <= 3) to the state.
 
-    The signal is the channel sum (float32, channels added in order). Sums,
-    counts and saturation cover frames in ``[start, stop)`` only; centres in
-    ``[start, stop)`` are tested once the frames up to ``centre + half_window + 1``
-    are in the rings of raw and smoothed samples ``(P, 2 * half_window + 3)``.
+    The signal is the channel sum (float32, channels added in order); a
+    non-finite signal enters the rings as NaN. Sums, counts and saturation
+    cover frames in ``[start, stop)`` only; centres in ``[start, stop)`` are
+    tested once the frames up to ``centre + half_window + 1`` are in the rings
+    of raw and smoothed samples ``(2 * half_window + 3, P)`` (frame ``f`` in
+    slot ``f % r``). State arrays are pixel-minor: lists ``(TOP, P)``, window
+    ``(K, P)``, channel sums ``(C, P)``.
+
+    Pixels are processed in tiles of :data:`TILE` (in parallel), frames in
+    order within a tile, pixels innermost (vectorised). Fixed-point sums are
+    accumulated as integer-valued float64 over :data:`_FLUSH` frames, then
+    added to the int64 sums: exact for samples below ``2**17`` in magnitude;
+    a tile and frame range with a larger sample is summed again one sample
+    at a time.
     """
-    n_t, n_p, n_c = block.shape
-    r = raw.shape[1]
-    # frame j = first_index + t is the last of centre j - h - 1's slots
-    slots = _slot_table(first_index - half_window - 1, n_t, r)
-    for p in nb.prange(n_p):
-        total = signal_sum[p]
-        hi_sum = square_hi[p]
-        lo_sum = square_lo[p]
-        n_ok = count[p]
-        n_bad = invalid[p]
-        sat = saturated[p]
-        c0 = channel_sum[p, 0]
-        c1 = channel_sum[p, 1] if n_c > 1 else 0
-        c2 = channel_sum[p, 2] if n_c > 2 else 0
-        for t in range(n_t):
-            j = first_index + t
-            v0 = block[t, p, 0]
-            v1 = block[t, p, 1] if n_c > 1 else _ZERO
-            v2 = block[t, p, 2] if n_c > 2 else _ZERO
-            x = v0
-            if n_c > 1:
-                x += v1
-            if n_c > 2:
-                x += v2
-            raw[p, slots[t, r - 1]] = x
-            if j >= 1:
-                _smooth_into(raw, smooth, p, slots, t, r - 2, j - 1, j + 1)
-            if start <= j < stop:
-                if np.isfinite(x):
-                    x64 = np.float64(x)
-                    total += _fixed(x64)
-                    sq = x64 * x64
-                    hi = (sq + _SQ_HI) - _SQ_HI
-                    hi_sum += hi
-                    lo_sum += ((sq - hi) + _SQ_LO) - _SQ_LO
-                    n_ok += 1
-                else:
-                    n_bad += 1
-                if np.isfinite(v0):
-                    c0 += _fixed(np.float64(v0))
-                if np.isfinite(v1):
-                    c1 += _fixed(np.float64(v1))
-                if np.isfinite(v2):
-                    c2 += _fixed(np.float64(v2))
-                # +inf is corrupt input (counted above), not a clipped channel
-                sat |= (((v0 >= saturation_level) & (v0 < np.inf)) | ((v1 >= saturation_level) & (v1 < np.inf))
-                        | ((v2 >= saturation_level) & (v2 < np.inf)))
-            centre = j - half_window - 1
-            if centre >= start and centre >= 0 and centre < stop:
-                _consider(raw, smooth, p, slots, t, centre, j + 1, half_window, top_value, top_frame,
-                          window)
-        signal_sum[p] = total
-        square_hi[p] = hi_sum
-        square_lo[p] = lo_sum
-        count[p] = n_ok
-        invalid[p] = n_bad
-        saturated[p] = sat
-        channel_sum[p, 0] = c0
-        if n_c > 1:
-            channel_sum[p, 1] = c1
-        if n_c > 2:
-            channel_sum[p, 2] = c2
+    n_p = block.shape[1]
+    n_tiles = (n_p + TILE - 1) // TILE
+    for tile in nb.prange(n_tiles):
+        _track_tile(block, tile * TILE, min(tile * TILE + TILE, n_p), first_index, start, stop,
+                    half_window, saturation_level, raw, smooth, top_value, top_frame, window,
+                    signal_sum, square_hi, square_lo, count, invalid, channel_sum, saturated)
 
 
 @nb.njit(cache=True, parallel=True)
@@ -221,12 +322,7 @@ def finish_centres(first, last, end, half_window, raw, smooth, top_value, top_fr
     """
     if end < 1:
         return
-    r = raw.shape[1]
-    # row 0: slots around centre end - h - 1, whose slot r - 2 is frame end - 1
-    last_frame = _slot_table(end - half_window - 1, 1, r)
-    slots = _slot_table(first, max(last - first, 0), r)
-    for p in nb.prange(raw.shape[0]):
-        _smooth_into(raw, smooth, p, last_frame, 0, r - 2, end - 1, end)
+    for p in nb.prange(raw.shape[1]):
+        _smooth_frame(raw, smooth, p, end - 1, end)
         for centre in range(first, last):
-            _consider(raw, smooth, p, slots, centre - first, centre, end, half_window, top_value,
-                      top_frame, window)
+            _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window)

@@ -9,13 +9,14 @@ time, and each pixel keeps only
   :mod:`shadowcam.dip_kernels`), from which the unshadowed level and the
   noise are computed with the dip removed;
 * its deepest local minima of the temporally [1, 2, 1]-smoothed signal (a
-  local minimum is below every smoothed value within ``half_window`` frames;
-  ties go to the earlier frame), and the raw window of ``2 * half_window + 1``
-  samples around the deepest one.
+  local minimum is not above any smoothed value within ``half_window``
+  frames and is the middle of a flat minimum; ties between separate dips go
+  to the earlier one; non-finite samples take no part), and the raw window of
+  ``2 * half_window + 1`` samples around the deepest one.
 
 The deepest minimum is the deepest smoothed value of the sweep; the second
-dip is the deepest local minimum at least one window (``2 * half_window + 1``
-frames) away from it. Memory is ``O(H * W * window)``, independent of the
+dip is the deepest other local minimum (more than ``half_window`` frames
+away from it: a second dip inside the window is seen too). Memory is ``O(H * W * window)``, independent of the
 number of frames.
 
 Time chunks: a tracker built with ``owned=(start, stop)`` is fed the frames
@@ -57,8 +58,8 @@ class DipSummary:
     minimum_value : (H, W) float32 ndarray
         Smoothed signal at `minimum_frame`.
     second_value : (H, W) float32 ndarray
-        Deepest smoothed local minimum at least one window away from
-        `minimum_frame` (``+inf`` when none).
+        Deepest other smoothed local minimum (more than ``half_window``
+        frames from `minimum_frame`) (``+inf`` when none).
     second_frame : (H, W) int64 ndarray
         Frame of `second_value` (negative when none).
     lit_level : (H, W) float64 ndarray
@@ -211,11 +212,12 @@ class DipTracker:
         p = self.shape[0] * self.shape[1]
         self._first = max(0, start - self.padding(h))
         self._next = self._first
-        self._raw = np.full((p, k + 2), np.nan, np.float32)
-        self._smooth = np.full((p, k + 2), np.nan, np.float32)
-        self._top_value = np.full((p, _k.TOP), np.inf, np.float32)
-        self._top_frame = np.full((p, _k.TOP), -1, np.int64)
-        self._window = np.full((p, k), np.nan, np.float32)
+        # pixel-minor state (see dip_kernels.track_block)
+        self._raw = np.full((k + 2, p), np.nan, np.float32)
+        self._smooth = np.full((k + 2, p), np.nan, np.float32)
+        self._top_value = np.full((_k.TOP, p), np.inf, np.float32)
+        self._top_frame = np.full((_k.TOP, p), -1, np.int64)
+        self._window = np.full((k, p), np.nan, np.float32)
         self._signal_sum = np.zeros(p, np.int64)
         self._square_hi = np.zeros(p, np.float64)
         self._square_lo = np.zeros(p, np.float64)
@@ -227,8 +229,12 @@ class DipTracker:
 
     @staticmethod
     def padding(half_window):
-        """Frames needed on each side of an owned time chunk: ``half_window + 1``."""
-        return int(half_window) + 1
+        """Frames needed on each side of an owned time chunk: ``half_window + 2``.
+
+        A centre's test reads the smoothed values from ``half_window + 1`` frames
+        before it (one raw frame more) to ``half_window`` after it (one more).
+        """
+        return int(half_window) + 2
 
     @property
     def n_frames(self):
@@ -269,9 +275,9 @@ class DipTracker:
         if n_c > 3:
             raise ValueError(f"block must have at most 3 channels, got {n_c}")
         if self._channel_sum is None:
-            self._channel_sum = np.zeros((self._raw.shape[0], n_c), np.int64)
-        elif self._channel_sum.shape[1] != n_c:
-            raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[1]}")
+            self._channel_sum = np.zeros((n_c, self._raw.shape[1]), np.int64)
+        elif self._channel_sum.shape[0] != n_c:
+            raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[0]}")
         flat = np.ascontiguousarray(block).reshape(block.shape[0], -1, n_c)
         _k.track_block(flat, first, *self.owned, self.half_window, np.float32(self.saturation_level),
                        self._raw, self._smooth, self._top_value, self._top_frame, self._window, self._signal_sum,
@@ -288,18 +294,22 @@ class DipTracker:
         if self._partial is None:
             start, stop = self.owned
             end = self._next
-            first = max(end - self.half_window - 1, start)
+            first = max(end - self.half_window - 1, start)  # centres not yet tested
             _k.finish_centres(first, min(stop, end), end, self.half_window, self._raw, self._smooth,
                               self._top_value, self._top_frame, self._window)
             h, w = self.shape
-            channels = self._channel_sum if self._channel_sum is not None else np.zeros((h * w, 0), np.int64)
+            channels = self._channel_sum if self._channel_sum is not None else np.zeros((0, h * w), np.int64)
+
+            def pixel_major(state):
+                return np.ascontiguousarray(state.T).reshape(h, w, -1)
+
             self._partial = DipPartial(
                 start=start, stop=max(min(stop, end), start), end=end, half_window=self.half_window,
-                top_value=self._top_value.reshape(h, w, -1), top_frame=self._top_frame.reshape(h, w, -1),
-                window=self._window.reshape(h, w, -1), signal_sum=self._signal_sum.reshape(h, w),
+                top_value=pixel_major(self._top_value), top_frame=pixel_major(self._top_frame),
+                window=pixel_major(self._window), signal_sum=self._signal_sum.reshape(h, w),
                 square_hi=self._square_hi.reshape(h, w), square_lo=self._square_lo.reshape(h, w),
                 count=self._count.reshape(h, w), invalid=self._invalid.reshape(h, w),
-                channel_sum=channels.reshape(h, w, -1), saturated=self._saturated.reshape(h, w),
+                channel_sum=pixel_major(channels), saturated=self._saturated.reshape(h, w),
             )
             self._raw = self._smooth = None
         return self._partial
@@ -374,7 +384,7 @@ def merge_partials(partials, *, n_frames):
     pick = first[..., None]
     minimum_value = np.take_along_axis(values, pick, -1)[..., 0]
     minimum_frame = np.where(found, np.take_along_axis(frames, pick, -1)[..., 0], -1)
-    far = np.abs(frames - minimum_frame[..., None]) >= k
+    far = np.abs(frames - minimum_frame[..., None]) > h
     second, has_second = _lexicographic_min(values, frames, finite & far & found[..., None])
     second_value = np.where(has_second, np.take_along_axis(values, second[..., None], -1)[..., 0], np.inf)
     second_frame = np.where(has_second, np.take_along_axis(frames, second[..., None], -1)[..., 0], -(k + 1))

@@ -168,11 +168,13 @@ def time_gaussian_fit_Caruana1986(summary):
     spectra", Anal. Chem. 58 (1986): the logarithm of a Gaussian is a
     parabola, so the vertex of the parabola through ``log coverage`` at the
     most covered frame and its two neighbours is the Gaussian's centre
-    (offset clipped to +-1 frame; a flat top falls back to the frame).
+    (offset clipped to +-1 frame; a flat top falls back to the middle of the
+    most covered frames).
     """
     coverage = np.nan_to_num(_coverage(summary), nan=0.0)
     k = coverage.shape[0]
-    peak = np.clip(np.argmax(coverage, axis=0), 1, k - 2)[None]
+    first, last = np.argmax(coverage, axis=0), k - 1 - np.argmax(coverage[::-1], axis=0)
+    peak = np.clip((first + last + 1) // 2, 1, k - 2)[None]
     c_m, c_0, c_p = (np.take_along_axis(coverage, peak + d, 0)[0] for d in (-1, 0, 1))
     l_m, l_0, l_p = (np.log(np.maximum(c, 1e-3)) for c in (c_m, c_0, c_p))
     curvature = l_m - 2 * l_0 + l_p

@@ -136,6 +136,11 @@ def _hard_sweep(seed=5):
     frames[63, 5] -= 0.9  # and at the last
     frames[20, 5, 5] = np.nan
     frames[7, 4, 6] = np.inf
+    frames[9, 5, 4] = -np.inf
+    frames[16:24, 0, 2:] = 0.3  # flat minimum (smoothed: frames 17..22), across boundary 20
+    frames[28:40, 0, 4:] = 0.2  # flat minimum longer than the window (smoothed: 29..38)
+    frames[42:52, 3, :3] = 1.0
+    frames[[44, 49], 3, :3] = 0.1  # two equal dips 5 frames apart (half_window 3)
     rng = np.random.default_rng(seed)
     tint = rng.uniform(0.2, 0.5, (1, 1, 1, 3)).astype(np.float32)
     return frames[..., None] * tint
@@ -152,6 +157,21 @@ def test_merged_chunks_equal_the_single_pass_bit_for_bit(bounds):
     # shuffled order: the merge does not depend on it
     partials = _chunked(frames, bounds, half_window=3)[::-1]
     _summaries_equal(merge_partials(partials, n_frames=64), expected)
+
+
+def test_flat_minima_are_centred_close_equal_dips_seen_and_minus_inf_ignored():
+    frames = _hard_sweep()
+    tracker = DipTracker(frames.shape[1:3], half_window=3)
+    tracker.update(frames)
+    summary = tracker.result()
+    # an even flat run 17..22: its later middle; a run longer than the window: h after its start
+    assert np.all(summary.minimum_frame[0, 2:4] == 20)
+    assert np.all(summary.minimum_frame[0, 4:] == 32) and np.all(summary.second_frame[0, 4:] == 20)
+    # equal dips closer than a window: the earlier is the minimum, the later the second
+    assert np.all(summary.minimum_frame[3, :3] == 44) and np.all(summary.second_frame[3, :3] == 49)
+    assert np.all(summary.second_value[3, :3] == summary.minimum_value[3, :3])
+    # -inf is counted, not taken for the deepest dip
+    assert summary.minimum_frame[5, 4] == 63 and summary.invalid_count[5, 4] == 1
 
 
 def test_second_dip_is_a_local_minimum_a_window_away_and_a_ramp_has_none():
@@ -194,3 +214,21 @@ def test_merge_rejects_gaps_and_short_feeds():
     tracker = DipTracker(frames.shape[1:3], half_window=2, owned=(20, 40))
     with pytest.raises(ValueError, match="first_index"):
         tracker.update(frames[20:30], first_index=20)
+
+
+@pytest.mark.parametrize("scale", [1.0, 3e5])  # 3e5: above 2**17, summed one sample at a time
+@pytest.mark.parametrize("block", [7, 40])
+def test_fixed_point_sums_are_exact_for_small_and_large_samples(scale, block):
+    from shadowcam.dip_kernels import quantise_sum
+
+    rng = np.random.default_rng(7)
+    frames = (rng.random((70, 3, 5, 3)) * scale).astype(np.float32)
+    frames[5, 1, 2, 1] = np.nan
+    tracker = DipTracker(frames.shape[1:3], half_window=2)
+    for start in range(0, 70, block):
+        tracker.update(frames[start:start + block])
+    partial = tracker.partial()
+    signal = frames[..., 0] + frames[..., 1] + frames[..., 2]  # float32, in channel order
+    np.testing.assert_array_equal(partial.signal_sum, quantise_sum(signal).sum(axis=0))
+    np.testing.assert_array_equal(partial.channel_sum, quantise_sum(frames).sum(axis=0))
+    np.testing.assert_array_equal(partial.count, np.isfinite(signal).sum(axis=0))

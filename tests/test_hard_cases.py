@@ -128,11 +128,6 @@ def test_area_source_penumbra_that_fits_the_window_is_timed_at_its_centre(method
     np.testing.assert_allclose(result["shadow_time"], 30.3, atol=0.1)
 
 
-@tracker_bug((
-    "DipTracker keeps the window around the FIRST frame of a flat smoothed "
-    "minimum (strict '<'), not its centre, so a 7-frame flat dip does not fit a 9-frame "
-    "window (half_window=4) and is flagged wide_dip; centring the window on the plateau "
-    "would time it"))
 def test_flat_minimum_narrower_than_the_window_is_timed():
     result = run(dips(60, 30.0, width=7.0), method="dip_centroid", half_window=4)
     assert (result["reason"] == OK).all()
@@ -156,11 +151,6 @@ def test_a_much_weaker_second_minimum_keeps_the_deeper_time():
     np.testing.assert_allclose(result["shadow_time"], 20.5, atol=0.05)
 
 
-@tracker_bug((
-    "a second, equally deep dip closer than one window (2*half_window+1 "
-    "frames) to the deepest one is neither recorded as the second minimum (which must be "
-    "a window away) nor, when it lies just outside the stored window, visible to the "
-    "classification: the pixel is timed at one of the two dips with reason ok"))
 @pytest.mark.parametrize("gap", [6.0, 8.0])
 def test_two_equal_minima_closer_than_a_window_are_flagged(gap):
     result = run(dips(60, [25.0, 25.0 + gap]), half_window=4)
@@ -191,6 +181,10 @@ def test_a_corrupt_sample_far_from_the_dip_is_ignored(bad):
     np.testing.assert_allclose(result["lit_level"], LEVEL, rtol=1e-6)
 
 
+@pytest.mark.xfail(strict=True, reason=(
+    "contradicts test_a_minus_inf_sample_far_from_the_dip_is_ignored (and DipTracker's "
+    "documented 'non-finite samples are counted and ignored'): it passed only through the "
+    "-inf bug, which made frame 3 the deepest dip; remove this test"))
 def test_a_minus_inf_sample_is_flagged_not_timed():
     frames = dips(40, 25.5)
     frames[3] = -np.inf
@@ -199,11 +193,6 @@ def test_a_minus_inf_sample_is_flagged_not_timed():
     assert (result["reason"] != OK).all()
 
 
-@tracker_bug((
-    "a -inf sample is counted as invalid but still enters the minimum search "
-    "(the smoothed signal is -inf there), so the deepest 'dip' is the corrupt frame and "
-    "the real dip is lost (the pixel is now flagged invalid_input rather than timed); "
-    "NaN and +inf are ignored as documented"))
 def test_a_minus_inf_sample_far_from_the_dip_is_ignored():
     frames = dips(40, 25.5)
     frames[3] = -np.inf
