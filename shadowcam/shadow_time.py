@@ -364,8 +364,8 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     noise_floor : float, optional
         Lower bound of the noise (signal units), for noise-free data.
     second_dip_ratio : float, optional
-        A second dip a window away at least this deep (relative to the first)
-        marks the pixel ``several_minima``.
+        A second dip (another local minimum more than half a window away) at
+        least this deep (relative to the first) marks the pixel ``several_minima``.
 
     Returns
     -------

@@ -19,11 +19,6 @@ from shadowcam.shadow_time import (OK, REASONS, SATURATED, SEVERAL_MINIMA, SHADO
                                    sweep_shadow_times)
 
 METHODS = sorted(SHADOW_TIME_METHODS)
-
-
-def tracker_bug(reason):
-    """Strict xfail for a known bug inside dip_tracker.py (routed to its owner)."""
-    return pytest.mark.xfail(strict=True, reason=f"dip_tracker: {reason}")
 LEVEL = 0.6  # lit level of the synthetic pixels (white = 1)
 
 
@@ -179,18 +174,6 @@ def test_a_corrupt_sample_far_from_the_dip_is_ignored(bad):
     assert (result["reason"] == OK).all()
     np.testing.assert_allclose(result["shadow_time"], 25.5, atol=0.05)
     np.testing.assert_allclose(result["lit_level"], LEVEL, rtol=1e-6)
-
-
-@pytest.mark.xfail(strict=True, reason=(
-    "contradicts test_a_minus_inf_sample_far_from_the_dip_is_ignored (and DipTracker's "
-    "documented 'non-finite samples are counted and ignored'): it passed only through the "
-    "-inf bug, which made frame 3 the deepest dip; remove this test"))
-def test_a_minus_inf_sample_is_flagged_not_timed():
-    frames = dips(40, 25.5)
-    frames[3] = -np.inf
-    result = run(frames)
-    check_invariants(result, 40)
-    assert (result["reason"] != OK).all()
 
 
 def test_a_minus_inf_sample_far_from_the_dip_is_ignored():
