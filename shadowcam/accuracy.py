@@ -281,11 +281,11 @@ def _dual_grid_map(dual_coords, ground_truth):
 
 
 def _map_points(homography, x, y):
-    """Apply a 3x3 homography to coordinate arrays `x`, `y` of any shape."""
-    w = homography[2, 0] * x + homography[2, 1] * y + homography[2, 2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return ((homography[0, 0] * x + homography[0, 1] * y + homography[0, 2]) / w,
-                (homography[1, 0] * x + homography[1, 1] * y + homography[1, 2]) / w)
+    """:func:`~shadowcam.dual_coords.apply_homography` on coordinate arrays `x`, `y` of any shape."""
+    from shadowcam.dual_coords import apply_homography
+
+    mapped = apply_homography(homography, np.column_stack([np.ravel(x), np.ravel(y)]))
+    return mapped[:, 0].reshape(np.shape(x)), mapped[:, 1].reshape(np.shape(x))
 
 
 def _reciprocal_on_grid(ground_truth, grid_map, shape):
