@@ -41,15 +41,16 @@ def naive_detection(stack, *, window=10, ratio=0.5):
     (rows, cols) int ndarray
         Frame index, -1 where never.
     """
+    from shadowcam.outdoor_accuracy import NaiveBaseline
+
     stack = np.asarray(stack, dtype=np.float64)
     if stack.ndim != 3:
         raise ValueError(f"stack: expected (K, rows, cols), got {stack.shape}")
-    found = np.full(stack.shape[1:], -1)
-    for k in range(1, stack.shape[0]):
-        recent = stack[max(0, k - window):k].max(axis=0)
-        hit = (found < 0) & (stack[k] < ratio * recent)
-        found[hit] = k
-    return found
+    # the pipeline's streaming baseline, timed in frame indices
+    baseline = NaiveBaseline(stack.shape[1:], window=window, fraction=ratio)
+    for k, frame in enumerate(stack):
+        baseline.update(frame[..., None], k)
+    return np.where(np.isnan(baseline.arrival_s), -1, baseline.arrival_s).astype(int)
 
 
 def capture_report(capture_dir):
