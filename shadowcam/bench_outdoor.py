@@ -26,6 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
+from shadowcam.frame_times import median_interval
+
 
 def naive_detection(stack, *, window=10, ratio=0.5):
     """First frame whose value drops below `ratio` x the max of the previous `window` frames.
@@ -73,7 +75,7 @@ def capture_report(capture_dir):
                         - raw.black_level_per_channel[0])
     raws = np.stack(raws)
     times = gt["times_s"].values
-    interval = float(np.median(np.diff(times)))
+    interval = median_interval(times)
     cls = gt["shadow_class"].values
     arrives = cls == 3
     report = {
