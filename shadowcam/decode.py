@@ -17,6 +17,7 @@ Offers
 RAW_EXTENSIONS : file-name suffixes decoded with rawpy.
 is_raw : whether a path is decoded as camera RAW.
 read_frame : one frame as a (H, W, 3) float32 array (optionally with its info).
+read_mosaic : a RAW frame's Bayer mosaic (uint16) and per-site black / white levels.
 header_metadata : exposure and capture time from the file header only.
 frame_info : size, bit depth, black/white levels, white balance, exposure and
     capture time of a frame, without decoding more than needed.
@@ -265,9 +266,26 @@ def _normalise_in_place(image, black, span):
         np.divide(image, span, out=image)
 
 
-def _decode_raw(path):
+def read_mosaic(path):
+    """Read a camera RAW file's visible Bayer mosaic and its levels, undemosaiced.
+
+    Parameters
+    ----------
+    path : str or Path
+        Camera RAW file (see :data:`RAW_EXTENSIONS`).
+
+    Returns
+    -------
+    mosaic : (M, N) uint16 ndarray
+        ``raw_image_visible``, in file units (DN).
+    levels : dict
+        ``cfa_pattern`` (e.g. ``"RGGB"``), ``black_sites`` and ``white_sites``
+        ((2, 2) float64 arrays: the black and white level of each site of the
+        top-left 2x2 block) and ``white_balance`` (as :func:`frame_info`).
+    """
     import rawpy
 
+    path = _check_path(path)
     try:
         raw = rawpy.imread(str(path))
     except (rawpy.LibRawError, OSError) as exc:
@@ -278,26 +296,32 @@ def _decode_raw(path):
                 f"{path}: RAW type {raw.raw_type.name} is not a single-plane Bayer mosaic; "
                 "convert it to TIFF or a Bayer DNG first"
             )
-        mosaic = raw.raw_image_visible
-        shape = mosaic.shape
+        mosaic = raw.raw_image_visible.copy()
         colours = raw.raw_colors_visible[:2, :2]  # CFA phase at the visible origin
         pattern = bayer_pattern(colours, raw.color_desc)
-        black_levels = np.asarray(raw.black_level_per_channel, dtype=np.float64)
-        black_sites = black_levels[colours]
-        white = float(raw.white_level)
+        black_sites = np.asarray(raw.black_level_per_channel, dtype=np.float64)[colours]
         white_per = raw.camera_white_level_per_channel
         white_sites = (
-            np.asarray(white_per, dtype=np.float64)[colours] if white_per is not None else np.full((2, 2), white)
+            np.asarray(white_per, dtype=np.float64)[colours] if white_per is not None
+            else np.full((2, 2), float(raw.white_level))
         )
         wb = _white_balance_rgb(raw.camera_whitebalance)
-        vmax = int(white_sites.max())
-        rgb, k = _demosaic_scaled(mosaic, pattern=pattern, max_value=vmax)
+    if np.any(white_sites <= black_sites):
+        raise ValueError(f"{path}: white level {white_sites.tolist()} not above black {black_sites.tolist()}")
+    return mosaic, {"cfa_pattern": pattern, "black_sites": black_sites, "white_sites": white_sites,
+                    "white_balance": wb}
+
+
+def _decode_raw(path):
+    mosaic, levels = read_mosaic(path)
+    shape = mosaic.shape
+    pattern, black_sites, white_sites = levels["cfa_pattern"], levels["black_sites"], levels["white_sites"]
+    vmax = int(white_sites.max())
+    rgb, k = _demosaic_scaled(mosaic, pattern=pattern, max_value=vmax)
     # (k * DN - k * black) / (k * (white - black)): exact at each CFA site's own
     # channel (integers below 2**24), computed in place on one float32 buffer
     black = _site_map(black_sites, shape, pattern, vmax) * np.float32(k)
     span = _site_map(white_sites, shape, pattern, vmax) * np.float32(k) - black
-    if np.any(span <= 0):
-        raise ValueError(f"{path}: white level {white_sites.tolist()} not above black {black_sites.tolist()}")
     image = rgb.astype(np.float32)
     _normalise_in_place(image, black, span)
     header = header_metadata(path)
@@ -311,7 +335,7 @@ def _decode_raw(path):
         "cfa_pattern": pattern,
         "black_level": [float(np.mean(black_sites[np.array(list(pattern)).reshape(2, 2) == c])) for c in _RGB],
         "white_level": float(white_sites.max()),
-        "white_balance": wb,
+        "white_balance": levels["white_balance"],
         "exposure_s": header["exposure_s"],
         "capture_time": header["capture_time"],
     }

@@ -21,8 +21,9 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from shadowcam.decode import read_frame
+from shadowcam.decode import is_raw, read_frame, read_mosaic
 from shadowcam.dip_tracker import DipTracker, merge_partials
+from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal, site_constants
 from shadowcam.shadow_time import summary_shadow_times
 
 #: worker start method: rawpy (OpenMP) may deadlock in forked processes
@@ -48,8 +49,42 @@ def chunk_bounds(n_frames, n_chunks):
     return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if b > a]
 
 
+class _MosaicFrames:
+    """Per-frame signal of RAW files straight from their mosaic, with the sweep's colour sums.
+
+    Feeds the tracker :func:`shadowcam.mosaic_signal.mosaic_signal` planes
+    and keeps, over the owned frames, the exact integer sum of each mosaic
+    site and whether any site the pixel interpolates from clipped.
+    """
+
+    def __init__(self, first_path, owned, saturation_level):
+        mosaic, self.levels = read_mosaic(first_path)
+        self.shape = mosaic.shape
+        self.owned = owned
+        self.saturation_level = saturation_level
+        self.site_sum = np.zeros(self.shape, np.int64)
+        self.saturated = np.zeros(self.shape, bool)
+
+    def read_into(self, path, index, out):
+        mosaic, levels = read_mosaic(path)
+        if mosaic.shape != self.shape or levels["cfa_pattern"] != self.levels["cfa_pattern"]:
+            raise ValueError(f"frame {path} has a {mosaic.shape} {levels['cfa_pattern']} mosaic but the "
+                             f"sweep's first frame has {self.shape} {self.levels['cfa_pattern']}")
+        owned = self.owned[0] <= index < self.owned[1]
+        mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
+                      white=levels["white_sites"], out=out,
+                      saturation_level=self.saturation_level if owned else np.inf, saturated=self.saturated)
+        if owned:
+            np.add(self.site_sum, mosaic, out=self.site_sum)
+
+
 def _track_chunk(paths, owned, half_window, block_frames, saturation_level, threads):
-    """Worker: decode the padded frames of one owned chunk and return its DipPartial."""
+    """Worker: decode the padded frames of one owned chunk; return its DipPartial (and RAW sums).
+
+    RAW files are tracked from their mosaic (one signal plane per frame, see
+    :mod:`shadowcam.mosaic_signal`); the partial then comes with the chunk's
+    per-site sums and clipped-pixel mask, else with None.
+    """
     if threads is not None:
         import numba
 
@@ -57,20 +92,38 @@ def _track_chunk(paths, owned, half_window, block_frames, saturation_level, thre
     start, stop = owned
     pad = DipTracker.padding(half_window)
     first, last = max(0, start - pad), min(len(paths), stop + pad)
-    tracker = None
+    mosaic = _MosaicFrames(paths[first], owned, saturation_level) if is_raw(paths[first]) else None
+    if mosaic is not None:
+        shape, frame_shape = mosaic.shape, mosaic.shape
+    else:
+        frame_shape = read_frame(paths[first]).shape
+        shape = frame_shape[:2]
+    # the mosaic signal is a sum of three channels: clipping is judged per site instead
+    tracker = DipTracker(shape, half_window=half_window, owned=owned,
+                         saturation_level=np.inf if mosaic is not None else saturation_level)
+    buffer = np.empty((block_frames,) + frame_shape, np.float32)
     block = []
     for index in range(first, last):
-        image = read_frame(paths[index])
-        if tracker is None:
-            tracker = DipTracker(image.shape[:2], half_window=half_window, owned=owned,
-                                 saturation_level=saturation_level)
-            buffer = np.empty((block_frames,) + image.shape, np.float32)
-        buffer[len(block)] = image
+        if mosaic is not None:
+            mosaic.read_into(paths[index], index, buffer[len(block)])
+        else:
+            buffer[len(block)] = read_frame(paths[index])
         block.append(index)
         if len(block) == block_frames or index == last - 1:
             tracker.update(buffer[:len(block)], first_index=block[0])
             block = []
-    return tracker.partial()
+    sums = None if mosaic is None else (mosaic.site_sum, mosaic.saturated, mosaic.levels)
+    return tracker.partial(), sums
+
+
+def _mosaic_colour(summary, site_sum, saturated, levels):
+    """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place)."""
+    black = site_constants(levels["black_sites"], site_sum.shape)
+    span = site_constants(levels["white_sites"], site_sum.shape) - black
+    normalised = (site_sum - summary.n_frames * black) / span
+    summary.channel_sum = bilinear_channels(normalised, pattern=levels["cfa_pattern"])
+    summary.saturated = summary.saturated | saturated
+    return summary
 
 
 def track_files(paths, *, half_window=4, workers=2, block_frames=8, saturation_level=0.999):
@@ -79,7 +132,10 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=8, saturation_l
     Parameters
     ----------
     paths : sequence of str or Path
-        Frame files in time order (anything :func:`shadowcam.decode.read_frame` reads).
+        Frame files in time order (anything :func:`shadowcam.decode.read_frame`
+        reads). RAW files are tracked from their Bayer mosaic without
+        demosaicking each frame (:mod:`shadowcam.mosaic_signal`): the same
+        channel-sum signal as the demosaiced frames, up to float32 rounding.
     half_window : int, optional
         See :class:`~shadowcam.dip_tracker.DipTracker`.
     workers : int, optional
@@ -101,12 +157,17 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=8, saturation_l
     chunks = chunk_bounds(len(paths), int(workers))
     args = (half_window, int(block_frames), saturation_level)
     if len(chunks) == 1:
-        partials = [_track_chunk(paths, chunks[0], *args, None)]
+        results = [_track_chunk(paths, chunks[0], *args, None)]
     else:
         with ProcessPoolExecutor(len(chunks), mp_context=_CONTEXT) as pool:
             futures = [pool.submit(_track_chunk, paths, owned, *args, 1) for owned in chunks]
-            partials = [f.result() for f in futures]
-    return merge_partials(partials, n_frames=len(paths))
+            results = [f.result() for f in futures]
+    summary = merge_partials([partial for partial, _ in results], n_frames=len(paths))
+    if results[0][1] is None:
+        return summary
+    site_sum = sum(sums[0] for _, sums in results)  # exact: integers
+    saturated = np.logical_or.reduce([sums[1] for _, sums in results])
+    return _mosaic_colour(summary, site_sum, saturated, results[0][1][2])
 
 
 def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, workers=2,
