@@ -21,8 +21,9 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from shadowcam.decode import is_raw, read_frame, read_mosaic
+from shadowcam.decode import is_raw, read_frame
 from shadowcam.dip_tracker import DipTracker, merge_partials
+from shadowcam.mosaic_reader import MosaicReader
 from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal, site_constants
 from shadowcam.shadow_time import summary_shadow_times
 
@@ -58,18 +59,15 @@ class _MosaicFrames:
     """
 
     def __init__(self, first_path, owned, saturation_level):
-        mosaic, self.levels = read_mosaic(first_path)
-        self.shape = mosaic.shape
+        self.reader = MosaicReader(first_path)
+        self.levels, self.shape = self.reader.levels, self.reader.shape
         self.owned = owned
         self.saturation_level = saturation_level
         self.site_sum = np.zeros(self.shape, np.int64)
         self.saturated = np.zeros(self.shape, bool)
 
     def read_into(self, path, index, out):
-        mosaic, levels = read_mosaic(path)
-        if mosaic.shape != self.shape or levels["cfa_pattern"] != self.levels["cfa_pattern"]:
-            raise ValueError(f"frame {path} has a {mosaic.shape} {levels['cfa_pattern']} mosaic but the "
-                             f"sweep's first frame has {self.shape} {self.levels['cfa_pattern']}")
+        mosaic, levels = self.reader.read(path)
         owned = self.owned[0] <= index < self.owned[1]
         mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
                       white=levels["white_sites"], out=out,
