@@ -2,7 +2,7 @@
 
 Offers
 ------
-write_dng : write a Bayer CFA mosaic as an uncompressed DNG that rawpy decodes exactly.
+write_dng : write a Bayer CFA mosaic as a DNG (uncompressed or lossless JPEG) that rawpy decodes exactly.
 write_tiff16 : write a (rows, cols, 3) uint16 linear RGB image as a TIFF.
 format_capture_time : EXIF ``YYYY:MM:DD HH:MM:SS`` string of a ``datetime``.
 format_subseconds : EXIF ``SubSecTimeOriginal`` digits of a ``datetime`` (ms or us).
@@ -16,7 +16,9 @@ depth (8, 10 and 12 bit packed MSB-first as DNG requires; 14-bit data are stored
 """
 
 import datetime
+import sys
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 
@@ -42,9 +44,31 @@ def format_subseconds(when):
     return f"{us // 1000:03d}" if us % 1000 == 0 else f"{us:06d}"
 
 
+def _lossless_jpeg_encoder():
+    """pidng's lossless-JPEG encoder module, backed by imagecodecs.
+
+    pidng imports ``ljpegCompress.pack16tolj`` when asked to compress; that C
+    extension no longer works on current Pythons (``PY_SSIZE_T_CLEAN``), so the
+    same function is provided from imagecodecs' LJ92 encoder: the mosaic as
+    ``height`` rows of ``width`` samples (pidng passes two mosaic rows per
+    JPEG row, as cameras do).
+    """
+    import types
+
+    import imagecodecs
+
+    def pack16tolj(frame, width, height, bits, *_):
+        samples = np.ascontiguousarray(frame, np.uint16).reshape(int(height), int(width))
+        return imagecodecs.ljpeg_encode(samples, bitspersample=int(bits))
+
+    module = types.ModuleType("ljpegCompress")
+    module.pack16tolj = pack16tolj
+    return module
+
+
 def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_time=None,
-              exposure_time=None):
-    """Write a Bayer RGGB mosaic as an uncompressed DNG.
+              exposure_time=None, compression="none"):
+    """Write a Bayer RGGB mosaic as a DNG, uncompressed or lossless-JPEG compressed.
 
     Parameters
     ----------
@@ -64,6 +88,9 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
         ``SubsecTimeOriginal`` (when not zero).
     exposure_time : float, optional
         Seconds, written as ``ExposureTime`` (a rational with denominator 10**6).
+    compression : {"none", "ljpeg"}, optional
+        ``ljpeg``: one lossless-JPEG (LJ92) tile, as cameras write their DNGs
+        (``BitsPerSample`` is then `bit_depth`).
 
     Returns
     -------
@@ -79,6 +106,8 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
     rows, cols = raw.shape
     if rows % 2 or cols % 2 or rows == 0:
         raise ValueError(f"raw: rows and cols must be even and positive, got {raw.shape}")
+    if compression not in ("none", "ljpeg"):
+        raise ValueError(f"compression: must be 'none' or 'ljpeg', got {compression!r}")
     if bit_depth not in _PACKABLE_BITS:
         raise ValueError(f"bit_depth: must be one of {_PACKABLE_BITS}, got {bit_depth}")
     max_value = 2**bit_depth - 1
@@ -98,7 +127,7 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
     tags.set(Tag.Orientation, 1)
     tags.set(Tag.PhotometricInterpretation, PhotometricInterpretation.Color_Filter_Array)
     tags.set(Tag.SamplesPerPixel, 1)
-    tags.set(Tag.BitsPerSample, _STORAGE_BITS[bit_depth])
+    tags.set(Tag.BitsPerSample, bit_depth if compression == "ljpeg" else _STORAGE_BITS[bit_depth])
     tags.set(Tag.CFARepeatPatternDim, [2, 2])
     tags.set(Tag.CFAPattern, CFAPattern.RGGB)
     tags.set(Tag.BlackLevelRepeatDim, [1, 1])
@@ -126,8 +155,9 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
 
     path = Path(path)
     converter = RAW2DNG()
-    converter.options(tags, path=str(path.parent), compress=False)
-    buffer = converter.convert(np.ascontiguousarray(raw))  # in memory: pidng appends .dng
+    converter.options(tags, path=str(path.parent), compress=compression == "ljpeg")
+    with mock.patch.dict(sys.modules, {"ljpegCompress": _lossless_jpeg_encoder()} if compression == "ljpeg" else {}):
+        buffer = converter.convert(np.ascontiguousarray(raw))  # in memory: pidng appends .dng
     path.write_bytes(bytes(buffer))
     return path
 

@@ -16,8 +16,12 @@ def _mosaic(seed, shape=(24, 40), top=16383):
     return np.random.default_rng(seed).integers(0, top + 1, shape).astype(np.uint16)
 
 
-def test_uncompressed_16_bit_dngs_are_read_directly_and_exactly(tmp_path):
-    paths = [write_dng(tmp_path / f"f{k}.dng", _mosaic(k), bit_depth=14, black_level=512) for k in range(3)]
+@pytest.mark.parametrize("bit_depth, compression", [(14, "none"), (12, "none"), (10, "none"),
+                                                    (14, "ljpeg"), (12, "ljpeg")])
+def test_dngs_are_read_directly_and_exactly_as_rawpy_reads_them(tmp_path, bit_depth, compression):
+    """16-bit, bit-packed and lossless-JPEG DNGs."""
+    paths = [write_dng(tmp_path / f"f{k}.dng", _mosaic(k, top=2**bit_depth - 1), bit_depth=bit_depth,
+                       black_level=64, compression=compression) for k in range(3)]
     reader = MosaicReader(paths[0])
     assert reader.direct
     for path in paths:
@@ -35,11 +39,12 @@ def test_a_frame_with_other_levels_is_read_with_rawpy(tmp_path):
     assert levels["black_sites"].tolist() == [[600.0, 600.0], [600.0, 600.0]]
 
 
-def test_bit_packed_dngs_use_rawpy(tmp_path):
-    path = write_dng(tmp_path / "p.dng", _mosaic(2, top=4095), bit_depth=12, black_level=256)
-    reader = MosaicReader(path)
-    assert not reader.direct
-    np.testing.assert_array_equal(reader.read(path)[0], read_mosaic(path)[0])
+def test_a_frame_compressed_otherwise_is_read_with_rawpy(tmp_path):
+    first = write_dng(tmp_path / "a.dng", _mosaic(0), bit_depth=14, black_level=512)
+    other = write_dng(tmp_path / "b.dng", _mosaic(1), bit_depth=14, black_level=512, compression="ljpeg")
+    reader = MosaicReader(first)
+    assert reader._direct(other)[0] != reader._layout
+    np.testing.assert_array_equal(reader.read(other)[0], read_mosaic(other)[0])
 
 
 @pytest.mark.skipif(not SHARED_RAW.is_dir(), reason="shared dev data not present")

@@ -10,12 +10,13 @@ import tifffile
 from shadowcam.raw_writer import write_dng, write_tiff16
 
 
-@pytest.mark.parametrize("bit_depth", [12, 14])
-def test_dng_round_trips_through_rawpy(tmp_path, bit_depth):
+@pytest.mark.parametrize("bit_depth, compression", [(12, "none"), (14, "none"), (12, "ljpeg"), (14, "ljpeg")])
+def test_dng_round_trips_through_rawpy(tmp_path, bit_depth, compression):
     rng = np.random.default_rng(bit_depth)
     raw = rng.integers(0, 2**bit_depth, size=(32, 48)).astype(np.uint16)
     path = write_dng(tmp_path / "f.dng", raw, bit_depth=bit_depth, black_level=256,
-                     capture_time=datetime.datetime(2024, 5, 6, 7, 8, 9))
+                     capture_time=datetime.datetime(2024, 5, 6, 7, 8, 9), compression=compression)
+    assert tifffile.TiffFile(path).pages[0].compression == {"none": 1, "ljpeg": 7}[compression]
     with rawpy.imread(str(path)) as r:
         np.testing.assert_array_equal(r.raw_image_visible, raw)
         np.testing.assert_array_equal(r.raw_pattern, [[0, 1], [3, 2]])
@@ -36,6 +37,9 @@ def test_dng_rejects_bad_input(tmp_path):
     with pytest.raises(ValueError, match="bit_depth"):
         write_dng(tmp_path / "a.dng", np.zeros((32, 32), np.uint16), bit_depth=13,
                   black_level=0)
+    with pytest.raises(ValueError, match="compression"):
+        write_dng(tmp_path / "a.dng", np.zeros((32, 32), np.uint16), bit_depth=12,
+                  black_level=0, compression="zip")
 
 
 def test_tiff16_round_trips(tmp_path):
