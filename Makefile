@@ -3,8 +3,8 @@
 # `make bench-outdoor` reruns the outdoor pipeline on dev_ridge and prints per-stage
 # wall time / peak memory and the arrival-time accuracy (ours and the naive baseline);
 # `make bench-outdoor-size` the same stages at a camera's size (24 MP by default), extrapolated.
-# `make bench` prints the speed benchmark (not part of the tests; ~10 min, renders
-# its DNG input once into results/bench/dng and reuses it).
+# `make bench` prints the speed benchmark (not part of the tests; ~10 min per compression,
+# renders its DNG input once into results/bench/dng-<compression> and reuses it).
 # Every target installs the package (editable, with test and SLURM-executor extras) into .venv first.
 
 PYTHON ?= python3
@@ -17,6 +17,8 @@ DATASET ?= synthetic_lab,synthetic_ridge
 
 OUTDOOR ?= dev_ridge
 BENCH_ARGS ?=
+# DNG compressions benchmarked: lossless JPEG (what cameras write), none (rawpy's cheapest decode)
+BENCH_COMPRESSION ?= ljpeg none
 # bench-outdoor-size: real-size sample (COLSxROWS), frames, frames per first-pass job, scratch dir
 BENCH_SIZE ?= 6000x4000
 BENCH_FRAMES ?= 16
@@ -62,7 +64,10 @@ bench-outdoor: $(STAMP)
 	print('targets (' + r['condition'] + '):', 'met' if r['all_targets_pass'] else 'NOT met')"
 
 bench: $(STAMP)
-	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/shadowcam bench --dir results/bench/dng --json results/bench/figures.json $(BENCH_ARGS)
+	for c in $(BENCH_COMPRESSION); do \
+	  PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/shadowcam bench --compression $$c \
+	    --json results/bench/figures-$$c.json $(BENCH_ARGS) || exit 1; \
+	done
 
 # The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of dev_ridge
 # upsampled to BENCH_SIZE (14-bit DNG, full-resolution noise) run in a scratch copy of the

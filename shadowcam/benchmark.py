@@ -2,14 +2,18 @@
 
 A wire's shadow sweeps a textured plane; frames are rendered analytically
 (exact shadow time at every pixel centre), mosaicked, given sensor noise and
-written as 14-bit DNG files. The benchmark then measures, on this machine:
+written as 14-bit DNG files (lossless-JPEG compressed as cameras write them,
+or uncompressed). The benchmark then measures, on this machine:
 
 * end to end, DNG files -> shadow-time maps (:func:`shadowcam.sweep_files.sweep_shadow_times_from_files`,
-  both cores), against the decode floor: the same files decoded by the
-  pipeline's own decoder (and by rawpy alone) in as many processes, doing
-  nothing else;
-* the shadow-time stage alone on in-memory frames, in pixel-frames per
-  second, against one numpy pass over the same bytes (memory-bandwidth floor);
+  both cores), against the decode floor: rawpy decoding the same files with
+  the pipeline's settings (the mosaic, ``raw_image_visible``) in as many
+  processes and doing nothing else; the pipeline's own mosaic reader and
+  the demosaicing ``read_frame`` are timed alike for context;
+* the shadow-time stage alone on in-memory frames (the channel-sum planes
+  the file pipeline tracks, and the RGB frames of the workflow's store), in
+  pixel-frames per second, against one numpy pass over the same bytes
+  (memory-bandwidth floor);
 * the peak memory of the end-to-end run for a short and a long sequence;
 * the accuracy of the default configuration against the exact truth.
 
@@ -108,17 +112,17 @@ class WireScene:
 _SENSOR = SensorModel(bit_depth=14, black_level=512, gain=1.0, read_noise=4.0)
 
 
-def _write_frames(scene, directory, indices):
+def _write_frames(scene, directory, indices, compression):
     """Worker: render, add noise and write frames `indices` of `scene`."""
     albedo = scene.albedo()
     for k in indices:
         raw = simulate_raw(scene.frame(k, albedo), sensor=_SENSOR, scale=scene.electrons,
                            seed=[scene.seed, int(k)])
         write_dng(Path(directory) / f"frame_{k:05d}.dng", raw, bit_depth=14,
-                  black_level=_SENSOR.black_level)
+                  black_level=_SENSOR.black_level, compression=compression)
 
 
-def write_sweep_dngs(scene, directory, *, workers=2):
+def write_sweep_dngs(scene, directory, *, workers=2, compression="none"):
     """Render `scene` to ``directory/frame_NNNNN.dng`` unless already there; return the paths.
 
     Parameters
@@ -128,6 +132,8 @@ def write_sweep_dngs(scene, directory, *, workers=2):
         Reused when its ``scene.json`` matches `scene`.
     workers : int, optional
         Rendering processes.
+    compression : {"none", "ljpeg"}, optional
+        DNG compression (see :func:`shadowcam.raw_writer.write_dng`).
 
     Returns
     -------
@@ -136,14 +142,15 @@ def write_sweep_dngs(scene, directory, *, workers=2):
     directory = Path(directory)
     stamp = directory / "scene.json"
     paths = [directory / f"frame_{k:05d}.dng" for k in range(scene.n_frames)]
-    if stamp.is_file() and json.loads(stamp.read_text()) == asdict(scene) and all(p.is_file() for p in paths):
+    written = dict(asdict(scene), compression=compression)
+    if stamp.is_file() and json.loads(stamp.read_text()) == written and all(p.is_file() for p in paths):
         return paths
     directory.mkdir(parents=True, exist_ok=True)
     stamp.unlink(missing_ok=True)
     parts = np.array_split(np.arange(scene.n_frames), workers)
     with ProcessPoolExecutor(workers, mp_context=_CONTEXT) as pool:
-        list(pool.map(_write_frames, [scene] * workers, [directory] * workers, parts))
-    stamp.write_text(json.dumps(asdict(scene)))
+        list(pool.map(_write_frames, [scene] * workers, [directory] * workers, parts, [compression] * workers))
+    stamp.write_text(json.dumps(written))
     return paths
 
 
@@ -154,6 +161,12 @@ def _decode_files(paths, reader):
         for path in paths:
             with rawpy.imread(str(path)) as raw:
                 raw.raw_image_visible.copy()
+    elif reader == "direct":
+        from shadowcam.mosaic_reader import MosaicReader
+
+        mosaics = MosaicReader(paths[0])
+        for path in paths:
+            mosaics.read(path)
     else:
         from shadowcam.decode import read_frame
 
@@ -161,17 +174,19 @@ def _decode_files(paths, reader):
             read_frame(path)
 
 
-def decode_floor_seconds(paths, *, workers=2, reader="shadowcam"):
+def decode_floor_seconds(paths, *, workers=2, reader="rawpy"):
     """Wall time to decode `paths` in `workers` processes and do nothing else.
 
     Parameters
     ----------
     paths : sequence of Path
     workers : int, optional
-    reader : {"shadowcam", "rawpy"}, optional
-        ``shadowcam``: :func:`shadowcam.decode.read_frame` (rawpy, demosaic,
-        linear float32 -- the pipeline's own decode); ``rawpy``: open and
-        unpack the mosaic only.
+    reader : {"rawpy", "direct", "read_frame"}, optional
+        ``rawpy``: open and unpack the mosaic (``raw_image_visible``), the
+        settings of the pipeline's RAW decode; ``direct``: the pipeline's
+        :class:`~shadowcam.mosaic_reader.MosaicReader`; ``read_frame``:
+        :func:`shadowcam.decode.read_frame` (rawpy, bilinear demosaic, linear
+        float32: what the workflow's decode step stores).
     """
     parts = [list(p) for p in np.array_split(np.array(paths, dtype=object), workers)]
     with ProcessPoolExecutor(workers, mp_context=_CONTEXT) as pool:
@@ -289,7 +304,33 @@ def end_to_end(paths, *, workers=2, out=None):
     return figures["seconds"], figures["peak_rss_mib"], shadow_time
 
 
-def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=240, log=print):
+def _stage_frames(paths, rows, cols):
+    """In-memory frames of a crop, as the two pipelines track them.
+
+    Returns
+    -------
+    rgb : (T, h, w, 3) float32 ndarray
+        Demosaiced frames (what the workflow's frame store holds).
+    signal : (T, h, w, 1) float32 ndarray
+        Channel-sum planes from the mosaic (what the file pipeline tracks).
+    """
+    from shadowcam.decode import read_frame
+    from shadowcam.mosaic_reader import MosaicReader
+    from shadowcam.mosaic_signal import mosaic_signal
+
+    mosaics = MosaicReader(paths[0])
+    rgb, signal = [], []
+    for path in paths:
+        rgb.append(read_frame(path)[rows, cols])
+        mosaic, levels = mosaics.read(path)
+        plane, _ = mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
+                                 white=levels["white_sites"])
+        signal.append(plane[rows, cols, None])
+    return np.stack(rgb), np.stack(signal)
+
+
+def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=240, compression="ljpeg",
+                  log=print):
     """Measure every figure of ``make bench``.
 
     Parameters
@@ -305,6 +346,9 @@ def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=2
     stage_frames : int, optional
         In-memory frames (central quarter of the image) for the stage-alone
         measurement; enough that the per-pixel minimum lists settle.
+    compression : {"ljpeg", "none"}, optional
+        DNG compression of the rendered files: lossless JPEG as cameras
+        write, or none (where rawpy's decode is cheapest).
     log : callable, optional
         Progress messages.
 
@@ -313,34 +357,34 @@ def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=2
     dict
         Figures (see :func:`format_report`).
     """
-    from shadowcam.decode import read_frame
-
     scene = scene or WireScene()
-    log(f"rendering {scene.n_frames} DNG frames of {scene.height}x{scene.width_px} into {directory} ...")
-    paths = write_sweep_dngs(scene, directory, workers=workers)
+    log(f"rendering {scene.n_frames} DNG frames ({compression}) of {scene.height}x{scene.width_px} "
+        f"into {directory} ...")
+    paths = write_sweep_dngs(scene, directory, workers=workers, compression=compression)
     pixels = scene.height * scene.width_px
     figures = {"height": scene.height, "width": scene.width_px, "n_frames": scene.n_frames,
-               "short": short, "workers": workers}
+               "short": short, "workers": workers, "compression": compression}
 
     log("reading the files once (page cache) ...")
     for path in paths:
         path.read_bytes()
-    log("decode floor, end to end, decode floor again ...")
-    floor_long = decode_floor_seconds(paths, workers=workers)
-    rawpy_long = decode_floor_seconds(paths, workers=workers, reader="rawpy")
+    log("decode floors, end to end, rawpy floor again ...")
+    floors = {reader: decode_floor_seconds(paths, workers=workers, reader=reader)
+              for reader in ("rawpy", "direct", "read_frame")}
     e2e_long, rss_long, shadow_time = end_to_end(paths, workers=workers)
-    floor_long = min(floor_long, decode_floor_seconds(paths, workers=workers))
+    floors["rawpy"] = min(floors["rawpy"], decode_floor_seconds(paths, workers=workers))
     log("end to end, short sequence ...")
     e2e_short, rss_short, _ = end_to_end(paths[:short], workers=workers)
+    pixel_frames = pixels * scene.n_frames
     figures.update(
-        decode_floor_s=floor_long, rawpy_floor_s=rawpy_long, end_to_end_s=e2e_long,
-        end_to_end_mpfs=pixels * scene.n_frames / e2e_long / 1e6,
-        decode_floor_mpfs=pixels * scene.n_frames / floor_long / 1e6,
-        rawpy_floor_mpfs=pixels * scene.n_frames / rawpy_long / 1e6,
-        ratio_to_decode_floor=floor_long / e2e_long, ratio_to_rawpy_floor=rawpy_long / e2e_long,
+        end_to_end_s=e2e_long, end_to_end_mpfs=pixel_frames / e2e_long / 1e6,
+        ratio_to_decode_floor=floors["rawpy"] / e2e_long,
         peak_rss_short_mib=rss_short, peak_rss_long_mib=rss_long,
         peak_rss_ratio=rss_long / rss_short, end_to_end_short_s=e2e_short,
     )
+    for reader, seconds in floors.items():
+        figures[f"{reader}_floor_s"] = seconds
+        figures[f"{reader}_floor_mpfs"] = pixel_frames / seconds / 1e6
     truth = scene.truth()
     figures["accuracy"] = shadow_time_errors(shadow_time, truth, lit=np.ones(truth.shape, bool))
 
@@ -348,20 +392,20 @@ def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=2
     middle = scene.n_frames // 2 - stage_frames // 2
     rows = slice(scene.height // 4, scene.height // 4 + scene.height // 2)
     cols = slice(scene.width_px // 4, scene.width_px // 4 + scene.width_px // 2)
-    frames = np.stack([read_frame(p)[rows, cols] for p in paths[middle:middle + stage_frames]])
-    tracking, finishing = stage_seconds(frames)
-    numpy_pass = numpy_pass_seconds(frames)
-    figures["tracking_cpu_ns"] = tracking_cpu_ns(frames)
-    crop = frames.shape[1] * frames.shape[2]
-    figures.update(
-        stage_frames=stage_frames,
-        stage_tracking_mpfs=crop * stage_frames / tracking / 1e6,
-        stage_finish_s=finishing * pixels / crop,
-        numpy_pass_mpfs=crop * stage_frames / numpy_pass / 1e6,
-        ratio_to_numpy_pass=numpy_pass / tracking,
-    )
-    figures["stage_with_finish_mpfs_at_n"] = pixels * scene.n_frames / (
-        pixels * scene.n_frames / (figures["stage_tracking_mpfs"] * 1e6) + figures["stage_finish_s"]) / 1e6
+    stages = dict(zip(("rgb", "signal"), _stage_frames(paths[middle:middle + stage_frames], rows, cols)))
+    figures["stage_frames"] = stage_frames
+    for name, frames in stages.items():
+        tracking, finishing = stage_seconds(frames)
+        numpy_pass = numpy_pass_seconds(frames)
+        crop = frames.shape[1] * frames.shape[2]
+        stage_mpfs = crop * stage_frames / tracking / 1e6
+        finish_s = finishing * pixels / crop
+        figures[name] = {
+            "tracking_mpfs": stage_mpfs, "numpy_pass_mpfs": crop * stage_frames / numpy_pass / 1e6,
+            "ratio_to_numpy_pass": numpy_pass / tracking, "tracking_cpu_ns": tracking_cpu_ns(frames),
+            "finish_s": finish_s,
+            "with_finish_mpfs_at_n": pixel_frames / (pixel_frames / (stage_mpfs * 1e6) + finish_s) / 1e6,
+        }
     return figures
 
 
@@ -369,27 +413,39 @@ def format_report(figures):
     """Printable text of :func:`run_benchmark`'s figures."""
     f = figures
     acc = f["accuracy"]
+    floor_note = {
+        "rawpy": "rawpy open + raw_image_visible: the pipeline's rawpy settings, nothing else",
+        "direct": "shadowcam.mosaic_reader: the pipeline's own mosaic read (checked against rawpy)",
+        "read_frame": "shadowcam.decode.read_frame: rawpy + bilinear demosaic + float32 RGB",
+    }
     lines = [
         f"shadowcam benchmark: {f['n_frames']} DNG frames of {f['height']}x{f['width']} "
-        f"(14-bit, uncompressed), {f['workers']} processes; best-effort timings on a shared machine",
+        f"(14-bit, compression {f['compression']}), {f['workers']} processes; best-effort timings on a shared machine",
         "",
         "end to end (DNG files -> shadow-time map, default method):",
-        f"  pipeline           {f['end_to_end_s']:8.1f} s  {f['end_to_end_mpfs']:8.1f} M pixel-frames/s",
-        f"  decode floor       {f['decode_floor_s']:8.1f} s  {f['decode_floor_mpfs']:8.1f} M pixel-frames/s"
-        "   (shadowcam.decode.read_frame: rawpy + demosaic + linear float32, nothing else)",
-        f"  rawpy-only floor   {f['rawpy_floor_s']:8.1f} s  {f['rawpy_floor_mpfs']:8.1f} M pixel-frames/s"
-        "   (rawpy open + raw_image_visible)",
-        f"  ratio to decode floor  {f['ratio_to_decode_floor']:.2f}   (target >= 0.8)",
-        f"  ratio to rawpy floor   {f['ratio_to_rawpy_floor']:.2f}",
+        f"  pipeline            {f['end_to_end_s']:8.1f} s  {f['end_to_end_mpfs']:8.1f} M pixel-frames/s",
+    ]
+    for reader, note in floor_note.items():
+        lines.append(f"  {reader + ' floor':19s} {f[reader + '_floor_s']:8.1f} s  "
+                     f"{f[reader + '_floor_mpfs']:8.1f} M pixel-frames/s   ({note})")
+    lines += [
+        f"  ratio to decode floor (rawpy)  {f['ratio_to_decode_floor']:.2f}   (target >= 0.8)",
         "",
-        f"shadow-time stage alone ({f['stage_frames']} in-memory (T, H/2, W/2, 3) float32 frames):",
-        f"  tracking           {f['stage_tracking_mpfs']:8.1f} M pixel-frames/s",
-        f"  one numpy pass     {f['numpy_pass_mpfs']:8.1f} M pixel-frames/s over the same bytes",
-        f"  ratio to numpy pass    {f['ratio_to_numpy_pass']:.3f}   (aim >= 0.25)",
-        f"  tracker CPU time   {f['tracking_cpu_ns']:8.1f} ns per pixel-frame on one thread"
-        " (process CPU time: less sensitive to other jobs)",
-        f"  classify + time (once per sweep, scaled to the full image) {f['stage_finish_s']:.2f} s;"
-        f" whole stage at {f['n_frames']} frames {f['stage_with_finish_mpfs_at_n']:.1f} M pixel-frames/s",
+        f"shadow-time stage alone ({f['stage_frames']} in-memory frames of the central quarter):",
+    ]
+    for name, label in (("signal", "(T, H/2, W/2) channel-sum planes, as the file pipeline tracks them"),
+                        ("rgb", "(T, H/2, W/2, 3) RGB frames, as the workflow's frame store holds them")):
+        g = f[name]
+        lines += [
+            f"  {label}:",
+            f"    tracking        {g['tracking_mpfs']:8.1f} M pixel-frames/s;"
+            f" one numpy pass over the same bytes {g['numpy_pass_mpfs']:8.1f}",
+            f"    ratio to numpy pass    {g['ratio_to_numpy_pass']:.3f}   (aim >= 0.25);"
+            f" tracker CPU {g['tracking_cpu_ns']:.1f} ns per pixel-frame on one thread",
+            f"    classify + time once per sweep (full image) {g['finish_s']:.2f} s;"
+            f" whole stage at {f['n_frames']} frames {g['with_finish_mpfs_at_n']:.1f} M pixel-frames/s",
+        ]
+    lines += [
         "",
         "peak memory of the end-to-end run (parent + workers):",
         f"  {f['short']:5d} frames  {f['peak_rss_short_mib']:8.0f} MiB",

@@ -21,7 +21,9 @@ def add_parser(subparsers, name):
     """Register ``bench`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="speed benchmark (make bench)",
                                    description=__doc__.split("\n\n")[0].strip("`"))
-    parser.add_argument("--dir", default="results/bench/dng", help="where the DNG sweep is rendered")
+    parser.add_argument("--dir", help="where the DNG sweep is rendered (default results/bench/dng-<compression>)")
+    parser.add_argument("--compression", choices=("ljpeg", "none"), default="ljpeg",
+                        help="DNG compression: lossless JPEG as cameras write (default), or none")
     parser.add_argument("--frames", type=int, default=1000, help="frames of the long sequence")
     parser.add_argument("--short", type=int, default=100, help="frames of the short sequence")
     parser.add_argument("--height", type=int, default=1200)
@@ -39,8 +41,10 @@ def run(args):
     span = args.width + 0.3 * args.height
     scene = WireScene(height=args.height, width_px=args.width, n_frames=args.frames,
                       px_per_frame=span / max(args.frames - 20, 1))
-    figures = run_benchmark(args.dir, scene=scene, short=args.short, workers=args.workers,
-                            stage_frames=min(240, args.frames), log=lambda m: print(m, flush=True))
+    directory = args.dir or f"results/bench/dng-{args.compression}"
+    figures = run_benchmark(directory, scene=scene, short=args.short, workers=args.workers,
+                            stage_frames=min(240, args.frames), compression=args.compression,
+                            log=lambda m: print(m, flush=True))
     print()
     print(format_report(figures))
     if args.json:
