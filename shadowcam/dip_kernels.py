@@ -326,3 +326,41 @@ def finish_centres(first, last, end, half_window, raw, smooth, top_value, top_fr
         _smooth_frame(raw, smooth, p, end - 1, end)
         for centre in range(first, last):
             _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window)
+
+
+@nb.njit(cache=True, parallel=True)
+def window_sums(window, keep):
+    """Exact sums of each kept pixel's window samples, as the running sums hold them.
+
+    Parameters
+    ----------
+    window : (K, P) float32 ndarray
+        Samples of each pixel's window (non-finite ones are skipped).
+    keep : (P,) bool ndarray
+        Pixels whose window is summed (others get zeros).
+
+    Returns
+    -------
+    count, fixed_sum : (P,) int64 ndarray
+        Finite samples and their fixed-point sum (as :func:`quantise_sum`).
+    square_hi, square_lo : (P,) float64 ndarray
+        Sums of the two parts of their squares (as :func:`split_square`).
+    """
+    n_k, n_p = window.shape
+    count = np.zeros(n_p, np.int64)
+    fixed_sum = np.zeros(n_p, np.int64)
+    square_hi = np.zeros(n_p)
+    square_lo = np.zeros(n_p)
+    for p in nb.prange(n_p):
+        if not keep[p]:
+            continue
+        for k in range(n_k):
+            x = np.float64(window[k, p])
+            if np.isfinite(x):
+                count[p] += 1
+                fixed_sum[p] += _fixed(x)
+                sq = x * x
+                hi = (sq + _SQ_HI) - _SQ_HI
+                square_hi[p] += hi
+                square_lo[p] += ((sq - hi) + _SQ_LO) - _SQ_LO
+    return count, fixed_sum, square_hi, square_lo

@@ -397,13 +397,11 @@ def merge_partials(partials, *, n_frames):
     def total(name):
         return sum(getattr(p, name) for p in partials)
 
-    win_finite = np.isfinite(window)
-    win_hi, win_lo = _k.split_square(window)
-    keep = found
-    lit_count = total("count") - np.where(keep, win_finite.sum(axis=0), 0)
-    lit_sum = (total("signal_sum") - np.where(keep, _k.quantise_sum(window).sum(axis=0), 0)) / _k.SUM_SCALE
-    lit_sumsq = ((total("square_hi") - np.where(keep, win_hi.sum(axis=0), 0))
-                 + (total("square_lo") - np.where(keep, win_lo.sum(axis=0), 0)))
+    win_count, win_sum, win_hi, win_lo = (
+        part.reshape(found.shape) for part in _k.window_sums(window.reshape(k, -1), found.ravel()))
+    lit_count = total("count") - win_count
+    lit_sum = (total("signal_sum") - win_sum) / _k.SUM_SCALE
+    lit_sumsq = (total("square_hi") - win_hi) + (total("square_lo") - win_lo)
     count = total("count")
     with np.errstate(invalid="ignore", divide="ignore"):
         lit_level = np.where(lit_count > 0, lit_sum / lit_count, np.nan)
