@@ -358,7 +358,11 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
     accumulated as integer-valued float64 over :data:`_FLUSH` frames, then
     added to the int64 sums: exact for samples below ``2**17`` in magnitude;
     a tile and frame range with a larger sample is summed again one sample
-    at a time.
+    at a time. Centres are tested vectorised too: a centre below the pixel's
+    last candidate and strictly below every smoothed value within
+    ``half_window`` frames is a local minimum and is inserted branch free
+    (:func:`_insert`); only centres with an equal value in their window take
+    the full flat-run test (:func:`_is_candidate`), one pixel at a time.
     """
     n_p = block.shape[1]
     n_tiles = (n_p + TILE - 1) // TILE
