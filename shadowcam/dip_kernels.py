@@ -21,9 +21,10 @@ Offers
 TOP : number of candidate minima kept per pixel.
 SUM_SCALE : fixed-point scale of the integer sums (``2**32``).
 quantise_sum : float samples -> int64 fixed point (numpy, same rounding as the kernel).
-split_square : float samples -> (hi, lo) float64 parts of their squares (numpy).
+split_square : float samples -> (hi, lo) float64 parts of their squares (numpy, as the kernels).
 track_block : feed a block of frames to the state (in place).
 finish_centres : test the last centres of a sequence that ended.
+window_sums : the exact sums of stored windows (to take the dip out of the running sums).
 """
 
 import numba as nb
@@ -82,11 +83,25 @@ def _smooth_frame(raw, smooth, p, i, end):
 
 
 @nb.njit(cache=True)
-def _is_candidate(smooth, p, centre, end, half_window, worst):
+def _ring_slots(centre, half_window, r):
+    """Ring slots ``(2 * half_window + 3,)`` of frames ``centre - half_window - 1 .. centre + half_window + 1``.
+
+    Frame ``f`` is in slot ``f % r``; the slots are computed once per centre
+    so that the per-pixel tests need no integer division.
+    """
+    slots = np.empty(2 * half_window + 3, np.uint64)
+    for k in range(slots.shape[0]):
+        slots[k] = (centre - half_window - 1 + k) % r
+    return slots
+
+
+@nb.njit(cache=True)
+def _is_candidate(smooth, p, centre, end, half_window, worst, slots):
     """Whether frame `centre` of pixel `p` is a local minimum deeper than `worst`.
 
     The ring `smooth` ``(r, P)`` must hold the smoothed values of frames
-    ``centre - half_window - 1 .. centre + half_window`` (slot ``frame % r``).
+    ``centre - half_window - 1 .. centre + half_window``, frame ``centre + d``
+    in slot ``slots[half_window + 1 + d]`` (see :func:`_ring_slots`).
     A local minimum is not larger than any smoothed value within
     ``half_window`` frames and, among the run of equal values around it (a
     flat minimum, seen within the window), is its middle frame (the later one
@@ -95,9 +110,9 @@ def _is_candidate(smooth, p, centre, end, half_window, worst):
     run longer than the window thus has one minimum, ``half_window`` frames
     after its first frame.
     """
-    r = smooth.shape[0]
     h = half_window
-    s = smooth[centre % r, p]
+    o = h + 1  # slots[o + d] holds frame centre + d
+    s = smooth[slots[o], p]
     if not s < worst:  # also rejects NaN
         return False
     first = centre  # the run of values equal to s, within the window
@@ -105,7 +120,7 @@ def _is_candidate(smooth, p, centre, end, half_window, worst):
     for d in range(1, h + 1):
         if centre - d < 0:
             break
-        v = smooth[(centre - d) % r, p]
+        v = smooth[slots[o - d], p]
         if v < s:
             return False
         if v == s:
@@ -114,14 +129,14 @@ def _is_candidate(smooth, p, centre, end, half_window, worst):
             first = centre - d
         else:
             open_run = False
-    if open_run and first == centre - h and centre - h - 1 >= 0 and smooth[(centre - h - 1) % r, p] == s:
+    if open_run and first == centre - h and centre - h - 1 >= 0 and smooth[slots[0], p] == s:
         return False  # the run starts before the window: an earlier frame is its minimum
     last = centre
     open_run = True
     for d in range(1, h + 1):
         if centre + d >= end:
             break
-        v = smooth[(centre + d) % r, p]
+        v = smooth[slots[o + d], p]
         if v < s:
             return False
         if v == s and open_run:
@@ -131,29 +146,52 @@ def _is_candidate(smooth, p, centre, end, half_window, worst):
     return centre == (first + last + 1) // 2
 
 
+@nb.njit(cache=True, inline="always")
+def _insert(top_value, top_frame, p, value, frame):
+    """Insert `value` (at `frame`) into pixel `p`'s ascending lists ``(TOP, P)``, if below their last.
+
+    Branch free, so that a loop over pixels vectorises: the entries above
+    `value` (a suffix of the sorted list) move down one place, the last one
+    drops out. Nothing changes for ``value = +inf``. Returns whether `value`
+    became the first (deepest) entry.
+    """
+    deepest = value < top_value[0, p]
+    carry_v = value
+    carry_f = frame
+    for k in range(TOP):
+        old_v = top_value[k, p]
+        old_f = top_frame[k, p]
+        moves = value < old_v
+        top_value[k, p] = carry_v if moves else old_v
+        top_frame[k, p] = carry_f if moves else old_f
+        carry_v = old_v if moves else carry_v
+        carry_f = old_f if moves else carry_f
+    return deepest
+
+
 @nb.njit(cache=True)
-def _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window):
+def _copy_window(raw, p, centre, end, half_window, window, slots):
+    """Copy pixel `p`'s raw frames ``centre - half_window .. centre + half_window`` to `window` ``(K, P)``.
+
+    Frames outside ``[0, end)`` are NaN; `slots` as in :func:`_is_candidate`.
+    """
+    h = half_window
+    for q in range(2 * h + 1):
+        f = centre - h + q
+        window[q, p] = raw[slots[q + 1], p] if 0 <= f < end else np.nan
+
+
+@nb.njit(cache=True)
+def _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window, slots):
     """Insert frame `centre` among pixel `p`'s deepest local minima if it is one.
 
     The sorted lists are ``(TOP, P)``; the raw window ``(K, P)`` is copied when
-    the centre becomes the deepest.
+    the centre becomes the deepest. `slots` as in :func:`_is_candidate`.
     """
-    if not _is_candidate(smooth, p, centre, end, half_window, top_value[TOP - 1, p]):
+    if not _is_candidate(smooth, p, centre, end, half_window, top_value[TOP - 1, p], slots):
         return
-    r = raw.shape[0]
-    h = half_window
-    s = smooth[centre % r, p]
-    pos = TOP - 1
-    while pos > 0 and s < top_value[pos - 1, p]:
-        top_value[pos, p] = top_value[pos - 1, p]
-        top_frame[pos, p] = top_frame[pos - 1, p]
-        pos -= 1
-    top_value[pos, p] = s
-    top_frame[pos, p] = centre
-    if pos == 0:
-        for q in range(2 * h + 1):
-            f = centre - h + q
-            window[q, p] = raw[f % r, p] if 0 <= f < end else np.nan
+    if _insert(top_value, top_frame, p, smooth[slots[half_window + 1], p], centre):
+        _copy_window(raw, p, centre, end, half_window, window, slots)
 
 
 #: pixels per tile: the tile's rings and sums stay in cache while a block streams through
@@ -196,7 +234,9 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     u0 = np.uint64(p0)
     acc = np.zeros(m)
     cacc = np.zeros((n_c, m))
-    hit = np.zeros(m, np.uint8)
+    hit = np.zeros(m, np.bool_)
+    tie = np.zeros(m, np.bool_)
+    new = np.zeros(m, np.bool_)
     t_flush = 0
     big = 0
     for t in range(n_t):
@@ -261,27 +301,43 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
             t_flush = t + 1
         centre = j - h - 1
         if centre >= start and centre >= 0 and centre < stop:
-            # necessary conditions, vectorised: below the current 5th candidate and not
-            # above any smoothed value within h frames (NaN, also frames before the
-            # sequence or the chunk, decide nothing)
-            cslot = np.uint64(centre % r)
+            # vectorised: below the current 5th candidate and not above any smoothed
+            # value within h frames (NaN, also frames before the sequence or the
+            # chunk, decide nothing), and whether one of those equals it
+            slots = _ring_slots(centre, h, r)
+            cslot = slots[h + 1]
             worst = np.uint64(TOP - 1)
             for q in range(m):
                 p = u0 + np.uint64(q)
                 hit[q] = smooth[cslot, p] < top_value[worst, p]
+                tie[q] = False
             for d in range(1, h + 1):
-                lslot, rslot = np.uint64((centre - d) % r), np.uint64((centre + d) % r)
+                lslot, rslot = slots[h + 1 - d], slots[h + 1 + d]
                 for q in range(m):
                     p = u0 + np.uint64(q)
                     sc = smooth[cslot, p]
-                    hit[q] &= (not smooth[lslot, p] < sc) & (not smooth[rslot, p] < sc)
+                    left, right = smooth[lslot, p], smooth[rslot, p]
+                    hit[q] &= (not left < sc) & (not right < sc)
+                    tie[q] |= (left == sc) | (right == sc)
             hits = 0
             for q in range(m):
                 hits += hit[q]
             if hits:
+                # a hit without a tie is a strict minimum within the window, so the middle
+                # of its own flat run: a local minimum (what _is_candidate would find);
+                # insert those branch free, and test the hits with ties one by one
+                deepest = 0
                 for q in range(m):
-                    if hit[q]:
-                        _consider(raw, smooth, p0 + q, centre, j + 1, h, top_value, top_frame, window)
+                    p = u0 + np.uint64(q)
+                    value = smooth[cslot, p] if hit[q] & ~tie[q] else np.float32(np.inf)
+                    new[q] = _insert(top_value, top_frame, p, value, centre)
+                    deepest += new[q]
+                    tie[q] &= hit[q]
+                for q in range(m):
+                    if tie[q]:
+                        _consider(raw, smooth, p0 + q, centre, j + 1, h, top_value, top_frame, window, slots)
+                    elif deepest and new[q]:
+                        _copy_window(raw, p0 + q, centre, j + 1, h, window, slots)
 
 
 @nb.njit(cache=True, parallel=True)
@@ -303,7 +359,11 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
     accumulated as integer-valued float64 over :data:`_FLUSH` frames, then
     added to the int64 sums: exact for samples below ``2**17`` in magnitude;
     a tile and frame range with a larger sample is summed again one sample
-    at a time.
+    at a time. Centres are tested vectorised too: a centre below the pixel's
+    last candidate and strictly below every smoothed value within
+    ``half_window`` frames is a local minimum and is inserted branch free
+    (:func:`_insert`); only centres with an equal value in their window take
+    the full flat-run test (:func:`_is_candidate`), one pixel at a time.
     """
     n_p = block.shape[1]
     n_tiles = (n_p + TILE - 1) // TILE
@@ -322,10 +382,14 @@ def finish_centres(first, last, end, half_window, raw, smooth, top_value, top_fr
     """
     if end < 1:
         return
+    slots = np.empty((max(last - first, 0), 2 * half_window + 3), np.uint64)
+    for centre in range(first, last):
+        slots[centre - first] = _ring_slots(centre, half_window, raw.shape[0])
     for p in nb.prange(raw.shape[1]):
         _smooth_frame(raw, smooth, p, end - 1, end)
         for centre in range(first, last):
-            _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window)
+            _consider(raw, smooth, p, centre, end, half_window, top_value, top_frame, window,
+                      slots[centre - first])
 
 
 @nb.njit(cache=True, parallel=True)

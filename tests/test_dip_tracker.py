@@ -219,7 +219,7 @@ def test_merge_rejects_gaps_and_short_feeds():
 @pytest.mark.parametrize("scale", [1.0, 3e5])  # 3e5: above 2**17, summed one sample at a time
 @pytest.mark.parametrize("block", [7, 40])
 def test_fixed_point_sums_are_exact_for_small_and_large_samples(scale, block):
-    from shadowcam.dip_kernels import quantise_sum
+    from shadowcam.dip_kernels import quantise_sum, split_square
 
     rng = np.random.default_rng(7)
     frames = (rng.random((70, 3, 5, 3)) * scale).astype(np.float32)
@@ -232,3 +232,22 @@ def test_fixed_point_sums_are_exact_for_small_and_large_samples(scale, block):
     np.testing.assert_array_equal(partial.signal_sum, quantise_sum(signal).sum(axis=0))
     np.testing.assert_array_equal(partial.channel_sum, quantise_sum(frames).sum(axis=0))
     np.testing.assert_array_equal(partial.count, np.isfinite(signal).sum(axis=0))
+    hi, lo = split_square(signal)
+    np.testing.assert_array_equal(partial.square_hi, hi.sum(axis=0))
+    np.testing.assert_array_equal(partial.square_lo, lo.sum(axis=0))
+
+
+def test_window_sums_match_the_running_sums_arithmetic():
+    """What merge_partials takes out of the running sums is what they added for those samples."""
+    from shadowcam.dip_kernels import quantise_sum, split_square, window_sums
+
+    rng = np.random.default_rng(3)
+    window = (rng.random((9, 50)) * np.array([1.0] * 25 + [3e5] * 25)).astype(np.float32)
+    window[2, 4], window[0, 7], window[5, 8] = np.nan, np.inf, -np.inf
+    keep = rng.random(50) < 0.8
+    count, fixed_sum, square_hi, square_lo = window_sums(window, keep)
+    hi, lo = split_square(window)
+    np.testing.assert_array_equal(count, np.where(keep, np.isfinite(window).sum(axis=0), 0))
+    np.testing.assert_array_equal(fixed_sum, np.where(keep, quantise_sum(window).sum(axis=0), 0))
+    np.testing.assert_array_equal(square_hi, np.where(keep, hi.sum(axis=0), 0))
+    np.testing.assert_array_equal(square_lo, np.where(keep, lo.sum(axis=0), 0))
