@@ -218,6 +218,25 @@ def _exact_sums(block, t0, t1, p0, p1, signal_sum, channel_sum):
                     channel_sum[c, p] += _fixed(np.float64(v))
 
 
+@nb.njit(cache=True, inline="always")
+def _window_rank(smooth, p, half_window, slots):
+    """How pixel `p`'s centre (slot ``slots[h + 1]``) compares with the smoothed values within the window.
+
+    Returns 0 if one of them is lower, 1 if all are higher (a strict
+    minimum), 2 if none is lower but some are equal. NaN neighbours (also
+    frames before the sequence or the chunk) decide nothing.
+    """
+    sc = smooth[slots[half_window + 1], p]
+    rank = 1
+    for d in range(1, half_window + 1):
+        left, right = smooth[slots[half_window + 1 - d], p], smooth[slots[half_window + 1 + d], p]
+        if left < sc or right < sc:
+            return 0
+        if left == sc or right == sc:
+            rank = 2
+    return rank
+
+
 @nb.njit(cache=True)
 def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation_level,
                 raw, smooth, top_value, top_frame, window, signal_sum, square_hi, square_lo,
@@ -234,9 +253,7 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     u0 = np.uint64(p0)
     acc = np.zeros(m)
     cacc = np.zeros((n_c, m))
-    hit = np.zeros(m, np.bool_)
-    tie = np.zeros(m, np.bool_)
-    new = np.zeros(m, np.bool_)
+    hits = np.zeros(m, np.int64)
     t_flush = 0
     big = 0
     for t in range(n_t):
@@ -301,43 +318,28 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
             t_flush = t + 1
         centre = j - h - 1
         if centre >= start and centre >= 0 and centre < stop:
-            # vectorised: below the current 5th candidate and not above any smoothed
-            # value within h frames (NaN, also frames before the sequence or the
-            # chunk, decide nothing), and whether one of those equals it
+            # vectorised pre-test: below the pixel's current 5th candidate (after the
+            # first few dips of a sweep a few per cent of pixels, ever fewer as it goes
+            # on); the passing pixels are gathered and tested one by one
             slots = _ring_slots(centre, h, r)
             cslot = slots[h + 1]
             worst = np.uint64(TOP - 1)
+            n_hits = 0
             for q in range(m):
                 p = u0 + np.uint64(q)
-                hit[q] = smooth[cslot, p] < top_value[worst, p]
-                tie[q] = False
-            for d in range(1, h + 1):
-                lslot, rslot = slots[h + 1 - d], slots[h + 1 + d]
-                for q in range(m):
-                    p = u0 + np.uint64(q)
-                    sc = smooth[cslot, p]
-                    left, right = smooth[lslot, p], smooth[rslot, p]
-                    hit[q] &= (not left < sc) & (not right < sc)
-                    tie[q] |= (left == sc) | (right == sc)
-            hits = 0
-            for q in range(m):
-                hits += hit[q]
-            if hits:
-                # a hit without a tie is a strict minimum within the window, so the middle
-                # of its own flat run: a local minimum (what _is_candidate would find);
-                # insert those branch free, and test the hits with ties one by one
-                deepest = 0
-                for q in range(m):
-                    p = u0 + np.uint64(q)
-                    value = smooth[cslot, p] if hit[q] & ~tie[q] else np.float32(np.inf)
-                    new[q] = _insert(top_value, top_frame, p, value, centre)
-                    deepest += new[q]
-                    tie[q] &= hit[q]
-                for q in range(m):
-                    if tie[q]:
-                        _consider(raw, smooth, p0 + q, centre, j + 1, h, top_value, top_frame, window, slots)
-                    elif deepest and new[q]:
+                hits[n_hits] = q
+                n_hits += smooth[cslot, p] < top_value[worst, p]
+            for i in range(n_hits):
+                q = hits[i]
+                p = u0 + np.uint64(q)
+                rank = _window_rank(smooth, p, h, slots)
+                if rank == 1:
+                    # a strict minimum is the middle of its own flat run: a local minimum
+                    # (what _is_candidate finds)
+                    if _insert(top_value, top_frame, p, smooth[cslot, p], centre):
                         _copy_window(raw, p0 + q, centre, j + 1, h, window, slots)
+                elif rank == 2:  # equal values around: the flat-run rules decide
+                    _consider(raw, smooth, p0 + q, centre, j + 1, h, top_value, top_frame, window, slots)
 
 
 @nb.njit(cache=True, parallel=True)
