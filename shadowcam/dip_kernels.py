@@ -150,9 +150,8 @@ def _is_candidate(smooth, p, centre, end, half_window, worst, slots):
 def _insert(top_value, top_frame, p, value, frame):
     """Insert `value` (at `frame`) into pixel `p`'s ascending lists ``(TOP, P)``, if below their last.
 
-    Branch free, so that a loop over pixels vectorises: the entries above
-    `value` (a suffix of the sorted list) move down one place, the last one
-    drops out. Nothing changes for ``value = +inf``. Returns whether `value`
+    Branch free: the entries above `value` (a suffix of the sorted list)
+    move down one place, the last one drops out. Nothing changes for ``value = +inf``. Returns whether `value`
     became the first (deepest) entry.
     """
     deepest = value < top_value[0, p]
@@ -361,11 +360,12 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
     accumulated as integer-valued float64 over :data:`_FLUSH` frames, then
     added to the int64 sums: exact for samples below ``2**17`` in magnitude;
     a tile and frame range with a larger sample is summed again one sample
-    at a time. Centres are tested vectorised too: a centre below the pixel's
-    last candidate and strictly below every smoothed value within
-    ``half_window`` frames is a local minimum and is inserted branch free
+    at a time. Centres are pre-tested vectorised (below the pixel's last
+    candidate); the pixels that pass are gathered and compared with the
+    smoothed values within ``half_window`` frames (:func:`_window_rank`): a
+    strict minimum is a local minimum and is inserted directly
     (:func:`_insert`); only centres with an equal value in their window take
-    the full flat-run test (:func:`_is_candidate`), one pixel at a time.
+    the full flat-run test (:func:`_is_candidate`).
     """
     n_p = block.shape[1]
     n_tiles = (n_p + TILE - 1) // TILE
