@@ -319,15 +319,18 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
         if centre >= start and centre >= 0 and centre < stop:
             # vectorised pre-test: below the pixel's current 5th candidate (after the
             # first few dips of a sweep a few per cent of pixels, ever fewer as it goes
-            # on); the passing pixels are gathered and tested one by one
+            # on) and not above its two neighbours (NaN decides nothing); the passing
+            # pixels are gathered and tested against the whole window one by one
             slots = _ring_slots(centre, h, r)
             cslot = slots[h + 1]
             worst = np.uint64(TOP - 1)
+            before, after = slots[h], slots[h + 2]
             n_hits = 0
             for q in range(m):
                 p = u0 + np.uint64(q)
+                sc = smooth[cslot, p]
                 hits[n_hits] = q
-                n_hits += smooth[cslot, p] < top_value[worst, p]
+                n_hits += (sc < top_value[worst, p]) & (not smooth[before, p] < sc) & (not smooth[after, p] < sc)
             for i in range(n_hits):
                 q = hits[i]
                 p = u0 + np.uint64(q)
@@ -361,7 +364,7 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
     added to the int64 sums: exact for samples below ``2**17`` in magnitude;
     a tile and frame range with a larger sample is summed again one sample
     at a time. Centres are pre-tested vectorised (below the pixel's last
-    candidate); the pixels that pass are gathered and compared with the
+    candidate and its two neighbours); the pixels that pass are gathered and compared with the
     smoothed values within ``half_window`` frames (:func:`_window_rank`): a
     strict minimum is a local minimum and is inserted directly
     (:func:`_insert`); only centres with an equal value in their window take
