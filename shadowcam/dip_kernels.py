@@ -83,13 +83,12 @@ def _smooth_frame(raw, smooth, p, i, end):
 
 
 @nb.njit(cache=True)
-def _ring_slots(centre, half_window, r):
-    """Ring slots ``(2 * half_window + 3,)`` of frames ``centre - half_window - 1 .. centre + half_window + 1``.
+def _ring_slots(centre, half_window, r, slots):
+    """Fill `slots` ``(2 * half_window + 3,)`` with the ring slots of frames ``centre - half_window - 1 ..``.
 
     Frame ``f`` is in slot ``f % r``; the slots are computed once per centre
     so that the per-pixel tests need no integer division.
     """
-    slots = np.empty(2 * half_window + 3, np.uint64)
     for k in range(slots.shape[0]):
         slots[k] = (centre - half_window - 1 + k) % r
     return slots
@@ -253,6 +252,7 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     acc = np.zeros(m)
     cacc = np.zeros((n_c, m))
     hits = np.zeros(m, np.int64)
+    slots = np.empty(2 * h + 3, np.uint64)
     t_flush = 0
     big = 0
     for t in range(n_t):
@@ -296,9 +296,10 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
                     v = block[t, p, c]
                     # +inf is corrupt input (counted above), not a clipped channel
                     saturated[p] |= (v >= saturation_level) & (v < np.inf)
-                    vd = np.float64(v) if v - v == 0 else 0.0
-                    big += abs(vd) >= _EXACT_BELOW
-                    cacc[c, q] += (vd * SUM_SCALE + _ROUND) - _ROUND
+                    if n_c > 1:  # one channel's sum is the signal's (flushed below)
+                        vd = np.float64(v) if v - v == 0 else 0.0
+                        big += abs(vd) >= _EXACT_BELOW
+                        cacc[c, q] += (vd * SUM_SCALE + _ROUND) - _ROUND
             if t + 1 == n_t or j + 1 == stop or t + 1 - t_flush == _FLUSH:
                 if big:  # float64 sums may have rounded: redo these frames exactly
                     _exact_sums(block, t_flush, t + 1, p0, p1, signal_sum, channel_sum)
@@ -306,9 +307,13 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
                     for q in range(m):
                         p = u0 + np.uint64(q)
                         signal_sum[p] += np.int64(acc[q])
-                    for c in range(n_c):
+                    if n_c == 1:
                         for q in range(m):
-                            channel_sum[c, u0 + np.uint64(q)] += np.int64(cacc[c, q])
+                            channel_sum[0, u0 + np.uint64(q)] += np.int64(acc[q])
+                    else:
+                        for c in range(n_c):
+                            for q in range(m):
+                                channel_sum[c, u0 + np.uint64(q)] += np.int64(cacc[c, q])
                 acc[:] = 0.0
                 cacc[:] = 0.0
                 big = 0
@@ -321,7 +326,7 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
             # first few dips of a sweep a few per cent of pixels, ever fewer as it goes
             # on) and not above its two neighbours (NaN decides nothing); the passing
             # pixels are gathered and tested against the whole window one by one
-            slots = _ring_slots(centre, h, r)
+            _ring_slots(centre, h, r, slots)
             cslot = slots[h + 1]
             worst = np.uint64(TOP - 1)
             before, after = slots[h], slots[h + 2]
@@ -389,7 +394,7 @@ def finish_centres(first, last, end, half_window, raw, smooth, top_value, top_fr
         return
     slots = np.empty((max(last - first, 0), 2 * half_window + 3), np.uint64)
     for centre in range(first, last):
-        slots[centre - first] = _ring_slots(centre, half_window, raw.shape[0])
+        _ring_slots(centre, half_window, raw.shape[0], slots[centre - first])
     for p in nb.prange(raw.shape[1]):
         _smooth_frame(raw, smooth, p, end - 1, end)
         for centre in range(first, last):
