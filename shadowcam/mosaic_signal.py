@@ -58,20 +58,26 @@ def site_constants(values, shape):
 
 
 @nb.njit(cache=True)
-def _load_row(mosaic, r, scale, offset, level, norm, clip):
-    """Normalise mosaic row `r` into ``norm[1:-1]`` with mirrored ends; flag clipped sites in `clip`."""
+def _load_row(mosaic, r, scale, offset, level, norm, clip, site_sum):
+    """Normalise mosaic row `r` into ``norm[1:-1]`` with mirrored ends; flag clipped sites in `clip`.
+
+    The row is added to `site_sum` unless that is empty.
+    """
     cols = mosaic.shape[1]
     sc, off = scale[r & 1], offset[r & 1]
     for j in range(cols):
         v = np.float32(mosaic[r, j]) * sc[j] + off[j]
         norm[j + 1] = v
         clip[j + 1] = v >= level
+    if site_sum.shape[0]:
+        for j in range(cols):
+            site_sum[r, j] += mosaic[r, j]
     norm[0], norm[cols + 1] = norm[2], norm[cols - 1]  # OpenCV's BORDER_REFLECT_101
     clip[0], clip[cols + 1] = clip[2], clip[cols - 1]
 
 
 @nb.njit(cache=True)
-def _signal_kernel(mosaic, scale, offset, edge_weight, corner_weight, level, out, saturated):
+def _signal_kernel(mosaic, scale, offset, edge_weight, corner_weight, level, out, saturated, site_sum):
     """Fill `out` with the channel-sum signal of `mosaic`; OR clipped footprints into `saturated`.
 
     Rows are normalised once into a ring of three padded rows; per-column
@@ -80,11 +86,11 @@ def _signal_kernel(mosaic, scale, offset, edge_weight, corner_weight, level, out
     rows, cols = mosaic.shape
     norm = np.empty((3, cols + 2), np.float32)  # rows i - 1, i, i + 1 (slot row % 3), mirrored ends
     clip = np.empty((3, cols + 2), np.uint8)
-    _load_row(mosaic, 0, scale, offset, level, norm[0], clip[0])
-    _load_row(mosaic, 1, scale, offset, level, norm[1], clip[1])
+    _load_row(mosaic, 0, scale, offset, level, norm[0], clip[0], site_sum)
+    _load_row(mosaic, 1, scale, offset, level, norm[1], clip[1], site_sum)
     for i in range(rows):
         if 1 <= i < rows - 1:
-            _load_row(mosaic, i + 1, scale, offset, level, norm[(i + 1) % 3], clip[(i + 1) % 3])
+            _load_row(mosaic, i + 1, scale, offset, level, norm[(i + 1) % 3], clip[(i + 1) % 3], site_sum)
         up = (i - 1) % 3 if i >= 1 else 1  # row -1 mirrors row 1, row M mirrors row M - 2
         down = (i + 1) % 3 if i + 1 < rows else up
         above, here, below = norm[up], norm[i % 3], norm[down]
@@ -99,7 +105,8 @@ def _signal_kernel(mosaic, scale, offset, edge_weight, corner_weight, level, out
             saturated[i, j] |= edge_clip | (corner_clip & (wc[j] > 0))
 
 
-def mosaic_signal(mosaic, *, pattern, black, white, saturation_level=0.999, out=None, saturated=None):
+def mosaic_signal(mosaic, *, pattern, black, white, saturation_level=0.999, out=None, saturated=None,
+                  site_sum=None):
     """Channel sum ``R + G + B`` of the bilinear demosaic of one mosaic frame, in one pass.
 
     Equals ``read_frame(path).sum(axis=2)`` for the file's mosaic up to
@@ -139,7 +146,10 @@ def mosaic_signal(mosaic, *, pattern, black, white, saturation_level=0.999, out=
         raise ValueError(f"white {np.asarray(white).tolist()} must be above black {black.tolist()} at every site")
     out = np.empty(mosaic.shape, np.float32) if out is None else out
     saturated = np.zeros(mosaic.shape, bool) if saturated is None else saturated
-    for name, array, dtype in (("out", out, np.float32), ("saturated", saturated, np.bool_)):
+    checks = [("out", out, np.float32), ("saturated", saturated, np.bool_)]
+    if site_sum is not None:
+        checks.append(("site_sum", site_sum, np.int64))
+    for name, array, dtype in checks:
         if array.shape != mosaic.shape or array.dtype != dtype or not array.flags.c_contiguous:
             raise ValueError(f"{name} must be a C-contiguous {np.dtype(dtype)} array of shape {mosaic.shape}")
     cols = mosaic.shape[1]
@@ -149,7 +159,8 @@ def mosaic_signal(mosaic, *, pattern, black, white, saturation_level=0.999, out=
     edge_weight = np.where(green, 0.5, 0.25).astype(np.float32)
     corner_weight = np.where(green, 0.0, 0.25).astype(np.float32)
     _signal_kernel(np.ascontiguousarray(mosaic), scale, offset, edge_weight, corner_weight,
-                   np.float32(saturation_level), out, saturated.view(np.uint8))
+                   np.float32(saturation_level), out, saturated.view(np.uint8),
+                   np.zeros((0, 0), np.int64) if site_sum is None else site_sum)
     return out, saturated
 
 

@@ -70,10 +70,9 @@ class _MosaicFrames:
         mosaic, levels = self.reader.read(path)
         owned = self.owned[0] <= index < self.owned[1]
         mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
-                      white=levels["white_sites"], out=out,
-                      saturation_level=self.saturation_level if owned else np.inf, saturated=self.saturated)
-        if owned:
-            np.add(self.site_sum, mosaic, out=self.site_sum)
+                      white=levels["white_sites"], out=out, saturated=self.saturated,
+                      saturation_level=self.saturation_level if owned else np.inf,
+                      site_sum=self.site_sum if owned else None)
 
 
 def _track_chunk(paths, owned, half_window, block_frames, saturation_level, threads):

@@ -81,3 +81,15 @@ def test_tracking_dng_files_from_the_mosaic_keeps_the_colour_sums(tmp_path):
     np.testing.assert_allclose(summary.channel_sum, frames.sum(axis=0), rtol=0, atol=1e-6)
     np.testing.assert_allclose(summary.mean_level, frames.sum(axis=3).mean(axis=0), rtol=0, atol=1e-6)
     assert not summary.saturated.any()
+
+
+def test_site_sums_accumulate_the_mosaic_exactly():
+    frames = [_noisy_mosaic((10, 14), k) for k in range(3)]
+    site_sum = np.zeros((10, 14), np.int64)
+    for mosaic in frames:
+        mosaic_signal(mosaic, pattern="RGGB", black=np.full((2, 2), 256), white=np.full((2, 2), 4095),
+                      site_sum=site_sum)
+    np.testing.assert_array_equal(site_sum, np.sum(frames, axis=0, dtype=np.int64))
+    with pytest.raises(ValueError, match="site_sum"):
+        mosaic_signal(frames[0], pattern="RGGB", black=np.zeros((2, 2)), white=np.full((2, 2), 4095),
+                      site_sum=np.zeros((10, 14), np.int32))
