@@ -21,6 +21,7 @@ sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, fla
 summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
 """
 
+import numba as nb
 import numpy as np
 from scipy.special import ndtri
 
@@ -56,17 +57,38 @@ def _coverage(summary):
         return np.clip(1.0 - summary.window / level, 0.0, 1.0)
 
 
-def _centroid(summary, coverage):
-    """Coverage-weighted mean time and its noise standard deviation."""
-    times = _window_times(summary)
-    weight = np.where(np.isfinite(coverage), coverage, 0.0)
-    total = weight.sum(axis=0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        centre = (weight * times).sum(axis=0) / total
-        # each coverage sample carries noise sigma / level; propagate it
-        spread = np.where(np.isfinite(coverage), (times - centre) ** 2, 0.0).sum(axis=0)
-        std = summary.noise / summary.lit_level * np.sqrt(spread) / total
+@nb.njit(cache=True, parallel=True, error_model="numpy")
+def _centroid_kernel(coverage, window_start, noise, lit_level):
+    """:func:`_centroid` per pixel (one pass over the window, both cores)."""
+    n_k, rows, cols = coverage.shape
+    centre = np.empty((rows, cols))
+    std = np.empty((rows, cols))
+    for r in nb.prange(rows):
+        for c in range(cols):
+            total = 0.0
+            moment = 0.0
+            for k in range(n_k):
+                v = coverage[k, r, c]
+                if np.isfinite(v):
+                    total += v
+                    moment += v * np.float64(window_start[r, c] + k)
+            mean = moment / total
+            spread = 0.0
+            for k in range(n_k):
+                if np.isfinite(coverage[k, r, c]):
+                    spread += (np.float64(window_start[r, c] + k) - mean) ** 2
+            centre[r, c] = mean
+            std[r, c] = noise[r, c] / lit_level[r, c] * np.sqrt(spread) / total
     return centre, std
+
+
+def _centroid(summary, coverage):
+    """Coverage-weighted mean time and its noise standard deviation, ``(H, W)`` each.
+
+    Each coverage sample carries noise ``sigma / level``, propagated to the
+    mean; non-finite samples take no part.
+    """
+    return _centroid_kernel(coverage, summary.window_start, summary.noise, summary.lit_level)
 
 
 def _crossings(summary, threshold):
