@@ -281,7 +281,8 @@ def read_mosaic(path):
     levels : dict
         ``cfa_pattern`` (e.g. ``"RGGB"``), ``black_sites`` and ``white_sites``
         ((2, 2) float64 arrays: the black and white level of each site of the
-        top-left 2x2 block) and ``white_balance`` (as :func:`frame_info`).
+        top-left 2x2 block), ``white_balance`` (as :func:`frame_info`) and
+        ``decoder`` (what read the mosaic).
     """
     import rawpy
 
@@ -309,11 +310,11 @@ def read_mosaic(path):
     if np.any(white_sites <= black_sites):
         raise ValueError(f"{path}: white level {white_sites.tolist()} not above black {black_sites.tolist()}")
     return mosaic, {"cfa_pattern": pattern, "black_sites": black_sites, "white_sites": white_sites,
-                    "white_balance": wb}
+                    "white_balance": wb, "decoder": "rawpy raw_image_visible"}
 
 
-def _decode_raw(path):
-    mosaic, levels = read_mosaic(path)
+def _decode_raw(path, mosaics=None):
+    mosaic, levels = read_mosaic(path) if mosaics is None else mosaics.read(path)
     shape = mosaic.shape
     pattern, black_sites, white_sites = levels["cfa_pattern"], levels["black_sites"], levels["white_sites"]
     vmax = int(white_sites.max())
@@ -328,7 +329,7 @@ def _decode_raw(path):
     bits = header["bits_per_sample"] or int(math.ceil(math.log2(white_sites.max() + 1)))
     info = {
         "path": str(path),
-        "decoder": "rawpy raw_image_visible + OpenCV bilinear demosaic (linear, no white balance)",
+        "decoder": f"{levels['decoder']} + OpenCV bilinear demosaic (linear, no white balance)",
         "height": int(shape[0]),
         "width": int(shape[1]),
         "bit_depth": int(bits),
@@ -404,7 +405,7 @@ def _check_path(path):
     return path
 
 
-def read_frame(path, *, return_info=False):
+def read_frame(path, *, return_info=False, mosaics=None):
     """Decode one frame to linear float32 RGB (black = 0, white level = 1).
 
     Parameters
@@ -413,6 +414,9 @@ def read_frame(path, *, return_info=False):
         Camera RAW (see :data:`RAW_EXTENSIONS`) or any image OpenImageIO reads.
     return_info : bool, optional
         Also return the frame's metadata (as :func:`frame_info`).
+    mosaics : shadowcam.mosaic_reader.MosaicReader, optional
+        Reads RAW mosaics of the frame's sweep (directly where verified
+        exact); default: rawpy.
 
     Returns
     -------
@@ -423,7 +427,7 @@ def read_frame(path, *, return_info=False):
         Only if `return_info`.
     """
     path = _check_path(path)
-    image, info = _decode_raw(path) if is_raw(path) else _decode_oiio(path)
+    image, info = _decode_raw(path, mosaics) if is_raw(path) else _decode_oiio(path)
     return (image, info) if return_info else image
 
 
@@ -460,6 +464,9 @@ def frame_info(path):
 def iter_frames(paths):
     """Decode frames one at a time, checking they all have the first one's size.
 
+    RAW mosaics are read through one :class:`~shadowcam.mosaic_reader.MosaicReader`
+    for the sequence (directly from the DNG data when that is verified exact).
+
     Parameters
     ----------
     paths : sequence of str or Path
@@ -477,8 +484,13 @@ def iter_frames(paths):
         If a frame's size differs from the first frame's (naming both files).
     """
     first = None
+    mosaics = None
     for path in paths:
-        image, info = read_frame(path, return_info=True)
+        if mosaics is None and is_raw(path):
+            from shadowcam.mosaic_reader import MosaicReader
+
+            mosaics = MosaicReader(_check_path(path))
+        image, info = read_frame(path, return_info=True, mosaics=mosaics)
         if first is None:
             first = (Path(path), image.shape)
         elif image.shape != first[1]:

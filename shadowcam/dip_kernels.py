@@ -25,6 +25,7 @@ split_square : float samples -> (hi, lo) float64 parts of their squares (numpy, 
 track_block : feed a block of frames to the state (in place).
 finish_centres : test the last centres of a sequence that ended.
 window_sums : the exact sums of stored windows (to take the dip out of the running sums).
+select_dips : the deepest and second dip of each pixel among candidate lists (merging chunks).
 """
 
 import numba as nb
@@ -438,3 +439,54 @@ def window_sums(window, keep):
                 square_hi[p] += hi
                 square_lo[p] += ((sq - hi) + _SQ_LO) - _SQ_LO
     return count, fixed_sum, square_hi, square_lo
+
+
+@nb.njit(cache=True, inline="always")
+def _before(values, frames, p, i, j):
+    """Whether entry `i` of pixel `p` precedes entry `j` in (value, frame) order."""
+    return values[p, i] < values[p, j] or (values[p, i] == values[p, j] and frames[p, i] < frames[p, j])
+
+
+@nb.njit(cache=True, parallel=True)
+def select_dips(values, frames, half_window):
+    """The deepest and the second dip of each pixel among candidate lists.
+
+    Parameters
+    ----------
+    values : (P, N) float32 ndarray
+        Candidate minima (non-finite = empty), e.g. the time chunks' lists side by side.
+    frames : (P, N) int64 ndarray
+        Their frames.
+    half_window : int
+        The second dip lies more than this many frames from the first.
+
+    Returns
+    -------
+    first, second : (P,) int64 ndarray
+        Index of the smallest finite (value, frame) (earliest index among
+        equals), and of the smallest one further than `half_window` frames
+        from it; 0 where there is none.
+    found, has_second : (P,) bool ndarray
+    """
+    n_p, n = values.shape
+    first = np.zeros(n_p, np.int64)
+    second = np.zeros(n_p, np.int64)
+    found = np.zeros(n_p, np.bool_)
+    has_second = np.zeros(n_p, np.bool_)
+    for p in nb.prange(n_p):
+        best = -1
+        for i in range(n):
+            if np.isfinite(values[p, i]) and (best < 0 or _before(values, frames, p, i, best)):
+                best = i
+        if best < 0:
+            continue
+        first[p], found[p] = best, True
+        frame = frames[p, best]
+        other = -1
+        for i in range(n):
+            if (np.isfinite(values[p, i]) and abs(frames[p, i] - frame) > half_window
+                    and (other < 0 or _before(values, frames, p, i, other))):
+                other = i
+        if other >= 0:
+            second[p], has_second[p] = other, True
+    return first, second, found, has_second

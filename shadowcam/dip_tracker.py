@@ -349,15 +349,6 @@ def _check_tiling(partials, n_frames):
         raise ValueError("partials have different channel counts; feed every chunk alike")
 
 
-def _lexicographic_min(values, frames, allowed):
-    """Index of the smallest (value, frame) among `allowed` entries along the last axis."""
-    v = np.where(allowed, values, np.inf)
-    best = v.min(axis=-1, keepdims=True)
-    tie = allowed & (v == best)
-    f = np.where(tie, frames, np.iinfo(np.int64).max)
-    return np.argmin(f, axis=-1), np.isfinite(best[..., 0])
-
-
 def merge_partials(partials, *, n_frames):
     """The :class:`DipSummary` of a sweep from the partials of its time chunks.
 
@@ -379,13 +370,13 @@ def merge_partials(partials, *, n_frames):
     k = 2 * h + 1
     values = np.concatenate([p.top_value for p in partials], axis=-1)
     frames = np.concatenate([p.top_frame for p in partials], axis=-1)
-    finite = np.isfinite(values)
-    first, found = _lexicographic_min(values, frames, finite)
+    shape = values.shape[:2]
+    first, second, found, has_second = (
+        part.reshape(shape) for part in _k.select_dips(values.reshape(-1, values.shape[2]),
+                                                        frames.reshape(-1, frames.shape[2]), h))
     pick = first[..., None]
     minimum_value = np.take_along_axis(values, pick, -1)[..., 0]
     minimum_frame = np.where(found, np.take_along_axis(frames, pick, -1)[..., 0], -1)
-    far = np.abs(frames - minimum_frame[..., None]) > h
-    second, has_second = _lexicographic_min(values, frames, finite & far & found[..., None])
     second_value = np.where(has_second, np.take_along_axis(values, second[..., None], -1)[..., 0], np.inf)
     second_frame = np.where(has_second, np.take_along_axis(frames, second[..., None], -1)[..., 0], -(k + 1))
     owner = first // _k.TOP

@@ -75,8 +75,8 @@ class MosaicReader:
     Attributes
     ----------
     levels : dict
-        The first frame's ``cfa_pattern``, ``black_sites``, ``white_sites``
-        (see :func:`shadowcam.decode.read_mosaic`).
+        The first frame's ``cfa_pattern``, ``black_sites``, ``white_sites``,
+        ``white_balance`` and ``decoder`` (see :func:`shadowcam.decode.read_mosaic`).
     shape : (int, int)
         Rows and cols of the mosaic.
     direct : bool
@@ -90,6 +90,8 @@ class MosaicReader:
         layout, direct = self._direct(first_path)
         if layout is not None and direct.shape == mosaic.shape and np.array_equal(direct, mosaic):
             self._layout = layout
+            self._direct_levels = dict(self.levels, decoder="tifffile/imagecodecs DNG data (equal to rawpy "
+                                                           "raw_image_visible on the sequence's first frame)")
 
     @property
     def direct(self):
@@ -122,7 +124,7 @@ class MosaicReader:
                 with tifffile.TiffFile(path) as tif:
                     page = _raw_page(tif)
                     if _direct_layout(page) == self._layout:
-                        return _read_direct(page), self.levels
+                        return _read_direct(page), self._direct_levels
             except (tifffile.TiffFileError, OSError, ValueError, KeyError, RuntimeError, NotImplementedError):
                 pass  # rawpy decides (and names the problem)
         mosaic, levels = read_mosaic(path)
