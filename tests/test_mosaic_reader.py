@@ -64,3 +64,14 @@ def test_frames_of_another_size_are_refused(tmp_path):
     broken.write_bytes(first.read_bytes()[:200])
     with pytest.raises(ValueError, match="c.dng"):
         MosaicReader(first).read(broken)
+
+
+def test_decoding_a_sequence_reads_its_mosaics_directly_with_identical_frames(tmp_path):
+    from shadowcam.decode import iter_frames, read_frame
+
+    paths = [write_dng(tmp_path / f"f{k}.dng", _mosaic(k), bit_depth=14, black_level=512, compression="ljpeg")
+             for k in range(3)]
+    for path, image, info in iter_frames(paths):
+        np.testing.assert_array_equal(image, read_frame(path), strict=True)  # read_frame alone: rawpy
+        assert info["decoder"].startswith("tifffile")
+    assert read_frame(paths[0], return_info=True)[1]["decoder"].startswith("rawpy")
