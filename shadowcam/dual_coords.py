@@ -467,7 +467,14 @@ def dual_coords_uniform(
         offset = (0.5 * scale[0] - 0.5, 0.5 * scale[1] - 0.5)
     valid = np.isfinite(t_u) & np.isfinite(t_v)
     if min_spread > 0 and valid.sum() >= 3:
-        ratio = _spread_ratio(np.column_stack([t_u[valid], t_v[valid]]).astype(np.float64))
+        points = np.column_stack([t_u[valid], t_v[valid]]).astype(np.float64)
+        for name, times, n in (("u", points[:, 0], n_u), ("v", points[:, 1], n_v)):
+            if np.all(times == times[0]):
+                raise ValueError(
+                    f"shadow_time: all {len(times)} pixels timed in both sweeps have t_{name} = {times[0]:g}; "
+                    f"sweep {name} ({n} frames) is too short, or its shadow did not move across the image"
+                )
+        ratio = _spread_ratio(points)
         if ratio < min_spread:
             raise ValueError(
                 f"shadow_time: the u and v times are (nearly) collinear (spread ratio "

@@ -66,6 +66,12 @@ def test_uniform_flags_parallel_sweeps():
         dual_coords_uniform(t, 0.5 * t + 3 + 1e-3 * np.sin(t), n_frames=(96, 96))
 
 
+def test_uniform_names_a_sweep_whose_times_never_change():
+    t = np.linspace(0, 90, 200).reshape(10, 20)
+    with pytest.raises(ValueError, match="sweep v .* too short"):
+        dual_coords_uniform(t, np.full_like(t, 2.0), n_frames=(96, 5))
+
+
 @pytest.mark.parametrize("truth, expected", [(AFFINE_TRUTH, "affine"),
                                              (PROJECTIVE_TRUTH, "homography")])
 def test_calibration_fit_picks_simplest_sufficient_model(truth, expected):

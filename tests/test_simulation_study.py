@@ -92,6 +92,7 @@ def test_unusable_settings_are_flagged_not_guessed():
     # 5 frames per sweep: no pixel keeps 3 unshadowed frames, the pipeline refuses
     ds = run_study({"frames": [5]}, size=24, supersample=1)
     assert str(ds["status"].values[0, 0]).startswith("failed:")
+    assert "too short" in str(ds["status"].values[0, 0])  # not blamed on the sweep directions
     assert np.isnan(ds["dual_coord_rmse"].values[0, 0])
 
 
