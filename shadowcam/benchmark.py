@@ -277,7 +277,7 @@ seconds = time.perf_counter() - start
 np.save(out, result["shadow_time"])
 own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
 child = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-print(json.dumps({"seconds": seconds, "peak_rss_mib": (own + workers * child) / 1024}))
+print(json.dumps({"seconds": seconds, "peak_rss_mib": (own + (workers - 1) * child) / 1024}))
 """
 
 
@@ -289,8 +289,9 @@ def end_to_end(paths, *, workers=2, out=None):
     seconds : float
         Wall time of the call (decode, tracking, merge, timing).
     peak_rss_mib : float
-        Peak resident memory of the parent plus `workers` times the largest
-        worker's (an upper bound of the simultaneous total).
+        Peak resident memory of the parent (which tracks one chunk itself)
+        plus ``workers - 1`` times the largest worker's (an upper bound of the
+        simultaneous total).
     shadow_time : (H, W) float32 ndarray
     """
     out = Path(out or f"/tmp/shadowcam-bench-{os.getpid()}.npy")

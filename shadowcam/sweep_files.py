@@ -1,10 +1,10 @@
 """Shadow times straight from a sweep's image files, decoding and tracking on every core.
 
-RAW decoding costs far more per pixel than the streaming dip tracker, so the
-sweep is cut into ``workers`` time chunks: each worker process decodes the
-frames of its chunk (plus the tracker's padding) and feeds them to a
-:class:`~shadowcam.dip_tracker.DipTracker` that owns the chunk; the parent
-merges the partials (bit for bit the single-pass result) and times the dips.
+The sweep is cut into ``workers`` time chunks: this process and ``workers - 1``
+worker processes each decode the frames of a chunk (plus the tracker's
+padding) and feed them to a :class:`~shadowcam.dip_tracker.DipTracker` that
+owns the chunk; this process then merges the partials (bit for bit the
+single-pass result) and times the dips.
 Decode and tracking of different chunks overlap, and no frame store is
 written.
 
@@ -76,16 +76,26 @@ class _MosaicFrames:
 
 
 def _track_chunk(paths, owned, half_window, block_frames, saturation_level, threads):
-    """Worker: decode the padded frames of one owned chunk; return its DipPartial (and RAW sums).
+    """Decode the padded frames of one owned chunk; return its DipPartial (and RAW sums).
 
     RAW files are tracked from their mosaic (one signal plane per frame, see
     :mod:`shadowcam.mosaic_signal`); the partial then comes with the chunk's
-    per-site sums and clipped-pixel mask, else with None.
+    per-site sums and clipped-pixel mask, else with None. `threads`: numba
+    threads meanwhile (None: unchanged).
     """
-    if threads is not None:
-        import numba
+    if threads is None:
+        return _track_owned(paths, owned, half_window, block_frames, saturation_level)
+    import numba
 
-        numba.set_num_threads(threads)
+    previous = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        return _track_owned(paths, owned, half_window, block_frames, saturation_level)
+    finally:
+        numba.set_num_threads(previous)
+
+
+def _track_owned(paths, owned, half_window, block_frames, saturation_level):
     start, stop = owned
     pad = DipTracker.padding(half_window)
     first, last = max(0, start - pad), min(len(paths), stop + pad)
@@ -159,9 +169,11 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
     if len(chunks) == 1:
         results = [_track_chunk(paths, chunks[0], *args, None)]
     else:
-        with ProcessPoolExecutor(len(chunks), mp_context=_CONTEXT) as pool:
-            futures = [pool.submit(_track_chunk, paths, owned, *args, 1) for owned in chunks]
-            results = [f.result() for f in futures]
+        # this process tracks the first chunk itself: one process fewer to start, one
+        # partial fewer to send back
+        with ProcessPoolExecutor(len(chunks) - 1, mp_context=_CONTEXT) as pool:
+            futures = [pool.submit(_track_chunk, paths, owned, *args, 1) for owned in chunks[1:]]
+            results = [_track_chunk(paths, chunks[0], *args, 1)] + [f.result() for f in futures]
     summary = merge_partials([partial for partial, _ in results], n_frames=len(paths))
     if results[0][1] is None:
         return summary
