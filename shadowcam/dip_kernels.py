@@ -253,6 +253,7 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     acc = np.zeros(m)
     cacc = np.zeros((n_c, m))
     hits = np.zeros(m, np.int64)
+    hit = np.zeros(m, np.bool_)
     slots = np.empty(2 * h + 3, np.uint64)
     t_flush = 0
     big = 0
@@ -323,20 +324,26 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
             t_flush = t + 1
         centre = j - h - 1
         if centre >= start and centre >= 0 and centre < stop:
-            # vectorised pre-test: below the pixel's current 5th candidate (after the
-            # first few dips of a sweep a few per cent of pixels, ever fewer as it goes
-            # on) and not above its two neighbours (NaN decides nothing); the passing
-            # pixels are gathered and tested against the whole window one by one
+            # vectorised test: below the pixel's current 5th candidate and not above any
+            # smoothed value within h frames (NaN decides nothing): after the first few
+            # dips of a sweep rare, ever rarer as it goes on; the passing pixels are
+            # gathered and inserted one by one (equal values: the flat-run rules)
             _ring_slots(centre, h, r, slots)
             cslot = slots[h + 1]
             worst = np.uint64(TOP - 1)
-            before, after = slots[h], slots[h + 2]
-            n_hits = 0
             for q in range(m):
                 p = u0 + np.uint64(q)
-                sc = smooth[cslot, p]
+                hit[q] = smooth[cslot, p] < top_value[worst, p]
+            for d in range(1, h + 1):
+                before, after = slots[h + 1 - d], slots[h + 1 + d]
+                for q in range(m):
+                    p = u0 + np.uint64(q)
+                    sc = smooth[cslot, p]
+                    hit[q] &= (not smooth[before, p] < sc) & (not smooth[after, p] < sc)
+            n_hits = 0
+            for q in range(m):
                 hits[n_hits] = q
-                n_hits += (sc < top_value[worst, p]) & (not smooth[before, p] < sc) & (not smooth[after, p] < sc)
+                n_hits += hit[q]
             for i in range(n_hits):
                 q = hits[i]
                 p = u0 + np.uint64(q)
@@ -369,10 +376,10 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
     accumulated as integer-valued float64 over :data:`_FLUSH` frames, then
     added to the int64 sums: exact for samples below ``2**17`` in magnitude;
     a tile and frame range with a larger sample is summed again one sample
-    at a time. Centres are pre-tested vectorised (below the pixel's last
-    candidate and its two neighbours); the pixels that pass are gathered and compared with the
-    smoothed values within ``half_window`` frames (:func:`_window_rank`): a
-    strict minimum is a local minimum and is inserted directly
+    at a time. Centres are tested vectorised (below the pixel's last
+    candidate and not above the smoothed values within ``half_window``
+    frames); the pixels that pass are gathered: a strict minimum
+    (:func:`_window_rank`) is a local minimum and is inserted directly
     (:func:`_insert`); only centres with an equal value in their window take
     the full flat-run test (:func:`_is_candidate`).
     """
