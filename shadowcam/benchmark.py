@@ -369,6 +369,8 @@ def run_benchmark(directory, *, scene=None, short=100, workers=2, stage_frames=2
     log("reading the files once (page cache) ...")
     for path in paths:
         path.read_bytes()
+    log("warming up (compiled kernels are cached on first use) ...")
+    end_to_end(paths[:min(20, len(paths))], workers=workers)
     log("decode floors, end to end, rawpy floor again ...")
     floors = {reader: decode_floor_seconds(paths, workers=workers, reader=reader)
               for reader in ("rawpy", "direct", "read_frame")}

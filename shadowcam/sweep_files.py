@@ -21,9 +21,10 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from shadowcam.decode import is_raw, read_frame
+from shadowcam.decode import is_raw, read_frame, read_mosaic
 from shadowcam.dip_tracker import DipTracker, merge_partials
 from shadowcam.mosaic_reader import MosaicReader
+from shadowcam.dip_kernels import SUM_SCALE, quantise_sum
 from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal, site_constants
 from shadowcam.shadow_time import summary_shadow_times
 
@@ -51,28 +52,67 @@ def chunk_bounds(n_frames, n_chunks):
 
 
 class _MosaicFrames:
-    """Per-frame signal of RAW files straight from their mosaic, with the sweep's colour sums.
+    """A chunk's RAW frames as channel-sum planes straight from their mosaic.
 
     Feeds the tracker :func:`shadowcam.mosaic_signal.mosaic_signal` planes
-    and keeps, over the owned frames, the exact integer sum of each mosaic
-    site and whether any site the pixel interpolates from clipped.
+    and keeps, over the owned frames, what the sweep's colour needs, in sums
+    that are exact whatever the chunking: the integer sum of each mosaic
+    site over the frames with the sweep's first levels (black and white of
+    its first frame) and their count, the fixed-point sum of the normalised
+    values of frames with other levels, and whether any site the pixel
+    interpolates from clipped (the plane is a sum of three channels, so the
+    tracker does not judge clipping).
     """
 
-    def __init__(self, first_path, owned, saturation_level):
-        self.reader = MosaicReader(first_path)
-        self.levels, self.shape = self.reader.levels, self.reader.shape
+    def __init__(self, paths, first, owned, saturation_level):
+        self.reader = MosaicReader(paths[first])
+        self.shape = self.frame_shape = self.reader.shape
+        self.levels = self.reader.levels if first == 0 else read_mosaic(paths[0])[1]
         self.owned = owned
         self.saturation_level = saturation_level
+        self.tracker_saturation_level = np.inf
         self.site_sum = np.zeros(self.shape, np.int64)
+        self.n_site_sum = 0
+        self.other_sum = np.zeros(self.shape, np.int64)
         self.saturated = np.zeros(self.shape, bool)
 
     def read_into(self, path, index, out):
         mosaic, levels = self.reader.read(path)
         owned = self.owned[0] <= index < self.owned[1]
+        usual = all(np.array_equal(levels[k], self.levels[k]) for k in ("black_sites", "white_sites"))
         mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
                       white=levels["white_sites"], out=out, saturated=self.saturated,
                       saturation_level=self.saturation_level if owned else np.inf,
-                      site_sum=self.site_sum if owned else None)
+                      site_sum=self.site_sum if owned and usual else None)
+        if owned and usual:
+            self.n_site_sum += 1
+        elif owned:
+            self.other_sum += quantise_sum(_normalised(mosaic, levels))
+
+    def sums(self):
+        return self.site_sum, self.n_site_sum, self.other_sum, self.saturated, self.levels
+
+
+def _normalised(site_values, levels, count=1):
+    """``(values - count * black) / (white - black)`` per mosaic site, float64."""
+    black = site_constants(levels["black_sites"], site_values.shape)
+    return (site_values - count * black) / (site_constants(levels["white_sites"], site_values.shape) - black)
+
+
+class _DecodedFrames:
+    """A chunk's frames decoded to RGB by :func:`shadowcam.decode.read_frame` (non-RAW files)."""
+
+    def __init__(self, paths, first, owned, saturation_level):
+        self._first = (paths[first], read_frame(paths[first]))
+        self.frame_shape = self._first[1].shape
+        self.shape = self.frame_shape[:2]
+        self.tracker_saturation_level = saturation_level
+
+    def read_into(self, path, index, out):
+        out[...] = self._first[1] if path == self._first[0] else read_frame(path)
+
+    def sums(self):
+        return None
 
 
 def _track_chunk(paths, owned, half_window, block_frames, saturation_level, threads):
@@ -99,37 +139,32 @@ def _track_owned(paths, owned, half_window, block_frames, saturation_level):
     start, stop = owned
     pad = DipTracker.padding(half_window)
     first, last = max(0, start - pad), min(len(paths), stop + pad)
-    mosaic = _MosaicFrames(paths[first], owned, saturation_level) if is_raw(paths[first]) else None
-    if mosaic is not None:
-        shape, frame_shape = mosaic.shape, mosaic.shape
-    else:
-        frame_shape = read_frame(paths[first]).shape
-        shape = frame_shape[:2]
-    # the mosaic signal is a sum of three channels: clipping is judged per site instead
-    tracker = DipTracker(shape, half_window=half_window, owned=owned,
-                         saturation_level=np.inf if mosaic is not None else saturation_level)
-    buffer = np.empty((block_frames,) + frame_shape, np.float32)
+    frames = (_MosaicFrames if is_raw(paths[first]) else _DecodedFrames)(paths, first, owned, saturation_level)
+    tracker = DipTracker(frames.shape, half_window=half_window, owned=owned,
+                         saturation_level=frames.tracker_saturation_level)
+    buffer = np.empty((block_frames,) + frames.frame_shape, np.float32)
     block = []
     for index in range(first, last):
-        if mosaic is not None:
-            mosaic.read_into(paths[index], index, buffer[len(block)])
-        else:
-            buffer[len(block)] = read_frame(paths[index])
+        frames.read_into(paths[index], index, buffer[len(block)])
         block.append(index)
         if len(block) == block_frames or index == last - 1:
             tracker.update(buffer[:len(block)], first_index=block[0])
             block = []
-    sums = None if mosaic is None else (mosaic.site_sum, mosaic.saturated, mosaic.levels)
-    return tracker.partial(), sums
+    return tracker.partial(), frames.sums()
 
 
-def _mosaic_colour(summary, site_sum, saturated, levels):
-    """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place)."""
-    black = site_constants(levels["black_sites"], site_sum.shape)
-    span = site_constants(levels["white_sites"], site_sum.shape) - black
-    normalised = (site_sum - summary.n_frames * black) / span
+def _mosaic_colour(summary, chunk_sums):
+    """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place).
+
+    `chunk_sums`: :meth:`_MosaicFrames.sums` of every chunk; integer sums
+    are added before anything is rounded, so the result does not depend on
+    the chunking.
+    """
+    site_sum, count, other_sum = (sum(part[i] for part in chunk_sums) for i in range(3))
+    levels = chunk_sums[0][4]
+    normalised = _normalised(site_sum, levels, count) + other_sum / SUM_SCALE
     summary.channel_sum = bilinear_channels(normalised, pattern=levels["cfa_pattern"])
-    summary.saturated = summary.saturated | saturated
+    summary.saturated = np.logical_or.reduce([summary.saturated] + [part[3] for part in chunk_sums])
     return summary
 
 
@@ -177,9 +212,7 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
     summary = merge_partials([partial for partial, _ in results], n_frames=len(paths))
     if results[0][1] is None:
         return summary
-    site_sum = sum(sums[0] for _, sums in results)  # exact: integers
-    saturated = np.logical_or.reduce([sums[1] for _, sums in results])
-    return _mosaic_colour(summary, site_sum, saturated, results[0][1][2])
+    return _mosaic_colour(summary, [sums for _, sums in results])
 
 
 def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, workers=2,

@@ -93,3 +93,14 @@ def test_site_sums_accumulate_the_mosaic_exactly():
     with pytest.raises(ValueError, match="site_sum"):
         mosaic_signal(frames[0], pattern="RGGB", black=np.zeros((2, 2)), white=np.full((2, 2), 4095),
                       site_sum=np.zeros((10, 14), np.int32))
+
+
+def test_colour_sums_follow_each_frames_own_levels(tmp_path):
+    """A camera may write another black level for some frames (rawpy reads those)."""
+    paths = [write_dng(tmp_path / f"f{k:02d}.dng", _noisy_mosaic((24, 32), k, black=black), black=black)
+             for k, black in enumerate([256, 256, 300, 256, 300, 256, 256, 256, 256, 300, 256, 256, 256, 256])]
+    summary = track_files(paths, workers=2, block_frames=4)
+    frames = np.stack([read_frame(p) for p in paths]).astype(np.float64)
+    np.testing.assert_allclose(summary.channel_sum, frames.sum(axis=0), rtol=0, atol=1e-6)
+    # the sums are exact: the chunking does not change a bit
+    np.testing.assert_array_equal(track_files(paths, workers=1).channel_sum, summary.channel_sum)
