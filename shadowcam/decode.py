@@ -8,6 +8,8 @@ white balance is *reported* by :func:`frame_info`, never applied).
 * Camera RAW (``.dng``, ``.cr2``, ``.nef``, ...) is read with rawpy:
   ``raw_image_visible`` minus ``black_level_per_channel`` at each CFA site,
   divided by ``white_level - black``, demosaiced bilinearly with OpenCV.
+  :func:`iter_frames` reads a sequence's DNG mosaics directly where that is
+  verified equal to rawpy (:mod:`shadowcam.mosaic_reader`).
 * TIFF / PNG / EXR / ... are read with OpenImageIO in their native type;
   integer types are divided by the type's maximum (a 16-bit PNG by 65535),
   floating-point data are taken as they are.
