@@ -128,6 +128,9 @@ def mosaic_signal(mosaic, *, pattern, black, white, saturation_level=0.999, out=
     saturated : (M, N) bool ndarray, optional
         OR-ed in place with whether any site the pixel's interpolation uses
         is clipped (a new array if not given).
+    site_sum : (M, N) int64 ndarray, optional
+        The mosaic (DN) is added to it in place: exact per-site sums over
+        frames, whatever their order.
 
     Returns
     -------
