@@ -25,6 +25,7 @@ frame_info : size, bit depth, black/white levels, white balance, exposure and
     capture time of a frame, without decoding more than needed.
 iter_frames : decode several frames one at a time, checking they share a size.
 bayer_pattern : the 2x2 CFA pattern ("RGGB", ...) from rawpy's description.
+site_constants : per-site constants of the top-left 2x2 block as a full-size mosaic map.
 opencv_bayer_code : the OpenCV ``COLOR_Bayer*2RGB`` code for a CFA pattern.
 demosaic_bilinear : bilinear demosaic of an integer Bayer mosaic with OpenCV.
 """
@@ -93,6 +94,26 @@ def bayer_pattern(raw_pattern, color_desc):
             f"(raw_pattern {pattern.tolist()}, color_desc {desc!r})"
         )
     return letters
+
+
+def site_constants(values, shape):
+    """Per-site constants of the top-left 2x2 block, tiled to `shape`.
+
+    Parameters
+    ----------
+    values : (2, 2) array_like
+    shape : tuple of int
+        ``(M, N)`` of the mosaic.
+
+    Returns
+    -------
+    (M, N) float64 ndarray
+    """
+    values = np.asarray(values, np.float64)
+    if values.shape != (2, 2):
+        raise ValueError(f"values must be (2, 2) per-site constants, got shape {values.shape}")
+    rows, cols = int(shape[0]), int(shape[1])
+    return np.tile(values, (rows // 2 + 1, cols // 2 + 1))[:rows, :cols]
 
 
 def opencv_bayer_code(pattern):
@@ -168,8 +189,7 @@ def _site_map(values, shape, pattern, max_value):
     values = np.asarray(values, dtype=np.float64).reshape(2, 2)
     if np.all(values == values.flat[0]):
         return np.full(3, values.flat[0], dtype=np.float32)
-    tile = np.tile(values.astype(np.uint16), (shape[0] // 2 + 1, shape[1] // 2 + 1))
-    return demosaic_bilinear(tile[: shape[0], : shape[1]], pattern=pattern, max_value=max_value)
+    return demosaic_bilinear(site_constants(values, shape).astype(np.uint16), pattern=pattern, max_value=max_value)
 
 
 # ---------------------------------------------------------------------------

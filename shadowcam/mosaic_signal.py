@@ -19,7 +19,6 @@ colour) are the demosaic of the per-site sums of the mosaic, computed once.
 
 Offers
 ------
-site_constants : per-site constants (2x2) as a full-size map of the mosaic.
 mosaic_signal : channel-sum signal of one mosaic frame (compiled, one pass), with saturation.
 bilinear_channels : bilinear demosaic of a float mosaic (numpy; once per sweep).
 """
@@ -28,6 +27,8 @@ import numba as nb
 import numpy as np
 from scipy import ndimage
 
+from shadowcam.decode import site_constants
+
 _RED_BLUE_KERNEL = np.array([[1, 2, 1], [2, 4, 2], [1, 2, 1]], np.float64) / 4
 _GREEN_KERNEL = np.array([[0, 1, 0], [1, 4, 1], [0, 1, 0]], np.float64) / 4
 
@@ -35,26 +36,6 @@ _GREEN_KERNEL = np.array([[0, 1, 0], [1, 4, 1], [0, 1, 0]], np.float64) / 4
 def _check_pattern(pattern):
     if not isinstance(pattern, str) or sorted(pattern) != ["B", "G", "G", "R"]:
         raise ValueError(f"pattern must be a Bayer pattern such as 'RGGB', got {pattern!r}")
-
-
-def site_constants(values, shape):
-    """Per-site constants of the top-left 2x2 block, tiled to `shape`.
-
-    Parameters
-    ----------
-    values : (2, 2) array_like
-    shape : tuple of int
-        ``(M, N)`` of the mosaic.
-
-    Returns
-    -------
-    (M, N) float64 ndarray
-    """
-    values = np.asarray(values, np.float64)
-    if values.shape != (2, 2):
-        raise ValueError(f"values must be (2, 2) per-site constants, got shape {values.shape}")
-    rows, cols = int(shape[0]), int(shape[1])
-    return np.tile(values, (rows // 2 + 1, cols // 2 + 1))[:rows, :cols]
 
 
 @nb.njit(cache=True)

@@ -21,11 +21,11 @@ from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
 
-from shadowcam.decode import is_raw, read_frame, read_mosaic
+from shadowcam.decode import is_raw, read_frame, read_mosaic, site_constants
 from shadowcam.dip_tracker import DipTracker, merge_partials
 from shadowcam.mosaic_reader import MosaicReader
 from shadowcam.dip_kernels import SUM_SCALE, quantise_sum
-from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal, site_constants
+from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal
 from shadowcam.shadow_time import summary_shadow_times
 
 #: worker start method: rawpy (OpenMP) may deadlock in forked processes

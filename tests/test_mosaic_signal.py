@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from dng_files import write_dng
-from shadowcam.decode import read_frame, read_mosaic
-from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal, site_constants
+from shadowcam.decode import read_frame, read_mosaic, site_constants
+from shadowcam.mosaic_signal import bilinear_channels, mosaic_signal
 from shadowcam.sweep_files import track_files
 
 SHARED_RAW = Path("/work/shared/data/lab-dev/dev_spheres_raw/frames_u")
