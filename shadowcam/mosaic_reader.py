@@ -86,6 +86,7 @@ class MosaicReader:
     def __init__(self, first_path):
         mosaic, self.levels = read_mosaic(first_path)
         self.shape = mosaic.shape
+        self._first = (str(first_path), mosaic)  # handed out by the first read of that path
         self._layout = None
         layout, direct = self._direct(first_path)
         if layout is not None and direct.shape == mosaic.shape and np.array_equal(direct, mosaic):
@@ -117,6 +118,9 @@ class MosaicReader:
         ValueError
             If the frame's mosaic size or CFA pattern differs from the first frame's.
         """
+        if self._first is not None and str(path) == self._first[0]:
+            mosaic, self._first = self._first[1], None  # equal to the direct read, if verified
+            return mosaic, self._direct_levels if self._layout is not None else self.levels
         if self._layout is not None:
             import tifffile
 

@@ -236,6 +236,6 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
     """
     summary = track_files(paths, half_window=half_window, workers=workers,
                           block_frames=block_frames)
-    _, info = read_frame(paths[0], return_info=True)
-    return summary_shadow_times(summary, method=method, cfa_pattern=info["cfa_pattern"],
+    cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
                                 method_params=method_params, classify_params=classify_params)
