@@ -24,8 +24,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from shadowcam.manifest import checksums_for
-from shadowcam.raw_writer import write_dng
+from shadowcam.io.manifest import checksums_for
+from shadowcam.io.raw_writer import write_dng
 
 REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent

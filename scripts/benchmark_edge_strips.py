@@ -50,12 +50,12 @@ def run_step(args):
 
 
 def prepare(out, tiles):
-    from shadowcam.decode import iter_frames
-    from shadowcam.frame_store import write_frames
-    from shadowcam.image_io import write_netcdf
-    from shadowcam.manifest import load_manifest
-    from shadowcam.outdoor_datasets import photometry_dataset
-    from shadowcam.outdoor_normalise import normalise_frames
+    from shadowcam.io.decode import iter_frames
+    from shadowcam.io.frame_store import write_frames
+    from shadowcam.io.images import write_netcdf
+    from shadowcam.io.manifest import load_manifest
+    from shadowcam.outdoor.datasets import photometry_dataset
+    from shadowcam.outdoor.normalise import normalise_frames
 
     sweep = load_manifest(REPO / "data_manifest" / "dev_ridge.yaml")["sweeps"]["timelapse"]
     photometry = normalise_frames(image for _, image, _ in iter_frames(sweep["paths"]))

@@ -51,7 +51,7 @@ def snakemake(args, cwd, *, timeout=600):
 
 def write_manifest(path, doc):
     """Write manifest `doc` (a dict) to `path` with a ``checksums`` block of its files; return `path`."""
-    from shadowcam.manifest import checksums_for
+    from shadowcam.io.manifest import checksums_for
 
     path = Path(path)
     path.write_text(yaml.safe_dump(doc))

@@ -14,7 +14,7 @@ make_timelapse : frames, times and the exact ground truth.
 
 import numpy as np
 
-from shadowcam.registration import apply_shift
+from shadowcam.outdoor.registration import apply_shift
 
 
 def make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.5, slope=0.15, y0=50.0,

@@ -44,11 +44,11 @@ def _open(path):
 
 def run(args):
     """Evaluate the products against the manifest's ground truth and write the report."""
-    from shadowcam.accuracy import accuracy_report, report_to_csv, report_to_json
-    from shadowcam.ground_truth import load_ground_truth
-    from shadowcam.image_io import atomic_path
-    from shadowcam.manifest import load_manifest
-    from shadowcam.provenance import file_sha256
+    from shadowcam.lab.accuracy import accuracy_report, report_to_csv, report_to_json
+    from shadowcam.io.ground_truth import load_ground_truth
+    from shadowcam.io.images import atomic_path
+    from shadowcam.io.manifest import load_manifest
+    from shadowcam.io.provenance import file_sha256
 
     params = parse_params(args.params, allowed={"noise"})
     manifest = load_manifest(args.manifest)

@@ -1,7 +1,7 @@
 """``shadowcam arrival``: per-pixel shadow-arrival time map (seconds, sub-frame).
 
 Edge crossing of the tracked edges, checked against the pixel's own coverage
-crossing (:mod:`shadowcam.arrival`). Writes ``results/<ds>/outdoor/arrival.nc``.
+crossing (:mod:`shadowcam.outdoor.arrival`). Writes ``results/<ds>/outdoor/arrival.nc``.
 
 Offers
 ------
@@ -9,11 +9,11 @@ add_parser : register the step and its options.
 run : compute and write the arrival map.
 """
 
-from shadowcam.arrival import arrival_from_edges, combine_arrivals, time_to_frame
+from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals, time_to_frame
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
-from shadowcam.frame_times import median_interval
-from shadowcam.outdoor_datasets import arrival_dataset
+from shadowcam.io.frame_times import median_interval
+from shadowcam.outdoor.datasets import arrival_dataset
 
 
 def add_parser(subparsers, name):

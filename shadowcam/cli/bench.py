@@ -14,7 +14,7 @@ run : run the benchmark and print the figures.
 import json
 from pathlib import Path
 
-from shadowcam.benchmark import WireScene, format_report, run_benchmark
+from shadowcam.evaluate.speed_benchmark import WireScene, format_report, run_benchmark
 
 
 def add_parser(subparsers, name):

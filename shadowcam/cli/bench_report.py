@@ -25,8 +25,8 @@ import re
 from pathlib import Path
 
 from shadowcam.cli.outdoor_io import open_dataset
-from shadowcam.frame_store import open_frames
-from shadowcam.outdoor_accuracy import registration_errors
+from shadowcam.io.frame_store import open_frames
+from shadowcam.outdoor.accuracy import registration_errors
 
 
 def add_parser(subparsers, name):

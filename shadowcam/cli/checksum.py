@@ -10,7 +10,7 @@ add_parser : register the step and its options.
 run : compute and print the block.
 """
 
-from shadowcam.manifest import checksums_for, format_checksums
+from shadowcam.io.manifest import checksums_for, format_checksums
 
 
 def add_parser(subparsers, name):

@@ -1,7 +1,7 @@
 """``shadowcam decode``: decode one sweep (or the reference) of a capture into a frame store.
 
 Verifies the sha256 of the files it decodes first, then streams the frames
-into ``results/<ds>/frames/<sweep>.zarr`` (see ``shadowcam.frame_store``).
+into ``results/<ds>/frames/<sweep>.zarr`` (see ``shadowcam.io.frame_store``).
 With ``--frames START:STOP`` it decodes only that range into a *part* store
 (one job of a long sweep; ``shadowcam merge-frames`` joins the parts).
 
@@ -14,9 +14,9 @@ run : verify checksums and decode.
 
 import xarray as xr
 
-from shadowcam.frame_store import write_frames, write_reference
-from shadowcam.manifest import load_manifest, manifest_files, verify_checksums
-from shadowcam.provenance import attach_provenance
+from shadowcam.io.frame_store import write_frames, write_reference
+from shadowcam.io.manifest import load_manifest, manifest_files, verify_checksums
+from shadowcam.io.provenance import attach_provenance
 
 
 def add_parser(subparsers, name):

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from shadowcam.cli.options import parse_params
-from shadowcam.dual_coords import (
+from shadowcam.cameras.dual_coords import (
     DUAL_COORD_METHODS,
     dual_coords_calibration,
     dual_coords_dataset,
@@ -60,9 +60,9 @@ def run(args):
     """Compute dual coordinates from ``args.shadow_time`` and write ``args.out``."""
     import xarray as xr
 
-    from shadowcam.image_io import read_image, write_netcdf
-    from shadowcam.manifest import load_manifest, verify_checksums
-    from shadowcam.provenance import attach_provenance, file_sha256
+    from shadowcam.io.images import read_image, write_netcdf
+    from shadowcam.io.manifest import load_manifest, verify_checksums
+    from shadowcam.io.provenance import attach_provenance, file_sha256
 
     params = parse_params(args.params,
                           allowed=set(_GRID_KEYS) | set(_UNIFORM_KEYS) | set(_CALIBRATION_KEYS))

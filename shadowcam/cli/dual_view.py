@@ -16,7 +16,7 @@ import time
 
 
 from shadowcam.cli.options import parse_params
-from shadowcam.dual_view import DUAL_VIEW_METHODS
+from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS
 
 log = logging.getLogger(__name__)
 
@@ -41,9 +41,9 @@ def run(args):
     """Resample the camera colours into the dual grid and write the outputs."""
     import xarray as xr
 
-    from shadowcam.dual_view import camera_colours, dual_view_dataset, resample_dual_view
-    from shadowcam.image_io import write_exr, write_netcdf, write_png_preview
-    from shadowcam.provenance import attach_provenance, file_sha256
+    from shadowcam.cameras.dual_view import camera_colours, dual_view_dataset, resample_dual_view
+    from shadowcam.io.images import write_exr, write_netcdf, write_png_preview
+    from shadowcam.io.provenance import attach_provenance, file_sha256
 
     params = parse_params(args.params)
     with xr.open_dataset(args.dual_coords, engine="h5netcdf") as ds:
@@ -56,7 +56,7 @@ def run(args):
         checksums[str(path)] = file_sha256(path)
     reference = None
     if args.reference:
-        from shadowcam.frame_store import open_frames
+        from shadowcam.io.frame_store import open_frames
 
         frames = open_frames(args.reference)
         image = frames["image"]

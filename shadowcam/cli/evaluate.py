@@ -6,7 +6,7 @@ Usage::
         --out results/evaluate/study.nc --figures results/evaluate/figures
 
 ``--params`` (JSON): ``levels`` (factor -> values, factors of
-``shadowcam.simulation_study.FACTORS``), ``baseline`` (factor -> value), and the options
+``shadowcam.evaluate.simulation_study.FACTORS``), ``baseline`` (factor -> value), and the options
 ``scene``, ``size``, ``supersample``, ``seed``, ``method``, ``half_window``,
 ``dual_view_method`` of ``simulate_setting``. Writes the study dataset (dims
 ``factor, level``) and one figure ``study_<factor>.png`` per factor, and prints a table
@@ -54,7 +54,7 @@ def format_table(study):
     Parameters
     ----------
     study : xarray.Dataset
-        As returned by ``shadowcam.simulation_study.run_study``.
+        As returned by ``shadowcam.evaluate.simulation_study.run_study``.
 
     Returns
     -------
@@ -77,7 +77,7 @@ def format_table(study):
 
 
 def _write_figures(study, outdir):
-    from shadowcam.figures import save_png, study_factor_figure
+    from shadowcam.report.figures import save_png, study_factor_figure
 
     outdir = Path(outdir)
     tmp = outdir.parent / f".{outdir.name}.tmp-{os.getpid()}"
@@ -102,9 +102,9 @@ def run(args):
     """Run the study, write the dataset (and figures), print the tables."""
     from dataclasses import replace
 
-    from shadowcam.image_io import atomic_path
-    from shadowcam.provenance import attach_provenance
-    from shadowcam.simulation_study import BASELINE, FACTORS, run_study
+    from shadowcam.io.images import atomic_path
+    from shadowcam.io.provenance import attach_provenance
+    from shadowcam.evaluate.simulation_study import BASELINE, FACTORS, run_study
 
     params = parse_params(args.params, allowed={"levels", "baseline", *OPTIONS})
     levels = params.get("levels") or {}

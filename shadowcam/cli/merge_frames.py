@@ -1,7 +1,7 @@
 """``shadowcam merge-frames``: join the part stores of one sweep into its frame store.
 
 The parts come from ``shadowcam decode --frames START:STOP`` (one job each);
-their chunk files are hard-linked, not copied (``shadowcam.frame_store``), and
+their chunk files are hard-linked, not copied (``shadowcam.io.frame_store``), and
 the provenance lists the checksums of every part's input files, so the store
 equals a single-job decode of the whole sweep.
 
@@ -15,8 +15,8 @@ import json
 
 import xarray as xr
 
-from shadowcam.frame_store import merge_frame_stores, open_frames
-from shadowcam.provenance import attach_provenance
+from shadowcam.io.frame_store import merge_frame_stores, open_frames
+from shadowcam.io.provenance import attach_provenance
 
 
 def add_parser(subparsers, name):

@@ -44,15 +44,15 @@ def _load(path):
 
 def run(args):
     """Measure every method against the ground truth and write table and chart."""
-    from shadowcam.dual_view import camera_colours
-    from shadowcam.frame_store import iter_frame_chunks, open_frames
-    from shadowcam.ground_truth import load_ground_truth
-    from shadowcam.image_io import atomic_path, write_netcdf
-    from shadowcam.manifest import load_manifest
-    from shadowcam.methods_comparison import (
+    from shadowcam.cameras.dual_view import camera_colours
+    from shadowcam.io.frame_store import iter_frame_chunks, open_frames
+    from shadowcam.io.ground_truth import load_ground_truth
+    from shadowcam.io.images import atomic_path, write_netcdf
+    from shadowcam.io.manifest import load_manifest
+    from shadowcam.evaluate.methods_comparison import (
         compare_dual_view_methods, compare_shadow_time_methods, methods_dataset, speed_error_figure,
     )
-    from shadowcam.provenance import attach_provenance
+    from shadowcam.io.provenance import attach_provenance
 
     if len(args.frames) != len(args.sweeps):
         raise ValueError(f"--frames has {len(args.frames)} stores but --sweeps names {len(args.sweeps)}")

@@ -17,15 +17,15 @@ import logging
 
 import numpy as np
 
-from shadowcam.accuracy import report_to_csv, report_to_json
+from shadowcam.lab.accuracy import report_to_csv, report_to_json
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import iter_frames, open_dataset
-from shadowcam.frame_store import open_frames
-from shadowcam.frame_times import median_interval
-from shadowcam.ground_truth import load_ground_truth
-from shadowcam.image_io import atomic_path
-from shadowcam.manifest import load_manifest
-from shadowcam.outdoor_accuracy import (
+from shadowcam.io.frame_store import open_frames
+from shadowcam.io.frame_times import median_interval
+from shadowcam.io.ground_truth import load_ground_truth
+from shadowcam.io.images import atomic_path
+from shadowcam.io.manifest import load_manifest
+from shadowcam.outdoor.accuracy import (
     NaiveBaseline, TARGETS, edge_errors, edges_to_truth_camera, evaluate_arrivals, false_arrivals,
     map_to_truth_camera, registration_errors,
 )

@@ -16,16 +16,16 @@ from pathlib import Path
 
 import numpy as np
 
-from shadowcam.arrival import ARRIVAL_REASONS
+from shadowcam.outdoor.arrival import ARRIVAL_REASONS
 from shadowcam.cli.outdoor_io import open_dataset
-from shadowcam.figures import save_png
-from shadowcam.frame_store import open_frames
-from shadowcam.frame_times import median_interval
-from shadowcam.image_io import atomic_path
-from shadowcam.outdoor_figures import (arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure,
+from shadowcam.report.figures import save_png
+from shadowcam.io.frame_store import open_frames
+from shadowcam.io.frame_times import median_interval
+from shadowcam.io.images import atomic_path
+from shadowcam.report.outdoor_figures import (arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure,
                                        pushbroom_figure)
-from shadowcam.pushbroom import resample_uniform_time
-from shadowcam.registration import apply_shift
+from shadowcam.cameras.pushbroom import resample_uniform_time
+from shadowcam.outdoor.registration import apply_shift
 
 
 def add_parser(subparsers, name):

@@ -15,9 +15,9 @@ from pathlib import Path
 
 import xarray as xr
 
-from shadowcam.frame_store import iter_frame_chunks
-from shadowcam.image_io import write_netcdf
-from shadowcam.provenance import attach_provenance
+from shadowcam.io.frame_store import iter_frame_chunks
+from shadowcam.io.images import write_netcdf
+from shadowcam.io.provenance import attach_provenance
 
 log = logging.getLogger(__name__)
 

@@ -2,7 +2,7 @@
 
 Reads the part datasets written by ``shadowcam outdoor-normalise --part``,
 concatenates the per-frame shifts and gains and takes the per-pixel minimum
-(:class:`shadowcam.outdoor_normalise.PartMerger`), then derives the lit and
+(:class:`shadowcam.outdoor.normalise.PartMerger`), then derives the lit and
 shadow levels as the single job does. Parts are read one at a time (ordered by
 their ``first_frame`` attribute, read without loading the data), so memory does
 not grow with their number. Writes ``results/<ds>/outdoor/photometry.nc``.
@@ -16,8 +16,8 @@ run : merge and write the photometry dataset.
 import numpy as np
 
 from shadowcam.cli.outdoor_io import input_checksums, open_dataset, read_attrs, write_dataset
-from shadowcam.outdoor_datasets import photometry_dataset, photometry_part_arrays
-from shadowcam.outdoor_normalise import PartMerger
+from shadowcam.outdoor.datasets import photometry_dataset, photometry_part_arrays
+from shadowcam.outdoor.normalise import PartMerger
 
 
 def add_parser(subparsers, name):

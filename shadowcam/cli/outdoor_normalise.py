@@ -1,6 +1,6 @@
 """``shadowcam outdoor-normalise``: register a time-lapse and estimate its gains and levels.
 
-First streaming pass over the frame store (:mod:`shadowcam.outdoor_normalise`):
+First streaming pass over the frame store (:mod:`shadowcam.outdoor.normalise`):
 sub-pixel shift of every frame to the first, lit and sky gains per frame, sky
 mask (manifest ``sky_mask`` override, else automatic), per-pixel lit and
 shadow levels. Writes ``results/<ds>/outdoor/photometry.nc``; with
@@ -19,13 +19,13 @@ import numpy as np
 
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import input_checksums, iter_frames, write_dataset
-from shadowcam.decode import read_frame
-from shadowcam.frame_store import open_frames
-from shadowcam.manifest import load_manifest, verify_checksums
-from shadowcam.outdoor_datasets import photometry_dataset, photometry_part_dataset
-from shadowcam.outdoor_normalise import normalise_frames, normalise_part, part_frames
-from shadowcam.photometric import exposure_gains
-from shadowcam.sky_mask import mask_from_image, polygon_mask
+from shadowcam.io.decode import read_frame
+from shadowcam.io.frame_store import open_frames
+from shadowcam.io.manifest import load_manifest, verify_checksums
+from shadowcam.outdoor.datasets import photometry_dataset, photometry_part_dataset
+from shadowcam.outdoor.normalise import normalise_frames, normalise_part, part_frames
+from shadowcam.outdoor.photometric import exposure_gains
+from shadowcam.outdoor.sky_mask import mask_from_image, polygon_mask
 
 
 def add_parser(subparsers, name):

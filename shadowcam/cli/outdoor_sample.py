@@ -4,7 +4,7 @@ Steadies consecutive frames of a small outdoor capture (e.g. dev_ridge; its
 recorded shake from the ground truth undone), upsamples them to a camera's
 size, shakes them by a seeded realistic amount (``--shake-px``, sub-pixel to
 2 px), adds full-resolution sensor noise and writes 14-bit RGGB DNGs
-(:mod:`shadowcam.outdoor_sample`, :mod:`shadowcam.raw_writer`), a sidecar with
+(:mod:`shadowcam.synthetic.outdoor.sample`, :mod:`shadowcam.io.raw_writer`), a sidecar with
 the frame times and the applied shake (``timestamps.json``: ``times_s``,
 ``shake_dx_px``, ``shake_dy_px``) and a checksummed ``kind: outdoor`` manifest,
 for the throughput and memory benchmark (``make bench-outdoor-size``), which
@@ -25,12 +25,12 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from shadowcam.decode import read_frame
-from shadowcam.ground_truth import load_ground_truth
-from shadowcam.manifest import checksums_for, load_manifest
-from shadowcam.outdoor_sample import parse_size, sample_mosaic, sample_shake, steady_frame, upsample_frame
-from shadowcam.raw_writer import write_dng
-from shadowcam.sensor import SensorModel, exposure_scale
+from shadowcam.io.decode import read_frame
+from shadowcam.io.ground_truth import load_ground_truth
+from shadowcam.io.manifest import checksums_for, load_manifest
+from shadowcam.synthetic.outdoor.sample import parse_size, sample_mosaic, sample_shake, steady_frame, upsample_frame
+from shadowcam.io.raw_writer import write_dng
+from shadowcam.synthetic.sensor import SensorModel, exposure_scale
 
 log = logging.getLogger(__name__)
 

@@ -37,7 +37,7 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Print the plan."""
-    from shadowcam.planning import plan_capture
+    from shadowcam.lab.planning import plan_capture
 
     plan = plan_capture(pixel_width=args.pixel_width, mask_distance=args.mask_distance,
                         depth=args.depth, focal_length=args.focal_length,

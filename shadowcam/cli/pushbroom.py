@@ -1,7 +1,7 @@
 """``shadowcam pushbroom``: the ridge pushbroom image from the tracked edges.
 
 Colours of the registered first frame along each frame's edge, stacked over
-time (:mod:`shadowcam.pushbroom`). Writes ``results/<ds>/outdoor/pushbroom.nc``
+time (:mod:`shadowcam.cameras.pushbroom`). Writes ``results/<ds>/outdoor/pushbroom.nc``
 and a PNG preview resampled to evenly spaced times (time upward).
 
 Offers
@@ -11,10 +11,10 @@ run : assemble and write the pushbroom.
 """
 
 from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
-from shadowcam.frame_times import median_interval
-from shadowcam.image_io import atomic_path, write_png_preview
-from shadowcam.outdoor_datasets import pushbroom_dataset
-from shadowcam.pushbroom import assemble_pushbroom, resample_uniform_time
+from shadowcam.io.frame_times import median_interval
+from shadowcam.io.images import atomic_path, write_png_preview
+from shadowcam.outdoor.datasets import pushbroom_dataset
+from shadowcam.cameras.pushbroom import assemble_pushbroom, resample_uniform_time
 
 
 def add_parser(subparsers, name):

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from shadowcam import __version__
-from shadowcam.provenance import attach_provenance, file_sha256
+from shadowcam.io.provenance import attach_provenance, file_sha256
 
 log = logging.getLogger(__name__)
 
@@ -133,8 +133,8 @@ def resolve_options(args):
 
 
 def _write_frame(path, radiance, *, options, sensor, scale, seed, when, exposure_time=None):
-    from shadowcam.raw_writer import write_dng, write_tiff16
-    from shadowcam.sensor import raw_to_linear, simulate_raw
+    from shadowcam.io.raw_writer import write_dng, write_tiff16
+    from shadowcam.synthetic.sensor import raw_to_linear, simulate_raw
 
     if options["format"] == "dng":
         raw = simulate_raw(radiance, sensor=sensor, scale=scale, seed=seed,
@@ -186,9 +186,9 @@ def write_ground_truth(folder, gt, *, sensor, scale, config, checksums, **attrs)
 
 def render_capture_dir(options, out_dir):
     """Render a capture described by `options` (see ``resolve_options``) into `out_dir`."""
-    from shadowcam.lab_render import SWEEP_INDEX, prepare_capture
-    from shadowcam.scene import make_scene
-    from shadowcam.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
+    from shadowcam.synthetic.lab.scene import make_scene
+    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
 
     started = time.perf_counter()
     scene = make_scene(options["scene"], seed=options["seed"], height=options["height"],

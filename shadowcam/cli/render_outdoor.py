@@ -8,7 +8,7 @@ scene is an outdoor scene (``ridge``). The output directory receives::
                             (base exposure x 2**ae_ev: the auto-exposure step, not the flicker)
     timestamps.json         times_s, files, nominal_index, dropped_nominal_indices,
                             intervals_s, exposure_time_s, capture_start
-    ground_truth.nc         shadowcam.outdoor_capture ground truth (+ sensor attrs, provenance)
+    ground_truth.nc         shadowcam.synthetic.outdoor.capture ground truth (+ sensor attrs, provenance)
     capture.json            capture description: kind outdoor, light distant, sweep timelapse,
                             timing from the timestamps.json sidecar, checksums, ground_truth
 
@@ -26,7 +26,7 @@ import logging
 import time
 
 from shadowcam import __version__
-from shadowcam.provenance import file_sha256
+from shadowcam.io.provenance import file_sha256
 
 log = logging.getLogger(__name__)
 
@@ -88,9 +88,9 @@ def render_outdoor_capture_dir(options, out_dir):
     import numpy as np
 
     from shadowcam.cli.render import DEFAULTS, _write_frame, staging_dir, write_ground_truth
-    from shadowcam.outdoor_capture import NUISANCES, edge_speed, render_outdoor_capture
-    from shadowcam.outdoor_render import make_outdoor_scene
-    from shadowcam.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.outdoor.capture import NUISANCES, edge_speed, render_outdoor_capture
+    from shadowcam.synthetic.outdoor.render import make_outdoor_scene
+    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
 
     started = time.perf_counter()
     outdoor = outdoor_options(options.get("outdoor"))

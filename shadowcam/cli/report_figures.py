@@ -22,7 +22,7 @@ from pathlib import Path
 
 import xarray as xr
 
-from shadowcam import figures
+from shadowcam.report import figures
 
 LOG = logging.getLogger(__name__)
 
@@ -43,7 +43,7 @@ def add_parser(subparsers, name):
 
 def _primal_image(reference, shadow_time):
     if reference is not None:
-        from shadowcam.frame_store import open_frames
+        from shadowcam.io.frame_store import open_frames
 
         image = open_frames(reference)["image"]
         if "time" in image.dims:
@@ -57,12 +57,12 @@ def _primal_image(reference, shadow_time):
 
 def _ground_truth(manifest_path):
     """Return the ground-truth dataset of the capture, or None if it has none."""
-    from shadowcam.manifest import load_manifest
+    from shadowcam.io.manifest import load_manifest
 
     manifest = load_manifest(manifest_path)
     if not manifest.get("ground_truth") and not manifest.get("synthetic"):
         return None
-    from shadowcam.ground_truth import load_ground_truth
+    from shadowcam.io.ground_truth import load_ground_truth
 
     return load_ground_truth(manifest)
 

@@ -18,10 +18,10 @@ import os
 from pathlib import Path
 
 from shadowcam.cli.options import parse_params
-from shadowcam.frame_store import iter_frame_chunks, open_frames
-from shadowcam.provenance import attach_provenance
-from shadowcam.dip_tracker import DipPartial, merge_partials
-from shadowcam.shadow_time import (
+from shadowcam.io.frame_store import iter_frame_chunks, open_frames
+from shadowcam.io.provenance import attach_provenance
+from shadowcam.lab.dip_tracker import DipPartial, merge_partials
+from shadowcam.lab.shadow_time import (
     SHADOW_TIME_METHODS,
     shadow_time_dataset,
     summary_shadow_times,

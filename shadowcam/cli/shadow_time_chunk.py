@@ -16,8 +16,8 @@ from pathlib import Path
 
 from shadowcam.cli.decode import parse_frame_range
 from shadowcam.cli.options import parse_params
-from shadowcam.dip_tracker import DipTracker
-from shadowcam.frame_store import iter_frame_chunks, open_frames
+from shadowcam.lab.dip_tracker import DipTracker
+from shadowcam.io.frame_store import iter_frame_chunks, open_frames
 
 log = logging.getLogger(__name__)
 

@@ -1,12 +1,12 @@
 """``shadowcam track-edges``: the shadow edge of every frame, with keyframe interpolation.
 
-Second streaming pass (:mod:`shadowcam.outdoor_tracking`): coverage, frame
+Second streaming pass (:mod:`shadowcam.outdoor.tracking`): coverage, frame
 differencing, sub-pixel column edges with confidence, and the per-pixel
 coverage crossing; then keyframes and interpolation in seconds of the edges
-of unreliable frames (:mod:`shadowcam.keyframes`). Writes
+of unreliable frames (:mod:`shadowcam.outdoor.keyframes`). Writes
 ``results/<ds>/outdoor/edges.nc``. With ``--strips`` the pass is not run here:
 the column strips of ``shadowcam track-edges-strip`` jobs are merged
-(:func:`shadowcam.outdoor_strips.merge_strips`, equal to one job bit for bit).
+(:func:`shadowcam.outdoor.strips.merge_strips`, equal to one job bit for bit).
 
 Offers
 ------
@@ -18,12 +18,12 @@ import json
 
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import input_checksums, iter_frames, open_dataset, write_dataset
-from shadowcam.frame_store import open_frames
-from shadowcam.frame_times import find_gaps, median_interval
-from shadowcam.keyframes import interpolate_edges, select_keyframes
-from shadowcam.outdoor_datasets import edges_dataset, photometry_arrays
-from shadowcam.outdoor_strips import merge_strips
-from shadowcam.outdoor_tracking import track_frames
+from shadowcam.io.frame_store import open_frames
+from shadowcam.io.frame_times import find_gaps, median_interval
+from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
+from shadowcam.outdoor.datasets import edges_dataset, photometry_arrays
+from shadowcam.outdoor.strips import merge_strips
+from shadowcam.outdoor.tracking import track_frames
 
 TRACK_OPTIONS = {"half_window", "min_drop", "margin", "max_step", "lit_update", "update_distance"}
 KEYFRAME_OPTIONS = {"min_confidence", "min_found_fraction"}

@@ -1,7 +1,7 @@
 """``shadowcam track-edges-strip``: the edge-tracking pass on one column strip (one job).
 
 Reads only the strip's window (its columns plus a halo for the registration
-shift and the frame-differencing widening, :mod:`shadowcam.outdoor_strips`) of
+shift and the frame-differencing widening, :mod:`shadowcam.outdoor.strips`) of
 every frame, tracks it and saves the strip (``.npz``, written atomically).
 ``shadowcam track-edges --strips`` merges the strips of a frame into exactly
 the single job's edges.
@@ -10,7 +10,7 @@ Offers
 ------
 add_parser : register the step and its options.
 run : track the strip and save it.
-save_strip : write a strip (:func:`shadowcam.outdoor_strips.track_strip`) to ``.npz``.
+save_strip : write a strip (:func:`shadowcam.outdoor.strips.track_strip`) to ``.npz``.
 load_strip : read it back.
 """
 
@@ -22,10 +22,10 @@ import numpy as np
 from shadowcam.cli.options import parse_params
 from shadowcam.cli.outdoor_io import iter_frames, open_dataset
 from shadowcam.cli.track_edges import KEYFRAME_OPTIONS, TRACK_OPTIONS
-from shadowcam.frame_store import open_frames
-from shadowcam.image_io import atomic_path
-from shadowcam.outdoor_datasets import photometry_arrays
-from shadowcam.outdoor_strips import strip_bounds, strip_halo, strip_window, track_strip
+from shadowcam.io.frame_store import open_frames
+from shadowcam.io.images import atomic_path
+from shadowcam.outdoor.datasets import photometry_arrays
+from shadowcam.outdoor.strips import strip_bounds, strip_halo, strip_window, track_strip
 
 log = logging.getLogger(__name__)
 
@@ -63,7 +63,7 @@ def save_strip(strip, path):
 
 
 def load_strip(path):
-    """Read a strip written by :func:`save_strip` (dict as :func:`shadowcam.outdoor_strips.track_strip`)."""
+    """Read a strip written by :func:`save_strip` (dict as :func:`shadowcam.outdoor.strips.track_strip`)."""
     with np.load(path) as data:
         missing = set(STRIP_KEYS) - set(data.files)
         if missing:

@@ -21,9 +21,9 @@ from pathlib import Path
 
 import yaml
 
-from shadowcam.decode import frame_info
-from shadowcam.frame_store import default_chunk_frames
-from shadowcam.manifest import natural_key
+from shadowcam.io.decode import frame_info
+from shadowcam.io.frame_store import default_chunk_frames
+from shadowcam.io.manifest import natural_key
 
 SCENE_SWEEPS = ("u", "v")
 CALIBRATION_SWEEPS = ("cal_u", "cal_v")

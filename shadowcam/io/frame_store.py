@@ -1,0 +1,420 @@
+"""Time-chunked frame stores (zarr v3): write decoded frames, open and stream them.
+
+A sweep store holds variable ``image (time, row, col, channel)`` float32
+(linear, black = 0, white level = 1) with coords ``time`` (frame index,
+float64, units ``frame``), ``time_s`` and ``exposure_s`` (seconds, NaN where
+unknown) and ``channel`` (``R``, ``G``, ``B``), chunked along time only and
+compressed with zstd level 1. A reference store holds ``image (row, col,
+channel)`` (the mean of the reference frames). Stores are written to
+``<out>.tmp`` and renamed when complete, so an interrupted job never leaves a
+store that looks finished.
+
+A long sweep can be decoded as several *part* stores, one per job, each
+holding a range of frames that starts on a chunk boundary;
+:func:`merge_frame_stores` joins them into the sweep store by hard-linking
+their chunk files (no data copied; the result equals a single-job decode
+bit for bit).
+
+Offers
+------
+CHUNK_BYTES : target size of one uncompressed time chunk (64 MiB).
+default_chunk_frames : frames per chunk for a frame shape.
+write_frames : decode frames one at a time into a sweep store.
+merge_frame_stores : join part stores (consecutive frame ranges) into one sweep store.
+write_reference : decode and average reference frame(s) into a reference store.
+open_frames : open a store lazily (xarray, no dask).
+iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order (optionally a frame range).
+"""
+
+import json
+import logging
+import os
+import shutil
+import time as _time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+from zarr.codecs import ZstdCodec
+
+from shadowcam.io.decode import iter_frames
+
+log = logging.getLogger(__name__)
+
+#: target uncompressed size of one time chunk
+CHUNK_BYTES = 64 * 2**20
+CHANNELS = ("R", "G", "B")
+_COMPRESSORS = (ZstdCodec(level=1),)
+
+
+def default_chunk_frames(frame_shape, *, itemsize=4, target_bytes=CHUNK_BYTES):
+    """Return the number of frames whose data make about `target_bytes` (>= 1).
+
+    Parameters
+    ----------
+    frame_shape : tuple of int
+        Shape of one frame, e.g. ``(H, W, 3)``.
+    itemsize : int, optional
+        Bytes per value (4 for float32).
+    target_bytes : int, optional
+    """
+    frame_bytes = int(np.prod(frame_shape)) * int(itemsize)
+    if frame_bytes <= 0:
+        raise ValueError(f"frame_shape must be positive; got {frame_shape}")
+    return max(1, int(target_bytes) // frame_bytes)
+
+
+def _decoder_attrs(info):
+    return {
+        "decoder": info["decoder"],
+        "bit_depth": info["bit_depth"],
+        "cfa_pattern": info["cfa_pattern"] or "",
+        "black_level": info["black_level"],
+        "white_level": info["white_level"],
+        "white_balance_as_shot": info["white_balance"] or [],
+        "white_balance_applied": 0,
+        "normalisation": "linear; (value - black_level) / (white_level - black_level)",
+    }
+
+
+def _json_safe(attrs):
+    out = {}
+    for key, value in (attrs or {}).items():
+        if isinstance(value, dict):
+            value = json.dumps(value, sort_keys=True, default=str)
+        out[str(key)] = value
+    return out
+
+
+def _image_attrs():
+    return {"long_name": "linear image", "units": "1 (black = 0, white level = 1)"}
+
+
+def _block_dataset(block, start, times_s, exposure_s, *, first_frame=0):
+    stop = start + block.shape[0]
+    frames = np.arange(first_frame + start, first_frame + stop, dtype=np.float64)
+    return xr.Dataset(
+        {"image": (("time", "row", "col", "channel"), block, _image_attrs())},
+        coords={
+            "time": ("time", frames, {"units": "frame", "long_name": "frame index"}),
+            "time_s": ("time", np.asarray(times_s[start:stop], dtype=np.float64), {"units": "s", "long_name": "frame time"}),
+            "exposure_s": (
+                "time",
+                np.asarray(exposure_s[start:stop], dtype=np.float64),
+                {"units": "s", "long_name": "exposure time"},
+            ),
+            "channel": ("channel", np.array(CHANNELS, dtype=object)),
+        },
+    )
+
+
+class _AtomicStore:
+    """Context manager: write to ``<out>.tmp``; rename to ``out`` only on success."""
+
+    def __init__(self, out_path):
+        self.out = Path(out_path)
+        self.tmp = self.out.with_name(self.out.name + ".tmp")
+
+    def __enter__(self):
+        if self.out.suffix != ".zarr":
+            raise ValueError(f"out_path must end with .zarr; got {self.out}")
+        self.out.parent.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(self.tmp, ignore_errors=True)
+        return self.tmp
+
+    def __exit__(self, exc_type, exc, tb):
+        if exc_type is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            return False
+        if self.out.exists():
+            shutil.rmtree(self.out)
+        os.replace(self.tmp, self.out)
+        return False
+
+
+def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk_frames=None,
+                 first_frame=0, log_every=25):
+    """Decode frames one at a time into a time-chunked zarr v3 store.
+
+    Memory stays bounded by one time chunk whatever the number of frames.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        Frame files in time order (all of the same size).
+    out_path : str or Path
+        Store to create (``*.zarr``); replaced if it exists. Written to
+        ``<out_path>.tmp`` first and renamed when complete.
+    times_s : (T,) array_like of float
+        Frame times in seconds.
+    exposure_s : (T,) array_like of float, optional
+        Exposure times in seconds; default: from each file's metadata (NaN if absent).
+    attrs : mapping, optional
+        Extra dataset attrs (e.g. provenance); dict values are stored as JSON.
+    chunk_frames : int, optional
+        Frames per time chunk; default: about :data:`CHUNK_BYTES` per chunk
+        (at most the number of frames). When given, it is the store's chunk
+        size even if the store holds fewer frames, so that part stores of
+        one sweep share it (see :func:`merge_frame_stores`).
+    first_frame : int, optional
+        Frame index of ``paths[0]`` in the whole sweep (a part store); the
+        ``time`` coordinate counts from it. Must be a multiple of
+        `chunk_frames` so that the part's chunks are chunks of the sweep.
+    log_every : int, optional
+        Log progress every this many frames.
+
+    Returns
+    -------
+    Path
+        `out_path`.
+    """
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise ValueError("paths must list at least one frame")
+    times_s = np.asarray(times_s, dtype=np.float64)
+    if times_s.shape != (len(paths),):
+        raise ValueError(f"times_s must have one value per frame ({len(paths)}); got shape {times_s.shape}")
+    exposure_given = exposure_s is not None
+    exposure = np.asarray(exposure_s, dtype=np.float64) if exposure_given else np.full(len(paths), np.nan)
+    if exposure.shape != (len(paths),):
+        raise ValueError(f"exposure_s must have one value per frame ({len(paths)}); got shape {exposure.shape}")
+    if chunk_frames is not None and int(chunk_frames) < 1:
+        raise ValueError(f"chunk_frames must be >= 1; got {chunk_frames}")
+    first_frame = int(first_frame)
+    if first_frame < 0 or (first_frame and (chunk_frames is None or first_frame % int(chunk_frames))):
+        raise ValueError(
+            f"first_frame must be >= 0 and a multiple of chunk_frames (given explicitly); "
+            f"got first_frame={first_frame}, chunk_frames={chunk_frames}"
+        )
+    if log_every < 1:
+        raise ValueError(f"log_every must be >= 1; got {log_every}")
+
+    n = len(paths)
+    started = _time.perf_counter()
+    with _AtomicStore(out_path) as tmp:
+        block, start, written = None, 0, 0
+        for k, (path, image, info) in enumerate(iter_frames(paths)):
+            if block is None:
+                chunk = int(chunk_frames) if chunk_frames else min(n, default_chunk_frames(image.shape))
+                block = np.empty((min(n, chunk),) + image.shape, dtype=np.float32)
+                store_attrs = {**_decoder_attrs(info), **_json_safe(attrs), "n_frames": n}
+            if not exposure_given and info["exposure_s"] is not None:
+                exposure[k] = info["exposure_s"]
+            block[k - start] = image
+            if k - start + 1 == block.shape[0] or k == n - 1:
+                ds = _block_dataset(block[: k - start + 1], start, times_s, exposure, first_frame=first_frame)
+                ds.attrs.update(store_attrs)  # appends rewrite the group attrs
+                if start == 0:
+                    encoding = {
+                        "image": {"chunks": (chunk,) + block.shape[1:], "compressors": _COMPRESSORS},
+                        "time": {"chunks": (chunk,)},
+                        "time_s": {"chunks": (chunk,)},
+                        "exposure_s": {"chunks": (chunk,)},
+                    }
+                    ds.to_zarr(tmp, mode="w-", zarr_format=3, encoding=encoding, consolidated=False)
+                else:
+                    ds.to_zarr(tmp, append_dim="time", zarr_format=3, consolidated=False)
+                written = k + 1
+                start = k + 1
+            if (k + 1) % log_every == 0 or k == n - 1:
+                elapsed = _time.perf_counter() - started
+                log.info("decoded %d/%d frames (%.1f frames/s) -> %s", k + 1, n, (k + 1) / max(elapsed, 1e-9), out_path)
+    assert written == n
+    return Path(out_path)
+
+
+def _part_layout(path):
+    """(first frame, frame count, chunk frames, frame shape) of a part store."""
+    image = open_frames(path)["image"]
+    if image.dims != ("time", "row", "col", "channel"):
+        raise ValueError(f"parts: {path} is not a sweep store (image dims {image.dims})")
+    times = image["time"].values
+    first = int(times[0]) if times.size else 0
+    if times.size and not np.array_equal(times, np.arange(first, first + times.size)):
+        raise ValueError(f"parts: {path} holds non-consecutive frames")
+    return first, int(times.size), int(image.encoding["chunks"][0]), tuple(image.shape[1:])
+
+
+def _link(source, target):
+    """Hard-link `source` to `target` (copy where the file system cannot link)."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        os.link(source, target)
+    except OSError:
+        shutil.copy2(source, target)
+
+
+def _read_json(path):
+    with open(path) as handle:
+        return json.load(handle)
+
+
+def _write_json(path, document):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w") as handle:
+        json.dump(document, handle, indent=2)
+
+
+def merge_frame_stores(parts, out_path, *, attrs=None):
+    """Join part stores of one sweep into a single sweep store, without copying data.
+
+    Each part's compressed chunk files are hard-linked into the new store under
+    their chunk index in the whole sweep, and the array metadata are those of
+    the first part with the time length of the whole sweep. The result reads
+    exactly like a store written by one :func:`write_frames` call over all frames
+    with the same `chunk_frames` (same values, same chunk files). Written to
+    ``<out_path>.tmp`` and renamed when complete.
+
+    Parameters
+    ----------
+    parts : sequence of str or Path
+        Part stores from :func:`write_frames` (with ``first_frame``), in time
+        order: the first starts at frame 0, each starts where the previous
+        ends, all share the chunk size and frame shape.
+    out_path : str or Path
+        Sweep store to create (``*.zarr``); replaced if it exists.
+    attrs : mapping, optional
+        Dataset attrs to set or replace (e.g. the merged provenance); ``n_frames``
+        is set to the total. Other attrs are the first part's.
+
+    Returns
+    -------
+    Path
+        `out_path`.
+    """
+    parts = [Path(p) for p in parts]
+    if not parts:
+        raise ValueError("parts must list at least one part store")
+    layouts = [_part_layout(p) for p in parts]
+    chunk, shape = layouts[0][2], layouts[0][3]
+    expected = 0
+    for path, (first, count, part_chunk, part_shape) in zip(parts, layouts):
+        if part_chunk != chunk or part_shape != shape:
+            raise ValueError(
+                f"parts: {path} has chunks of {part_chunk} frames of {part_shape} but {parts[0]} has "
+                f"{chunk} of {shape}; decode every part with the same --chunk-frames"
+            )
+        if first != expected or first % chunk:
+            raise ValueError(
+                f"parts: {path} starts at frame {first}, expected {expected} (on a multiple of "
+                f"{chunk}); list the parts in time order without gaps"
+            )
+        expected += count
+    total = expected
+    with _AtomicStore(out_path) as tmp:
+        group = _read_json(parts[0] / "zarr.json")
+        group["attributes"] = {**group.get("attributes", {}), **_json_safe(attrs), "n_frames": total}
+        _write_json(tmp / "zarr.json", group)
+        for meta_path in sorted(parts[0].glob("*/zarr.json")):
+            name = meta_path.parent.name
+            meta = _read_json(meta_path)
+            encoding = meta.get("chunk_key_encoding", {})
+            if encoding.get("name") != "default" or encoding.get("configuration", {}).get("separator") != "/":
+                raise ValueError(f"parts: {meta_path} uses chunk key encoding {encoding}; expected default '/'")
+            along_time = (meta.get("dimension_names") or [None])[0] == "time"
+            if along_time:
+                meta["shape"][0] = total
+            _write_json(tmp / name / "zarr.json", meta)
+            for path, (first, *_rest) in zip(parts if along_time else parts[:1], layouts):
+                offset = first // chunk if along_time else 0
+                for source in sorted((path / name / "c").rglob("*")):
+                    if source.is_file():
+                        key = source.relative_to(path / name / "c").parts
+                        index = (str(int(key[0]) + offset),) + key[1:]
+                        _link(source, tmp.joinpath(name, "c", *index))
+    log.info("merged %d part store(s), %d frames -> %s", len(parts), total, out_path)
+    return Path(out_path)
+
+
+def write_reference(paths, out_path, *, attrs=None):
+    """Decode reference frame(s) and store their mean as ``image (row, col, channel)``.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        One or more unshadowed frames of the same size.
+    out_path : str or Path
+        Store to create (``*.zarr``), written atomically like :func:`write_frames`.
+    attrs : mapping, optional
+        Extra dataset attrs.
+
+    Returns
+    -------
+    Path
+    """
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise ValueError("paths must list at least one reference frame")
+    total, info = None, None
+    for _, image, frame_info in iter_frames(paths):
+        total = image.astype(np.float64) if total is None else total + image
+        info = info or frame_info
+    mean = (total / len(paths)).astype(np.float32)
+    ds = xr.Dataset(
+        {"image": (("row", "col", "channel"), mean, _image_attrs())},
+        coords={"channel": ("channel", np.array(CHANNELS, dtype=object))},
+        attrs={**_decoder_attrs(info), **_json_safe(attrs), "n_frames_averaged": len(paths)},
+    )
+    with _AtomicStore(out_path) as tmp:
+        ds.to_zarr(tmp, mode="w-", zarr_format=3, encoding={"image": {"compressors": _COMPRESSORS}}, consolidated=False)
+    return Path(out_path)
+
+
+def open_frames(path):
+    """Open a frame store lazily (no data read until indexed; no dask).
+
+    Parameters
+    ----------
+    path : str or Path
+        A store written by :func:`write_frames` or :func:`write_reference`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``image (time, row, col, channel)`` (or ``(row, col, channel)`` for a reference).
+    """
+    path = Path(path)
+    if not path.is_dir():
+        tmp = path.with_name(path.name + ".tmp")
+        hint = " (an unfinished write left it as .tmp; rerun the decode step)" if tmp.exists() else ""
+        raise ValueError(f"frame store {path} does not exist{hint}")
+    return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
+
+
+def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
+    """Yield blocks of consecutive frames, reading one chunk at a time.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        With ``image (time, row, col, channel)`` (e.g. from :func:`open_frames`).
+    chunk_frames : int, optional
+        Frames per block; default: the store's time chunk (or about
+        :data:`CHUNK_BYTES` for in-memory data).
+    start, stop : int, optional
+        Read only frames ``[start, stop)`` (`stop` clipped to the frame count;
+        default: all).
+
+    Yields
+    ------
+    start : int
+        Index of the block's first frame.
+    block : (T_chunk, H, W, C) float32 ndarray
+    """
+    if "image" not in dataset or dataset["image"].dims != ("time", "row", "col", "channel"):
+        raise ValueError("dataset must have variable image with dims (time, row, col, channel)")
+    image = dataset["image"]
+    if chunk_frames is None:
+        stored = image.encoding.get("chunks") or image.encoding.get("preferred_chunks", {}).get("time")
+        chunk_frames = stored[0] if isinstance(stored, (tuple, list)) else stored
+        chunk_frames = chunk_frames or default_chunk_frames(image.shape[1:])
+    chunk_frames = int(chunk_frames)
+    if chunk_frames < 1:
+        raise ValueError(f"chunk_frames must be >= 1; got {chunk_frames}")
+    n = image.sizes["time"]
+    stop = n if stop is None else min(int(stop), n)
+    if not 0 <= int(start) <= stop:
+        raise ValueError(f"start must be in [0, {stop}] (frames {n}); got start={start}, stop={stop}")
+    for first in range(int(start), stop, chunk_frames):
+        block = image.isel(time=slice(first, min(first + chunk_frames, stop))).values
+        yield first, np.asarray(block, dtype=np.float32)

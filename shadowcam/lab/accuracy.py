@@ -1,0 +1,425 @@
+"""Accuracy of shadow times, dual coordinates and dual views against ground truth.
+
+Metrics (synthetic data with exact ground truth, docs/architecture.md form):
+
+* shadow time, per sweep, over lit pixels with a GT time: absolute error
+  median, 95th percentile, RMSE, fraction > 1 frame; coverage = fraction of
+  those pixels with an estimate; false-time rate = fraction of GT-unlit pixels
+  that were given a time.
+* dual coordinates: Euclidean error (dual pixels) of ``(u, v)`` against the
+  GT times expressed on the same dual grid (uniform model: the mask plane
+  scaled; calibration model: the calibration plane's window, reached from
+  the mask plane by the exact GT homography of the central projection).
+* dual image against the GT reciprocal render, after ONE least-squares gain
+  fitted inside the valid mask (coverage & dual_cam_visible & finite
+  reciprocal; the render resampled onto the dual grid when the grids
+  differ): relative RMSE inside that mask, and over the whole image with
+  holes counted as zero -- the two curves of the paper's Fig. 5.
+
+Targets (foundation issue) are checked and reported pass/fail.
+
+Offers
+------
+ACCURACY_TARGETS : the targets and their thresholds.
+shadow_time_errors : error statistics of one sweep's shadow times.
+dual_coord_errors : error statistics of dual coordinates.
+dual_image_errors : gain-fitted relative RMSE of a dual view, masked and whole image.
+check_targets : pass/fail of every target for a report.
+accuracy_report : the nested report for one dataset's products.
+flatten_report : the report as ``(key, value)`` rows.
+report_to_json, report_to_csv : serialise a report to text.
+"""
+
+import csv
+import io
+import json
+
+import numpy as np
+
+#: targets of the foundation issue; the shadow-time p95 depends on the noise condition
+ACCURACY_TARGETS = {
+    "shadow_time_p95_frames": {"noise_free": 0.1, "raw12": 0.3, "comparison": "<="},
+    "shadow_time_coverage": {"threshold": 0.98, "comparison": ">="},
+    "false_time_rate": {"threshold": 0.01, "comparison": "<"},
+}
+
+
+def _stats(err):
+    """median, p95, RMSE, max of a 1-D error array (NaN if empty)."""
+    if err.size == 0:
+        return {"median": float("nan"), "p95": float("nan"), "rmse": float("nan"),
+                "max": float("nan")}
+    return {
+        "median": float(np.median(err)),
+        "p95": float(np.percentile(err, 95)),
+        "rmse": float(np.sqrt(np.mean(err**2))),
+        "max": float(err.max()),
+    }
+
+
+def shadow_time_errors(estimate, truth, *, lit):
+    """Error statistics of one sweep's shadow times.
+
+    Parameters
+    ----------
+    estimate : (rows, cols) ndarray
+        Estimated shadow time (frames), NaN = no estimate.
+    truth : (rows, cols) ndarray
+        GT shadow time (frames), NaN where not lit or not swept.
+    lit : (rows, cols) bool ndarray, keyword-only
+        GT: the pixel's point sees the light.
+
+    Returns
+    -------
+    dict
+        ``n_truth`` (lit pixels with a GT time), ``n_evaluated``, ``coverage``,
+        ``median``, ``p95``, ``rmse``, ``max`` (absolute error, frames),
+        ``frac_gt_1_frame``, ``n_unlit``, ``false_time_rate``, ``mean_signed``.
+    """
+    estimate = np.asarray(estimate, dtype=np.float64)
+    truth = np.asarray(truth, dtype=np.float64)
+    lit = np.asarray(lit, dtype=bool)
+    if estimate.shape != truth.shape or lit.shape != truth.shape:
+        raise ValueError(
+            f"estimate/truth/lit: shapes differ: {estimate.shape}, {truth.shape}, {lit.shape}"
+        )
+    has_truth = lit & np.isfinite(truth)
+    has_est = np.isfinite(estimate)
+    evaluated = has_truth & has_est
+    signed = (estimate - truth)[evaluated]
+    err = np.abs(signed)
+    n_truth, n_unlit = int(has_truth.sum()), int((~lit).sum())
+    out = {
+        "n_truth": n_truth,
+        "n_evaluated": int(evaluated.sum()),
+        "coverage": float(evaluated.sum() / n_truth) if n_truth else float("nan"),
+        **_stats(err),
+        "frac_gt_1_frame": float(np.mean(err > 1.0)) if err.size else float("nan"),
+        "mean_signed": float(signed.mean()) if err.size else float("nan"),
+        "n_unlit": n_unlit,
+        "false_time_rate": float((has_est & ~lit).sum() / n_unlit) if n_unlit else 0.0,
+    }
+    return out
+
+
+def dual_coord_errors(u, v, true_u, true_v, *, valid=None):
+    """Euclidean error (dual pixels) of dual coordinates.
+
+    Parameters
+    ----------
+    u, v : (rows, cols) ndarray
+        Estimated dual coordinates, NaN = none.
+    true_u, true_v : (rows, cols) ndarray
+        GT dual coordinates, NaN = none.
+    valid : (rows, cols) bool ndarray, optional
+        Estimates to use (default: finite ``u`` and ``v``).
+
+    Returns
+    -------
+    dict
+        ``n_truth``, ``n_evaluated``, ``coverage``, ``median``, ``p95``,
+        ``rmse``, ``max`` of ``hypot(u - true_u, v - true_v)``, and per-axis
+        ``rmse_u``, ``rmse_v``.
+    """
+    u, v, tu, tv = (np.asarray(a, dtype=np.float64) for a in (u, v, true_u, true_v))
+    if not (u.shape == v.shape == tu.shape == tv.shape):
+        raise ValueError(f"u/v/true_u/true_v: shapes differ: {u.shape}, {v.shape}, {tu.shape}")
+    est = np.isfinite(u) & np.isfinite(v)
+    if valid is not None:
+        est &= np.asarray(valid, dtype=bool)
+    has_truth = np.isfinite(tu) & np.isfinite(tv)
+    ev = est & has_truth
+    du, dv = (u - tu)[ev], (v - tv)[ev]
+    n_truth = int(has_truth.sum())
+    return {
+        "n_truth": n_truth,
+        "n_evaluated": int(ev.sum()),
+        "coverage": float(ev.sum() / n_truth) if n_truth else float("nan"),
+        **_stats(np.hypot(du, dv)),
+        "rmse_u": float(np.sqrt(np.mean(du**2))) if du.size else float("nan"),
+        "rmse_v": float(np.sqrt(np.mean(dv**2))) if dv.size else float("nan"),
+    }
+
+
+def dual_image_errors(dual_view, coverage, reciprocal, *, dual_cam_visible):
+    """Relative RMSE of a dual view against the reciprocal render, one gain fitted.
+
+    The gain ``g`` minimises ``sum (g * est - ref)^2`` over the valid mask
+    ``coverage & dual_cam_visible & finite(reciprocal)`` (all channels). Then
+
+    * ``rel_rmse_masked = sqrt(mean((g est - ref)^2) / mean(ref^2))`` in the mask;
+    * ``rel_rmse_whole``: the same over every dual pixel with a finite
+      reciprocal, holes (no estimate) counted as zero.
+
+    Parameters
+    ----------
+    dual_view : (v, u, channel) ndarray
+        Estimated dual view (linear), NaN = hole.
+    coverage : (v, u) bool ndarray
+    reciprocal : (v, u, channel) ndarray
+        GT reciprocal render on the same grid.
+    dual_cam_visible : (v, u) bool ndarray, keyword-only
+        GT: the dual pixel's point is seen by the camera.
+
+    Returns
+    -------
+    dict
+        ``gain``, ``rel_rmse_masked``, ``rel_rmse_whole``, ``n_mask``,
+        ``coverage_of_visible`` (fraction of camera-visible dual pixels covered),
+        ``covered_not_visible`` (fraction of covered pixels the camera cannot see).
+    """
+    est = np.asarray(dual_view, dtype=np.float64)
+    ref = np.asarray(reciprocal, dtype=np.float64)
+    cov = np.asarray(coverage, dtype=bool)
+    vis = np.asarray(dual_cam_visible, dtype=bool)
+    if est.shape != ref.shape:
+        raise ValueError(f"dual_view: shape {est.shape} differs from reciprocal {ref.shape}")
+    if cov.shape != est.shape[:2] or vis.shape != est.shape[:2]:
+        raise ValueError(f"coverage/dual_cam_visible: shapes {cov.shape}, {vis.shape} "
+                         f"differ from dual_view {est.shape[:2]}")
+    ref_ok = np.all(np.isfinite(ref), axis=2)
+    est_ok = cov & np.all(np.isfinite(est), axis=2)
+    mask = est_ok & vis & ref_ok
+    e, r = est[mask], ref[mask]
+    denom = float(np.sum(e * e))
+    gain = float(np.sum(e * r) / denom) if denom > 0 else float("nan")
+    out = {
+        "gain": gain,
+        "n_mask": int(mask.sum()),
+        "coverage_of_visible": float((cov & vis).sum() / vis.sum()) if vis.any() else float("nan"),
+        "covered_not_visible": float((cov & ~vis).sum() / cov.sum()) if cov.any() else 0.0,
+    }
+    if mask.any() and np.isfinite(gain):
+        out["rel_rmse_masked"] = float(np.sqrt(np.mean((gain * e - r) ** 2) / np.mean(r**2)))
+        filled = np.where(est_ok[..., None], est, 0.0)[ref_ok]
+        whole_ref = ref[ref_ok]
+        out["rel_rmse_whole"] = float(
+            np.sqrt(np.mean((gain * filled - whole_ref) ** 2) / np.mean(whole_ref**2))
+        )
+    else:
+        out["rel_rmse_masked"] = out["rel_rmse_whole"] = float("nan")
+    return out
+
+
+def _compare(value, threshold, comparison):
+    if not np.isfinite(value):
+        return False
+    return {"<=": value <= threshold, "<": value < threshold, ">=": value >= threshold}[comparison]
+
+
+def check_targets(report, *, noise="noise_free"):
+    """Pass/fail of every target of `ACCURACY_TARGETS` for a report's shadow times.
+
+    Parameters
+    ----------
+    report : dict
+        With ``report["shadow_time"][sweep]`` from `shadow_time_errors`.
+    noise : {"noise_free", "raw12"}, keyword-only
+        Noise condition; selects the shadow-time p95 threshold.
+
+    Returns
+    -------
+    list of dict
+        ``target``, ``sweep``, ``value``, ``threshold``, ``comparison``, ``pass``.
+    """
+    p95 = ACCURACY_TARGETS["shadow_time_p95_frames"]
+    if noise not in ("noise_free", "raw12"):
+        raise ValueError(f"noise: expected 'noise_free' or 'raw12', got {noise!r}")
+    rows = []
+    for sweep, stats in report.get("shadow_time", {}).items():
+        for target, key, threshold, comparison in (
+            ("shadow_time_p95_frames", "p95", p95[noise], p95["comparison"]),
+            ("shadow_time_coverage", "coverage", ACCURACY_TARGETS["shadow_time_coverage"]["threshold"],
+             ACCURACY_TARGETS["shadow_time_coverage"]["comparison"]),
+            ("false_time_rate", "false_time_rate", ACCURACY_TARGETS["false_time_rate"]["threshold"],
+             ACCURACY_TARGETS["false_time_rate"]["comparison"]),
+        ):
+            value = stats[key]
+            rows.append({"target": target, "sweep": sweep, "value": value, "threshold": threshold,
+                         "comparison": comparison, "pass": bool(_compare(value, threshold, comparison))})
+    return rows
+
+
+def _dual_grid_map(dual_coords, ground_truth):
+    """Homography from GT mask-plane coordinates (``t_u``, ``t_v``) to the dual grid.
+
+    The uniform model's grid is an axis scaling of the mask plane. A
+    calibration plane's grid is the plane window of the dual coordinates
+    (attrs ``plane_window``, ``axes_flipped``, ``dual_width``,
+    ``dual_height``); for a point light the mask plane and the calibration
+    plane are related by the central projection from the light, a
+    homography, fitted exactly to the GT calibration times and plane points.
+    Returns None when the GT cannot express that grid.
+    """
+    attrs = dual_coords.attrs
+    method = attrs.get("method", attrs.get("model"))
+    if method == "uniform":
+        scale = np.asarray(attrs.get("scale", (1.0, 1.0)), dtype=np.float64)
+        offset = np.asarray(attrs.get("offset", (0.0, 0.0)), dtype=np.float64)
+        return np.array([[scale[0], 0, offset[0]], [0, scale[1], offset[1]], [0, 0, 1.0]])
+    needed = ("t_cal_u", "t_cal_v", "plane_xy")
+    if method != "calibration" or not all(k in ground_truth for k in needed):
+        return None
+    import cv2
+
+    times = np.stack([ground_truth["t_cal_u"].values, ground_truth["t_cal_v"].values], -1)
+    plane = ground_truth["plane_xy"].values
+    ok = np.all(np.isfinite(times), -1) & np.all(np.isfinite(plane), -1)
+    if ok.sum() < 4:
+        return None
+    to_plane, _ = cv2.findHomography(times[ok].astype(np.float64), plane[ok].astype(np.float64), 0)
+    x0, y0, x1, y1 = (float(w) for w in attrs["plane_window"])
+    flip_x, flip_y = (bool(f) for f in attrs.get("axes_flipped", (False, False)))
+    sx = float(attrs["dual_width"]) / (x1 - x0)
+    sy = float(attrs["dual_height"]) / (y1 - y0)
+    to_grid = np.array([
+        [-sx if flip_x else sx, 0, (sx * x1 if flip_x else -sx * x0) - 0.5],
+        [0, -sy if flip_y else sy, (sy * y1 if flip_y else -sy * y0) - 0.5],
+        [0, 0, 1.0],
+    ])
+    return to_grid @ to_plane
+
+
+def _map_points(homography, x, y):
+    """:func:`~shadowcam.cameras.dual_coords.apply_homography` on coordinate arrays `x`, `y` of any shape."""
+    from shadowcam.cameras.dual_coords import apply_homography
+
+    mapped = apply_homography(homography, np.column_stack([np.ravel(x), np.ravel(y)]))
+    return mapped[:, 0].reshape(np.shape(x)), mapped[:, 1].reshape(np.shape(x))
+
+
+def _reciprocal_on_grid(ground_truth, grid_map, shape):
+    """GT reciprocal render and camera visibility resampled onto a dual grid.
+
+    Each grid pixel centre is mapped back to mask-plane coordinates (the
+    reciprocal render's pixel grid: centre of column i is ``t_u = i``) and
+    the render is interpolated bilinearly there (NaN outside it); visibility
+    is taken from the nearest reciprocal pixel.
+    """
+    from scipy.ndimage import map_coordinates
+
+    reciprocal = ground_truth["reciprocal"].transpose("v", "u", "channel").values.astype(np.float64)
+    visible = ground_truth["dual_cam_visible"].transpose("v", "u").values
+    rows, cols = np.indices(shape, dtype=np.float64)
+    t_u, t_v = _map_points(np.linalg.inv(grid_map), cols, rows)
+    h, w = visible.shape
+    inside = (t_u >= -0.5) & (t_u <= w - 0.5) & (t_v >= -0.5) & (t_v <= h - 0.5)
+    coords = np.stack([np.where(inside, t_v, 0), np.where(inside, t_u, 0)])
+    resampled = np.stack([map_coordinates(reciprocal[..., c], coords, order=1, mode="nearest")
+                          for c in range(reciprocal.shape[2])], axis=-1)
+    resampled[~inside] = np.nan
+    nearest = np.rint(coords).astype(np.intp)
+    visible_on_grid = inside & visible[np.clip(nearest[0], 0, h - 1), np.clip(nearest[1], 0, w - 1)]
+    return resampled, visible_on_grid
+
+
+def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=None,
+                    noise="noise_free", sweeps=("u", "v")):
+    """Accuracy report of one dataset's products against its ground truth.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``shadow_time (sweep, row, col)``.
+    ground_truth : xarray.Dataset
+        Standard GT form: ``t_u``, ``t_v``, ``lit`` over ``(row, col)``;
+        ``reciprocal (v, u, channel)``, ``dual_cam_visible (v, u)``.
+    dual_coords : xarray.Dataset, optional
+        ``u``, ``v``, ``valid`` over ``(row, col)``.
+    dual_view : xarray.Dataset, optional
+        ``dual_view (v, u, channel)``, ``coverage (v, u)``.
+    noise : {"noise_free", "raw12"}, keyword-only
+        Noise condition of the capture (selects the shadow-time target).
+    sweeps : sequence of str
+        Scene sweeps to evaluate (GT ``t_<sweep>``).
+
+    Returns
+    -------
+    dict
+        ``shadow_time`` (per sweep), ``dual_coords``, ``dual_image``,
+        ``targets`` (list), ``all_targets_pass``, ``noise``.
+    """
+    lit = np.asarray(ground_truth["lit"].values, dtype=bool)
+    report = {"noise": noise, "shadow_time": {}}
+    names = [str(s) for s in shadow_time["sweep"].values]
+    for sweep in sweeps:
+        if sweep not in names or f"t_{sweep}" not in ground_truth:
+            continue
+        est = shadow_time["shadow_time"].sel(sweep=sweep).transpose("row", "col").values
+        report["shadow_time"][sweep] = shadow_time_errors(
+            est, ground_truth[f"t_{sweep}"].transpose("row", "col").values, lit=lit)
+    # without dual coordinates the dual view is taken to be on the reciprocal grid
+    grid_map = np.eye(3) if dual_coords is None else _dual_grid_map(dual_coords, ground_truth)
+    if dual_coords is not None:
+        if grid_map is None:
+            report["dual_coords"] = {"skipped": "the ground truth cannot express this dual grid"}
+        else:
+            true_u, true_v = _map_points(grid_map, ground_truth["t_u"].values.astype(np.float64),
+                                         ground_truth["t_v"].values.astype(np.float64))
+            report["dual_coords"] = dual_coord_errors(
+                dual_coords["u"].values, dual_coords["v"].values, true_u, true_v,
+                valid=dual_coords["valid"].values)
+    if dual_view is not None:
+        image = dual_view["dual_view"].transpose("v", "u", "channel").values
+        if grid_map is None:
+            report["dual_image"] = {"skipped": "the ground truth cannot express this dual grid"}
+        else:
+            reciprocal, visible = _reciprocal_on_grid(ground_truth, grid_map, image.shape[:2])
+            report["dual_image"] = dual_image_errors(
+                image, dual_view["coverage"].values, reciprocal, dual_cam_visible=visible)
+    report["targets"] = check_targets(report, noise=noise)
+    report["all_targets_pass"] = bool(report["targets"]) and all(t["pass"] for t in report["targets"])
+    return report
+
+
+def flatten_report(report):
+    """Flatten a nested report into ``(key, value)`` rows (keys joined by ``.``).
+
+    Target rows become ``targets.<target>.<sweep>.value|threshold|pass``.
+    """
+    rows = []
+
+    def walk(prefix, node):
+        if isinstance(node, dict):
+            for key, value in node.items():
+                walk(f"{prefix}.{key}" if prefix else str(key), value)
+        else:
+            rows.append((prefix, node))
+
+    for key, value in report.items():
+        if key == "targets":
+            for t in value:
+                base = f"targets.{t['target']}.{t['sweep']}"
+                rows += [(f"{base}.value", t["value"]), (f"{base}.threshold", t["threshold"]),
+                         (f"{base}.pass", t["pass"])]
+        else:
+            walk(key, value)
+    return rows
+
+
+def _json_safe(node):
+    if isinstance(node, dict):
+        return {k: _json_safe(v) for k, v in node.items()}
+    if isinstance(node, (list, tuple)):
+        return [_json_safe(v) for v in node]
+    if isinstance(node, (float, np.floating)):
+        return float(node) if np.isfinite(node) else None
+    if isinstance(node, np.integer):
+        return int(node)
+    if isinstance(node, np.bool_):
+        return bool(node)
+    return node
+
+
+def report_to_json(report):
+    """The report as indented JSON text (NaN/inf written as null)."""
+    return json.dumps(_json_safe(report), indent=2, sort_keys=False) + "\n"
+
+
+def report_to_csv(report):
+    """The report as a two-column CSV table ``metric,value``."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["metric", "value"])
+    writer.writerows(flatten_report(report))
+    return buf.getvalue()

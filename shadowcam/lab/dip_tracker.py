@@ -1,0 +1,420 @@
+"""Streaming per-pixel tracking of the deepest intensity dip of a sweep.
+
+A moving mask's shadow shows at a camera pixel as a short dip of its
+intensity over time (paper section II-A). Finding it needs neither the whole
+video nor its length in memory: frames are fed in time order, one block at a
+time, and each pixel keeps only
+
+* exact running sums of its signal, its square and each channel (see
+  :mod:`shadowcam.lab.dip_kernels`), from which the unshadowed level and the
+  noise are computed with the dip removed;
+* its deepest local minima of the temporally [1, 2, 1]-smoothed signal (a
+  local minimum is not above any smoothed value within ``half_window``
+  frames and is the middle of a flat minimum; ties between separate dips go
+  to the earlier one; non-finite samples take no part), and the raw window of
+  ``2 * half_window + 1`` samples around the deepest one.
+
+The deepest minimum is the deepest smoothed value of the sweep; the second
+dip is the deepest other local minimum (more than ``half_window`` frames
+away from it: a second dip inside the window is seen too). Memory is ``O(H * W * window)``, independent of the
+number of frames.
+
+Time chunks: a tracker built with ``owned=(start, stop)`` is fed the frames
+``[max(0, start - pad), min(n, stop + pad))`` (``pad = DipTracker.padding(h)``)
+and contributes the centres and sums of frames ``[start, stop)`` only; its
+:meth:`DipTracker.partial` is a :class:`DipPartial` (plain arrays, saved
+atomically to ``.npz``), and :func:`merge_partials` of the chunks of a sweep
+equals the single-pass :meth:`DipTracker.result` bit for bit, whatever the
+chunking and block sizes (the sums are exact, the minima are a selection).
+
+Offers
+------
+DipTracker : the streaming accumulator (``update`` with frame blocks, then ``result`` or ``partial``).
+DipSummary : what the tracker hands to the timing methods (plain arrays).
+DipPartial : the state of one time chunk (``save`` / ``load``).
+merge_partials : the summary of a sweep from its time chunks.
+"""
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from shadowcam.lab import dip_kernels as _k
+
+
+@dataclass
+class DipSummary:
+    """Per-pixel statistics of one sweep, enough to time and classify the dip.
+
+    Attributes
+    ----------
+    window : (K, H, W) float32 ndarray
+        Raw signal around the deepest smoothed minimum; ``window[k]`` is frame
+        ``window_start + k``. Frames outside the sequence are NaN.
+    window_start : (H, W) int64 ndarray
+        Frame index of ``window[0]``.
+    minimum_frame : (H, W) int64 ndarray
+        Frame of the deepest smoothed minimum (-1 where no valid frame).
+    minimum_value : (H, W) float32 ndarray
+        Smoothed signal at `minimum_frame`.
+    second_value : (H, W) float32 ndarray
+        Deepest other smoothed local minimum (more than ``half_window``
+        frames from `minimum_frame`) (``+inf`` when none).
+    second_frame : (H, W) int64 ndarray
+        Frame of `second_value` (negative when none).
+    lit_level : (H, W) float64 ndarray
+        Mean signal over the valid frames outside the window (unshadowed level).
+    noise : (H, W) float64 ndarray
+        Standard deviation of those frames (temporal noise).
+    lit_count : (H, W) int64 ndarray
+        Number of frames behind `lit_level`.
+    mean_level : (H, W) float64 ndarray
+        Mean signal over all valid frames.
+    invalid_count : (H, W) int64 ndarray
+        Number of non-finite samples seen.
+    n_frames : int
+        Frames seen.
+    channel_sum : (H, W, C) float64 ndarray or None
+        Sum over all frames of each channel (non-finite samples as 0), when
+        the tracker was fed ``(T, H, W, C)`` blocks.
+    saturated : (H, W) bool ndarray or None
+        Whether any channel reached the saturation level in any frame.
+    """
+
+    window: np.ndarray
+    window_start: np.ndarray
+    minimum_frame: np.ndarray
+    minimum_value: np.ndarray
+    second_value: np.ndarray
+    second_frame: np.ndarray
+    lit_level: np.ndarray
+    noise: np.ndarray
+    lit_count: np.ndarray
+    mean_level: np.ndarray
+    invalid_count: np.ndarray
+    n_frames: int
+    channel_sum: np.ndarray = None
+    saturated: np.ndarray = None
+
+    @property
+    def half_window(self):
+        """Half width of the stored window, in frames."""
+        return (self.window.shape[0] - 1) // 2
+
+
+@dataclass
+class DipPartial:
+    """State of a :class:`DipTracker` over its owned frames (one time chunk).
+
+    Arrays are pixel-major; ``TOP`` = :data:`shadowcam.lab.dip_kernels.TOP`,
+    ``K = 2 * half_window + 1``.
+
+    Attributes
+    ----------
+    start, stop : int
+        Owned frames ``[start, stop)`` (`stop` clipped to the frames fed).
+    end : int
+        One past the last frame fed.
+    half_window : int
+    top_value : (H, W, TOP) float32 ndarray
+        Deepest smoothed local minima with centre in ``[start, stop)``, ascending
+        (``+inf`` = empty slot).
+    top_frame : (H, W, TOP) int64 ndarray
+        Their frames (-1 = empty).
+    window : (H, W, K) float32 ndarray
+        Raw samples around ``top_frame[..., 0]``.
+    signal_sum : (H, W) int64 ndarray
+        Fixed-point sum (units ``2**-32``) of the finite signal samples.
+    square_hi, square_lo : (H, W) float64 ndarray
+        Exact-summing parts of the sum of squares.
+    count, invalid : (H, W) int64 ndarray
+        Finite and non-finite signal samples.
+    channel_sum : (H, W, C) int64 ndarray
+        Fixed-point per-channel sums (C = 0 if fed scalar frames).
+    saturated : (H, W) bool ndarray
+    """
+
+    start: int
+    stop: int
+    end: int
+    half_window: int
+    top_value: np.ndarray
+    top_frame: np.ndarray
+    window: np.ndarray
+    signal_sum: np.ndarray
+    square_hi: np.ndarray
+    square_lo: np.ndarray
+    count: np.ndarray
+    invalid: np.ndarray
+    channel_sum: np.ndarray
+    saturated: np.ndarray
+
+    def save(self, path):
+        """Write to `path` (ending ``.npz``) atomically: a temporary file, then a rename."""
+        from shadowcam.io.images import atomic_path
+
+        with atomic_path(path) as tmp:
+            np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
+
+    @classmethod
+    def load(cls, path):
+        """Read a partial written by :meth:`save`."""
+        with np.load(path) as data:
+            missing = {f.name for f in fields(cls)} - set(data.files)
+            if missing:
+                raise ValueError(f"path {path} is not a DipPartial file: missing {sorted(missing)}")
+            values = {f.name: data[f.name] for f in fields(cls)}
+        for name in ("start", "stop", "end", "half_window"):
+            values[name] = int(values[name])
+        return cls(**values)
+
+
+class DipTracker:
+    """Streaming tracker of each pixel's deepest dip.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)`` of the frames.
+    half_window : int, optional
+        Frames kept on each side of the minimum; the dip must fit in
+        ``2 * half_window + 1`` frames for entry and exit to be seen.
+    owned : (int, int), optional
+        Time chunk ``(start, stop)`` this tracker contributes; feed it frames
+        ``[max(0, start - pad), min(n, stop + pad))`` with
+        ``pad = DipTracker.padding(half_window)`` and take :meth:`partial`.
+        Default: the whole sequence.
+    saturation_level : float, optional
+        Channel value at or above which a pixel counts as saturated.
+
+    Examples
+    --------
+    >>> tracker = DipTracker((2, 3), half_window=2)
+    >>> frames = np.ones((20, 2, 3), np.float32); frames[7] = 0.1
+    >>> tracker.update(frames)
+    >>> int(tracker.result().minimum_frame[0, 0])
+    7
+    """
+
+    def __init__(self, shape, *, half_window=4, owned=None, saturation_level=0.999):
+        if len(shape) != 2 or min(shape) < 1:
+            raise ValueError(f"shape must be (H, W) with positive sizes, got {shape!r}")
+        if int(half_window) < 1:
+            raise ValueError(f"half_window must be >= 1, got {half_window!r}")
+        start, stop = (0, np.iinfo(np.int64).max) if owned is None else (int(owned[0]), int(owned[1]))
+        if not 0 <= start < stop:
+            raise ValueError(f"owned must be (start, stop) with 0 <= start < stop, got {owned!r}")
+        self.shape = tuple(int(s) for s in shape)
+        self.half_window = h = int(half_window)
+        self.owned = (start, stop)
+        self.saturation_level = float(saturation_level)
+        k = 2 * h + 1
+        p = self.shape[0] * self.shape[1]
+        self._first = max(0, start - self.padding(h))
+        self._next = self._first
+        # pixel-minor state (see dip_kernels.track_block)
+        self._raw = np.full((k + 2, p), np.nan, np.float32)
+        self._smooth = np.full((k + 2, p), np.nan, np.float32)
+        self._top_value = np.full((_k.TOP, p), np.inf, np.float32)
+        self._top_frame = np.full((_k.TOP, p), -1, np.int64)
+        self._window = np.full((k, p), np.nan, np.float32)
+        self._signal_sum = np.zeros(p, np.int64)
+        self._square_hi = np.zeros(p, np.float64)
+        self._square_lo = np.zeros(p, np.float64)
+        self._count = np.zeros(p, np.int64)
+        self._invalid = np.zeros(p, np.int64)
+        self._channel_sum = None
+        self._saturated = np.zeros(p, bool)
+        self._partial = None
+
+    @staticmethod
+    def padding(half_window):
+        """Frames needed on each side of an owned time chunk: ``half_window + 2``.
+
+        A centre's test reads the smoothed values from ``half_window + 1`` frames
+        before it (one raw frame more) to ``half_window`` after it (one more).
+        """
+        return int(half_window) + 2
+
+    @property
+    def n_frames(self):
+        """One past the last frame fed so far (the frames seen, for a whole sweep)."""
+        return self._next
+
+    def update(self, block, *, first_index=None):
+        """Feed the next frames.
+
+        Parameters
+        ----------
+        block : (T, H, W), (H, W) or (T, H, W, C) array_like
+            Signal of the next frames, in time order; with channels, the
+            signal is their sum and per-channel sums and saturation are kept
+            too. Non-finite samples are counted and ignored.
+        first_index : int, optional
+            Frame index of ``block[0]``; blocks must follow each other without
+            gaps. Default: the next frame.
+        """
+        if self._partial is not None:
+            raise ValueError("update() called after result()/partial(); start a new DipTracker")
+        block = np.asarray(block, dtype=np.float32)
+        if block.ndim == 2:
+            block = block[None]
+        if block.ndim == 3:
+            block = block[..., None]
+        if block.ndim != 4 or block.shape[1:3] != self.shape:
+            raise ValueError(
+                f"block must have shape (T, {self.shape[0]}, {self.shape[1]}[, C]), got {block.shape}"
+            )
+        first = self._next if first_index is None else int(first_index)
+        if first != self._next:
+            raise ValueError(
+                f"first_index must be {self._next} (the frame after the last one fed, or "
+                f"max(0, start - padding) at first), got {first}"
+            )
+        n_c = block.shape[3]
+        if n_c > 3:
+            raise ValueError(f"block must have at most 3 channels, got {n_c}")
+        if self._channel_sum is None:
+            self._channel_sum = np.zeros((n_c, self._raw.shape[1]), np.int64)
+        elif self._channel_sum.shape[0] != n_c:
+            raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[0]}")
+        flat = np.ascontiguousarray(block).reshape(block.shape[0], -1, n_c)
+        _k.track_block(flat, first, *self.owned, self.half_window, np.float32(self.saturation_level),
+                       self._raw, self._smooth, self._top_value, self._top_frame, self._window, self._signal_sum,
+                       self._square_hi, self._square_lo, self._count, self._invalid,
+                       self._channel_sum, self._saturated)
+        self._next = first + block.shape[0]
+
+    def partial(self):
+        """Finish the owned chunk and return its :class:`DipPartial`.
+
+        Centres whose window runs past the last frame fed are tested as the
+        end of the sequence. The tracker cannot be updated afterwards.
+        """
+        if self._partial is None:
+            start, stop = self.owned
+            end = self._next
+            first = max(end - self.half_window - 1, start)  # centres not yet tested
+            _k.finish_centres(first, min(stop, end), end, self.half_window, self._raw, self._smooth,
+                              self._top_value, self._top_frame, self._window)
+            h, w = self.shape
+            channels = self._channel_sum if self._channel_sum is not None else np.zeros((0, h * w), np.int64)
+
+            def pixel_major(state):
+                return np.ascontiguousarray(state.T).reshape(h, w, -1)
+
+            self._partial = DipPartial(
+                start=start, stop=max(min(stop, end), start), end=end, half_window=self.half_window,
+                top_value=pixel_major(self._top_value), top_frame=pixel_major(self._top_frame),
+                window=pixel_major(self._window), signal_sum=self._signal_sum.reshape(h, w),
+                square_hi=self._square_hi.reshape(h, w), square_lo=self._square_lo.reshape(h, w),
+                count=self._count.reshape(h, w), invalid=self._invalid.reshape(h, w),
+                channel_sum=pixel_major(channels), saturated=self._saturated.reshape(h, w),
+            )
+            self._raw = self._smooth = None
+        return self._partial
+
+    def result(self):
+        """Finish the sweep and return its :class:`DipSummary` (the tracker must own it all)."""
+        partial = self.partial()
+        if partial.start != self._first:
+            raise ValueError("result() needs a tracker owning the whole sweep; use partial() and merge_partials()")
+        return merge_partials([partial], n_frames=partial.end)
+
+
+def _check_tiling(partials, n_frames):
+    """Raise ValueError unless the partials' owned chunks tile ``[0, n_frames)`` and were fed enough."""
+    if not partials:
+        raise ValueError("partials is empty: give the partials of every time chunk")
+    ordered = sorted(partials, key=lambda part: part.start)
+    expected = 0
+    for part in ordered:
+        if part.start != expected:
+            raise ValueError(
+                f"partials must tile frames [0, {n_frames}) without gaps or overlaps; "
+                f"a chunk starts at {part.start} where {expected} was expected"
+            )
+        pad = DipTracker.padding(part.half_window)
+        if part.end < min(n_frames, part.stop + pad):
+            raise ValueError(
+                f"the chunk owning [{part.start}, {part.stop}) was fed frames up to {part.end} only; "
+                f"feed it up to min(n_frames, stop + {pad})"
+            )
+        expected = part.stop
+    if expected != n_frames:
+        raise ValueError(f"n_frames is {n_frames} but the partials cover frames [0, {expected})")
+    if len({part.half_window for part in ordered}) != 1:
+        raise ValueError("partials have different half_window values; track every chunk alike")
+    if len({part.channel_sum.shape[2] for part in ordered}) != 1:
+        raise ValueError("partials have different channel counts; feed every chunk alike")
+
+
+def merge_partials(partials, *, n_frames):
+    """The :class:`DipSummary` of a sweep from the partials of its time chunks.
+
+    Parameters
+    ----------
+    partials : sequence of DipPartial
+        One per chunk, in any order; their owned chunks must tile ``[0, n_frames)``.
+    n_frames : int
+        Frames of the sweep.
+
+    Returns
+    -------
+    DipSummary
+        Equal bit for bit to the single-pass :meth:`DipTracker.result`.
+    """
+    n_frames = int(n_frames)
+    _check_tiling(partials, n_frames)
+    h = partials[0].half_window
+    k = 2 * h + 1
+    values = np.concatenate([p.top_value for p in partials], axis=-1)
+    frames = np.concatenate([p.top_frame for p in partials], axis=-1)
+    shape = values.shape[:2]
+    first, second, found, has_second = (
+        part.reshape(shape) for part in _k.select_dips(values.reshape(-1, values.shape[2]),
+                                                        frames.reshape(-1, frames.shape[2]), h))
+    pick = first[..., None]
+    minimum_value = np.take_along_axis(values, pick, -1)[..., 0]
+    minimum_frame = np.where(found, np.take_along_axis(frames, pick, -1)[..., 0], -1)
+    second_value = np.where(has_second, np.take_along_axis(values, second[..., None], -1)[..., 0], np.inf)
+    second_frame = np.where(has_second, np.take_along_axis(frames, second[..., None], -1)[..., 0], -(k + 1))
+    owner = first // _k.TOP
+    window = np.full(partials[0].window.shape, np.nan, np.float32)
+    for index, part in enumerate(partials):
+        np.copyto(window, part.window, where=(found & (owner == index))[..., None])
+    window = np.ascontiguousarray(np.moveaxis(window, -1, 0))
+
+    def total(name):
+        return sum(getattr(p, name) for p in partials)
+
+    win_count, win_sum, win_hi, win_lo = (
+        part.reshape(found.shape) for part in _k.window_sums(window.reshape(k, -1), found.ravel()))
+    lit_count = total("count") - win_count
+    lit_sum = (total("signal_sum") - win_sum) / _k.SUM_SCALE
+    lit_sumsq = (total("square_hi") - win_hi) + (total("square_lo") - win_lo)
+    count = total("count")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit_level = np.where(lit_count > 0, lit_sum / lit_count, np.nan)
+        variance = lit_sumsq / lit_count - lit_level**2
+        # unbiased, and never negative from round-off
+        variance = np.maximum(variance, 0) * lit_count / np.maximum(lit_count - 1, 1)
+        mean_level = np.where(count > 0, total("signal_sum") / _k.SUM_SCALE / count, np.nan)
+    channel_sum = total("channel_sum")
+    saturated = np.logical_or.reduce([p.saturated for p in partials])
+    return DipSummary(
+        window=window,
+        window_start=np.where(found, minimum_frame - h, 0),
+        minimum_frame=minimum_frame.astype(np.int64),
+        minimum_value=minimum_value.astype(np.float32),
+        second_value=second_value.astype(np.float32),
+        second_frame=second_frame.astype(np.int64),
+        lit_level=lit_level,
+        noise=np.sqrt(variance),
+        lit_count=lit_count.astype(np.int64),
+        mean_level=mean_level,
+        invalid_count=total("invalid").astype(np.int64),
+        n_frames=n_frames,
+        channel_sum=channel_sum / _k.SUM_SCALE if channel_sum.shape[-1] else None,
+        saturated=saturated,
+    )

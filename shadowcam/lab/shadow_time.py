@@ -1,0 +1,685 @@
+"""Per-pixel shadow time of a sweep: when the mask's shadow passes each pixel.
+
+The frames of one sweep stream through a :class:`~shadowcam.lab.dip_tracker.DipTracker`
+(memory independent of the frame count); each pixel's dip is then classified
+(is there a reliable shadow at all?) and timed to a fraction of a frame by one
+of the methods of :data:`SHADOW_TIME_METHODS`. The default, ``edge_fit``, adds
+the spatial structure of the shadow edge (:mod:`shadowcam.lab.edge_refine`): a
+pixel's own samples are nearly on/off when the shadow crosses it within a
+frame, so its neighbours' times sharpen it (paper II-A: the shadow camera's
+resolution depends on the edge detector, not on the shadow width).
+
+Offers
+------
+SHADOW_TIME_METHODS : name -> timing function ``f(summary) -> (time, entry, exit, time_std)``.
+REASONS : flag code -> meaning, for pixels without a reliable time.
+classify_dips : reason code, contrast and confidence per pixel.
+shadow_times : timing + classification of one sweep's :class:`DipSummary`.
+track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
+lit_colour : unshadowed colour per pixel from a summary with channel sums.
+sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
+summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
+"""
+
+import numba as nb
+import numpy as np
+from scipy.special import ndtri
+
+from shadowcam.lab.dip_tracker import DipTracker
+from shadowcam.lab.edge_refine import refine_times, shifted
+
+#: flag code -> meaning (0 = a reliable time)
+REASONS = {
+    0: "ok",
+    1: "never_shadowed",
+    2: "low_contrast",
+    3: "saturated",
+    4: "several_minima",
+    5: "invalid_input",
+    6: "wide_dip",
+}
+OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP = range(7)
+
+#: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
+_SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
+
+
+def _window_times(summary):
+    """Frame index of each window slot, ``(K, H, W)`` float64."""
+    k = summary.window.shape[0]
+    return summary.window_start[None] + np.arange(k)[:, None, None]
+
+
+def _coverage(summary):
+    """Fraction of light removed in each window frame, ``(K, H, W)``; NaN outside."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        level = summary.lit_level[None]
+        return np.clip(1.0 - summary.window / level, 0.0, 1.0)
+
+
+@nb.njit(cache=True, parallel=True, error_model="numpy")
+def _centroid_kernel(coverage, window_start, noise, lit_level):
+    """:func:`_centroid` per pixel (one pass over the window, both cores)."""
+    n_k, rows, cols = coverage.shape
+    centre = np.empty((rows, cols))
+    std = np.empty((rows, cols))
+    for r in nb.prange(rows):
+        for c in range(cols):
+            total = 0.0
+            moment = 0.0
+            for k in range(n_k):
+                v = coverage[k, r, c]
+                if np.isfinite(v):
+                    total += v
+                    moment += v * np.float64(window_start[r, c] + k)
+            mean = moment / total
+            spread = 0.0
+            for k in range(n_k):
+                if np.isfinite(coverage[k, r, c]):
+                    spread += (np.float64(window_start[r, c] + k) - mean) ** 2
+            centre[r, c] = mean
+            std[r, c] = noise[r, c] / lit_level[r, c] * np.sqrt(spread) / total
+    return centre, std
+
+
+def _centroid(summary, coverage):
+    """Coverage-weighted mean time and its noise standard deviation, ``(H, W)`` each.
+
+    Each coverage sample carries noise ``sigma / level``, propagated to the
+    mean; non-finite samples take no part.
+    """
+    return _centroid_kernel(coverage, summary.window_start, summary.noise, summary.lit_level)
+
+
+def _crossings(summary, threshold):
+    """Entry and exit times where the signal crosses `threshold` (linear interpolation).
+
+    The crossings nearest to the minimum on each side are used; NaN where the
+    dip does not come back above `threshold` inside the window.
+    """
+    win = summary.window
+    k = win.shape[0]
+    h = summary.half_window
+    above = win >= threshold[None]
+    idx = np.arange(k)[:, None, None]
+    # entry: last slot before the centre that is above the threshold
+    left = np.where(above & (idx < h), idx, -1).max(axis=0)
+    # exit: first slot after the centre that is above the threshold
+    right = np.where(above & (idx > h), idx, k).min(axis=0)
+    rows, cols = np.indices(threshold.shape)
+
+    def interpolate(a, b):
+        ok = (a >= 0) & (a < k) & (b >= 0) & (b < k)
+        a_c, b_c = np.clip(a, 0, k - 1), np.clip(b, 0, k - 1)
+        va, vb = win[a_c, rows, cols], win[b_c, rows, cols]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            frac = (va - threshold) / (va - vb)
+            crossing = summary.window_start + a_c + frac * (b_c - a_c)
+        return np.where(ok & np.isfinite(frac), crossing, np.nan)
+
+    entry = interpolate(left, left + 1)
+    exit_ = interpolate(right, right - 1)
+    centre_below = win[h] < threshold
+    entry = np.where(centre_below, entry, np.nan)
+    exit_ = np.where(centre_below, exit_, np.nan)
+    return entry, exit_
+
+
+def _noise_time_std(summary, depth):
+    """Rough time uncertainty of a crossing: noise / slope of a one-frame edge."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return summary.noise / depth
+
+
+def time_midpoint_crossing_BouguetPerona1998(summary):
+    """Midpoint of the entry and exit crossings of (Imax + Imin) / 2.
+
+    Bouguet & Perona, "3D photography on your desk", ICCV 1998: the shadow
+    time is where the temporal profile crosses the mean of its extremes, with
+    linear interpolation between frames; entry and exit are both kept.
+    """
+    minimum = np.nanmin(np.where(np.isfinite(summary.window), summary.window, np.inf), axis=0)
+    threshold = 0.5 * (summary.lit_level + minimum)
+    entry, exit_ = _crossings(summary, threshold)
+    depth = summary.lit_level - minimum
+    return 0.5 * (entry + exit_), entry, exit_, _noise_time_std(summary, depth)
+
+
+def time_argmin_parabolic(summary):
+    """Deepest frame of the [1, 2, 1]-smoothed profile, refined by a parabola.
+
+    The vertex of the parabola through the smoothed samples at the minimum
+    and its two neighbours gives the sub-frame offset (clipped to +-0.5).
+    """
+    win = summary.window.astype(np.float64)
+    h = summary.half_window
+    padded = np.concatenate([win[:1], win, win[-1:]])
+    padded = np.where(np.isfinite(padded), padded, np.nan)
+    smooth = 0.25 * padded[:-2] + 0.5 * padded[1:-1] + 0.25 * padded[2:]
+    s_m, s_0, s_p = smooth[h - 1], smooth[h], smooth[h + 1]
+    curvature = s_m - 2 * s_0 + s_p
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.clip(0.5 * (s_m - s_p) / curvature, -0.5, 0.5)
+    offset = np.where(np.isfinite(offset), offset, 0.0)
+    time = summary.minimum_frame + offset
+    depth = summary.lit_level - summary.minimum_value
+    with np.errstate(invalid="ignore", divide="ignore"):
+        std = summary.noise * _SMOOTHED_NOISE / np.abs(curvature)
+    entry, exit_ = _crossings(summary, 0.5 * (summary.lit_level + summary.minimum_value))
+    return time, entry, exit_, np.minimum(std, 0.5) + 0 * depth
+
+
+def time_dip_centroid(summary):
+    """Centroid of the removed-light fraction over the window around the minimum.
+
+    With the dip fully inside the window, the centroid of ``1 - I / I_lit``
+    is the time the shadow's centre line crosses the pixel, using the partial
+    coverage of the frames at the dip's edges.
+    """
+    coverage = _coverage(summary)
+    time, std = _centroid(summary, coverage)
+    threshold = summary.lit_level * 0.5 + 0.5 * summary.minimum_value
+    entry, exit_ = _crossings(summary, threshold)
+    return time, entry, exit_, std
+
+
+def time_gaussian_fit_Caruana1986(summary):
+    """Vertex of a Gaussian through the three most covered frames of the dip.
+
+    Caruana, Searle, Heller & Shupack, "Fast algorithm for the resolution of
+    spectra", Anal. Chem. 58 (1986): the logarithm of a Gaussian is a
+    parabola, so the vertex of the parabola through ``log coverage`` at the
+    most covered frame and its two neighbours is the Gaussian's centre
+    (offset clipped to +-1 frame; a flat top falls back to the middle of the
+    most covered frames).
+    """
+    coverage = np.nan_to_num(_coverage(summary), nan=0.0)
+    k = coverage.shape[0]
+    first, last = np.argmax(coverage, axis=0), k - 1 - np.argmax(coverage[::-1], axis=0)
+    peak = np.clip((first + last + 1) // 2, 1, k - 2)[None]
+    c_m, c_0, c_p = (np.take_along_axis(coverage, peak + d, 0)[0] for d in (-1, 0, 1))
+    l_m, l_0, l_p = (np.log(np.maximum(c, 1e-3)) for c in (c_m, c_0, c_p))
+    curvature = l_m - 2 * l_0 + l_p
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.where(curvature < 0, 0.5 * (l_m - l_p) / curvature, 0.0)
+        # noise sigma / level on each coverage sample, through d offset / d log c = 1 / c
+        rel = summary.noise / summary.lit_level
+        std = 0.5 * rel * np.sqrt(1 / np.maximum(c_m, 1e-3) ** 2 + 1 / np.maximum(c_p, 1e-3) ** 2)
+        std = std / np.abs(curvature)
+    time = summary.window_start + peak[0] + np.clip(offset, -1.0, 1.0)
+    threshold = 0.5 * (summary.lit_level + summary.minimum_value)
+    entry, exit_ = _crossings(summary, threshold)
+    return time, entry, exit_, np.minimum(std, 1.0)
+
+
+def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
+    """Deepest frame of the Gaussian-smoothed profile, refined by a parabola.
+
+    Temporal smoothing before the minimum: the window is convolved with a
+    Gaussian of `sigma` frames (samples outside the window or non-finite
+    replaced by the nearest valid edge), then the parabola through the
+    smoothed minimum and its neighbours gives the sub-frame offset.
+    """
+    if not sigma > 0:
+        raise ValueError(f"sigma must be > 0, got {sigma!r}")
+    win = summary.window.astype(np.float64)
+    k = win.shape[0]
+    radius = max(1, int(np.ceil(3 * sigma)))
+    taps = np.exp(-0.5 * (np.arange(-radius, radius + 1) / sigma) ** 2)
+    taps /= taps.sum()
+    filled = np.where(np.isfinite(win), win, summary.lit_level[None])
+    padded = np.concatenate([np.repeat(filled[:1], radius, 0), filled, np.repeat(filled[-1:], radius, 0)])
+    smooth = sum(t * padded[i:i + k] for i, t in enumerate(taps))
+    centre = np.clip(np.argmin(smooth[1:-1], axis=0) + 1, 1, k - 2)[None]
+    s_m, s_0, s_p = (np.take_along_axis(smooth, centre + d, 0)[0] for d in (-1, 0, 1))
+    curvature = s_m - 2 * s_0 + s_p
+    with np.errstate(invalid="ignore", divide="ignore"):
+        offset = np.clip(0.5 * (s_m - s_p) / curvature, -0.5, 0.5)
+        noise = summary.noise * np.sqrt(np.sum(taps**2))
+        std = np.minimum(noise / np.abs(curvature), 0.5)
+    time = summary.window_start + centre[0] + np.where(np.isfinite(offset), offset, 0.0)
+    entry, exit_ = _crossings(summary, 0.5 * (summary.lit_level + summary.minimum_value))
+    return time, entry, exit_, std
+
+
+def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15):
+    """Dip centroid refined by an edge-aware local plane fit of neighbours' times.
+
+    See :func:`shadowcam.lab.edge_refine.refine_times`; `floor_std` is the
+    per-pixel error, in frames, that remains without noise (the on/off
+    staircase of a shadow that crosses a pixel within one frame).
+    """
+    time, entry, exit_, std = time_dip_centroid(summary)
+    refined, refined_std = refine_times(
+        time, np.hypot(std, floor_std), radius=radius, range_sigma=range_sigma
+    )
+    shift = refined - time
+    return refined, entry + shift, exit_ + shift, refined_std
+
+
+#: shadow-time methods: name -> function(summary) -> (time, entry, exit, time_std)
+SHADOW_TIME_METHODS = {
+    "argmin_parabolic": time_argmin_parabolic,
+    "midpoint_crossing_BouguetPerona1998": time_midpoint_crossing_BouguetPerona1998,
+    "dip_centroid": time_dip_centroid,
+    "gaussian_fit_Caruana1986": time_gaussian_fit_Caruana1986,
+    "argmin_gaussian_smoothed": time_argmin_gaussian_smoothed,
+    "edge_fit": time_edge_fit,
+}
+
+
+def detection_threshold(n_frames, *, false_alarm=1e-3):
+    """Dip depth, in units of the smoothed-sample noise, that pure noise rarely reaches.
+
+    The deepest of `n_frames` smoothed noise samples exceeds ``z`` standard
+    deviations with probability about ``n_frames * Q(z)``; ``z`` is chosen so
+    that this is `false_alarm`.
+    """
+    if not 0 < false_alarm < 1:
+        raise ValueError(f"false_alarm must be in (0, 1), got {false_alarm!r}")
+    return float(-ndtri(false_alarm / max(int(n_frames), 1)))
+
+
+def _shifts(radius):
+    """Neighbour offsets ``(dr, dc)`` within `radius`, excluding ``(0, 0)``."""
+    return [(dr, dc) for dr in range(-radius, radius + 1) for dc in range(-radius, radius + 1)
+            if (dr, dc) != (0, 0)]
+
+
+def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, frames_per_pixel=1.5,
+                             min_support=3):
+    """Weak dips whose timing agrees with enough strong neighbours.
+
+    A real but faint shadow dip occurs when the neighbours' dips occur (the
+    edge sweeps across them); a dip of pure noise falls at a random frame. A
+    candidate is supported when at least `min_support` strong neighbours, and
+    at least half of the strong neighbours, have their minimum within
+    ``1 + frames_per_pixel * distance`` frames of the candidate's.
+    """
+    agree = np.zeros(candidate.shape, np.int32)
+    total = np.zeros(candidate.shape, np.int32)
+    frame = minimum_frame.astype(np.float64)
+    for dr, dc in _shifts(radius):
+        n_strong = shifted(strong, dr, dc, False)
+        n_frame = shifted(frame, dr, dc, np.nan)
+        tolerance = 1.0 + frames_per_pixel * np.hypot(dr, dc)
+        total += n_strong
+        agree += n_strong & (np.abs(n_frame - frame) <= tolerance)
+    return candidate & (agree >= min_support) & (2 * agree >= total)
+
+
+def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5,
+                   shadow_ratio=0.1):
+    """Detected pixels at a shadow boundary whose lit part is under `min_lit_fraction`.
+
+    A pixel straddling the boundary of a cast (scene) shadow dips when the
+    mask passes, although its centre is in shadow. Its lit fraction is
+    estimated as its level over the brightest detected neighbour of the same
+    colour; only pixels beside the shadow side are tested: an undetected
+    neighbour, or a same-colour neighbour darker than `shadow_ratio` times
+    the pixel's level (a cast shadow keeps only ambient light, an order of
+    magnitude below direct light, while neighbouring albedos of a texture
+    rarely differ that much). For demosaiced RAW, `level` should be each
+    site's own measured channel and `site_colour` its CFA colour:
+    interpolated channels carry light from lit neighbours into shadowed
+    sites, so those are detected too and only the darkness test finds them.
+    """
+    same_colour_radius = 1 if site_colour is None else 2
+    colour = np.zeros(level.shape, np.int8) if site_colour is None else site_colour
+    lit_level = np.where(detected, level, 0.0)
+    brightest = np.zeros_like(lit_level)
+    shadow_side = np.zeros(detected.shape, bool)
+    for dr, dc in _shifts(same_colour_radius):
+        same = shifted(colour, dr, dc, -1) == colour
+        brightest = np.maximum(brightest, np.where(same, shifted(lit_level, dr, dc, 0.0), 0.0))
+        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * level
+        shadow_side |= (same & darker) | ~shifted(detected, dr, dc, True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fraction = level / brightest
+    return detected & shadow_side & (fraction < min_lit_fraction)
+
+
+def _wider_than_window(summary, depth, significant):
+    """The window's first or last sample (when inside the sweep) is still shadowed by more
+    than 3/4 of the dip's depth (and by more than `significant`, capped at 0.9 `depth`):
+    the dip goes on beyond the window (thick wire, area source) and its time would be
+    biased toward the window."""
+    need = np.maximum(0.75 * depth, np.minimum(significant, 0.9 * depth))
+    with np.errstate(invalid="ignore"):
+        return ((summary.lit_level - summary.window[0] > need)
+                | (summary.lit_level - summary.window[-1] > need))
+
+
+def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
+                  false_alarm=1e-2, weak_false_alarm=0.5,
+                  min_relative_depth=0.1, min_lit_fraction=0.5, shadow_ratio=0.1,
+                  noise_floor=1e-4, second_dip_ratio=0.5):
+    """Decide per pixel whether its dip is a reliable shadow, and why not.
+
+    A dip is detected when it is deeper than pure noise gets within the
+    sweep (threshold from the measured per-pixel noise and `false_alarm`),
+    or when it passes the looser `weak_false_alarm` threshold and its timing
+    agrees with detected neighbours. Detected pixels at a cast-shadow
+    boundary whose lit fraction is below `min_lit_fraction` (centre in
+    shadow) are then rejected.
+
+    Parameters
+    ----------
+    summary : DipSummary
+        One sweep.
+    saturated : (H, W) bool ndarray, optional
+        Pixels that reached the white level in any channel.
+    site_level, site_colour : (H, W) ndarray, optional
+        For demosaiced RAW: each pixel's lit level in its own CFA channel and
+        that channel's index, used by the cast-shadow boundary test.
+    false_alarm : float, optional
+        Wanted probability that a pixel of pure noise is given a time on its own.
+    weak_false_alarm : float, optional
+        The same for a dip that neighbours must confirm.
+    min_relative_depth : float, optional
+        Smallest dip depth, as a fraction of the lit level, taken as a shadow.
+    min_lit_fraction : float, optional
+        Smallest lit fraction of a boundary pixel's footprint.
+    shadow_ratio : float, optional
+        A same-colour neighbour darker than this fraction of a pixel's level
+        is taken as the shadowed side of a cast-shadow boundary.
+    noise_floor : float, optional
+        Lower bound of the noise (signal units), for noise-free data.
+    second_dip_ratio : float, optional
+        A second dip (another local minimum more than half a window away) at
+        least this deep (relative to the first) marks the pixel ``several_minima``.
+
+    Returns
+    -------
+    reason : (H, W) uint8 ndarray
+        Codes of :data:`REASONS`.
+    contrast : (H, W) float32 ndarray
+        Dip depth over its noise standard deviation.
+    """
+    z = detection_threshold(summary.n_frames, false_alarm=false_alarm)
+    z_weak = detection_threshold(summary.n_frames, false_alarm=weak_false_alarm)
+    noise = np.maximum(np.nan_to_num(summary.noise, nan=np.inf), noise_floor)
+    level = summary.lit_level
+    depth = level - summary.minimum_value
+    with np.errstate(invalid="ignore", divide="ignore"):
+        contrast = depth / (noise * _SMOOTHED_NOISE)
+        second_depth = level - summary.second_value
+    deep_enough = depth > min_relative_depth * level
+    strong = (contrast > z) & deep_enough
+    weak = (contrast > z_weak) & deep_enough & ~strong
+    detected = strong | _supported_by_neighbours(weak, strong, summary.minimum_frame)
+    significant_level = level > z * noise / np.sqrt(np.maximum(summary.lit_count, 1))
+
+    reason = np.zeros(level.shape, np.uint8)
+    reason[~detected] = NEVER_SHADOWED
+    reason[~significant_level] = LOW_CONTRAST
+    boundary_level = level if site_level is None else site_level
+    partial = _partially_lit(detected, boundary_level, site_colour=site_colour,
+                             min_lit_fraction=min_lit_fraction, shadow_ratio=shadow_ratio)
+    reason[partial] = LOW_CONTRAST
+    several = detected & (second_depth >= second_dip_ratio * depth) & (
+        second_depth / (noise * _SMOOTHED_NOISE) > z
+    )
+    reason[(reason == OK) & several] = SEVERAL_MINIMA
+    reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
+    if saturated is not None:
+        reason[(reason == OK) & saturated] = SATURATED
+    # a non-finite sample in the window at a frame inside the sweep (slots outside the
+    # sweep are NaN padding)
+    frame = _window_times(summary)
+    in_sweep = (frame >= 0) & (frame < summary.n_frames)
+    window_invalid = (in_sweep & ~np.isfinite(summary.window)).any(axis=0)
+    broken = (summary.invalid_count > 0) & window_invalid
+    broken |= summary.lit_count < 3
+    broken |= summary.minimum_frame < 0
+    reason[broken] = INVALID_INPUT
+    return reason, np.nan_to_num(contrast, nan=0.0, posinf=0.0).astype(np.float32)
+
+
+def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=None,
+                 **classify_params):
+    """Time and classify the dips of one sweep.
+
+    Parameters
+    ----------
+    summary : DipSummary
+    method : str, optional
+        Key of :data:`SHADOW_TIME_METHODS`.
+    saturated : (H, W) bool ndarray, optional
+    method_params : dict, optional
+        Keyword options of the timing method.
+    **classify_params
+        Options of :func:`classify_dips`.
+
+    Returns
+    -------
+    dict of (H, W) ndarrays
+        ``shadow_time``, ``entry_time``, ``exit_time`` (frames, NaN where
+        unreliable), ``time_std`` (frames), ``confidence`` (0..1),
+        ``contrast``, ``reason`` (uint8), ``lit_level``, ``noise``.
+    """
+    if method not in SHADOW_TIME_METHODS:
+        raise ValueError(
+            f"method must be one of {sorted(SHADOW_TIME_METHODS)}, got {method!r}"
+        )
+    reason, contrast = classify_dips(summary, saturated=saturated, **classify_params)
+    masked = _masked_summary(summary, reason == OK)
+    time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
+    last = summary.n_frames - 1
+    outside = ~((time >= 0) & (time <= last))
+    reason = reason.copy()
+    reason[(reason == OK) & outside] = NEVER_SHADOWED
+    good = reason == OK
+    std = np.where(good, std, np.nan)
+    confidence = np.where(good, np.exp(-0.5 * (std / 0.25) ** 2), 0.0)
+    nan = np.float32(np.nan)
+    return {
+        "shadow_time": np.where(good, time, nan).astype(np.float32),
+        "entry_time": np.where(good, np.clip(entry, 0, last), nan).astype(np.float32),
+        "exit_time": np.where(good, np.clip(exit_, 0, last), nan).astype(np.float32),
+        "time_std": std.astype(np.float32),
+        "confidence": np.nan_to_num(confidence, nan=0.0).astype(np.float32),
+        "contrast": contrast,
+        "reason": reason,
+        "lit_level": summary.lit_level.astype(np.float32),
+        "noise": summary.noise.astype(np.float32),
+    }
+
+
+def _masked_summary(summary, keep):
+    """Copy of `summary` whose window is NaN outside `keep` (so methods ignore them)."""
+    from dataclasses import replace
+
+    return replace(summary, window=np.where(keep[None], summary.window, np.nan))
+
+
+def track_sweep(blocks, shape, *, half_window=4, saturation_level=0.999, progress=None):
+    """Stream one sweep's frames through a :class:`DipTracker`.
+
+    Parameters
+    ----------
+    blocks : iterable of (T, H, W, C) float ndarray
+        Frames in time order (any block sizes).
+    shape : tuple of int
+        ``(H, W)``.
+    half_window : int, optional
+    saturation_level : float, optional
+        Linear value (white = 1) at or above which a channel is saturated.
+    progress : callable, optional
+        Called with the number of frames done after each block.
+
+    Returns
+    -------
+    summary : DipSummary
+        Of the channel-summed signal.
+    lit_image : (H, W, C) float32 ndarray
+        Unshadowed colour per pixel (see :func:`lit_colour`).
+    saturated : (H, W) bool ndarray
+    """
+    tracker = DipTracker(shape, half_window=half_window, saturation_level=saturation_level)
+    for block in blocks:
+        block = np.asarray(block, np.float32)
+        if block.ndim != 4 or block.shape[1:3] != tuple(shape):
+            raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C), got {block.shape}")
+        tracker.update(block)
+        if progress is not None:
+            progress(tracker.n_frames)
+    if tracker.n_frames == 0:
+        raise ValueError("blocks is empty: the sweep has no frames")
+    summary = tracker.result()
+    return summary, lit_colour(summary), summary.saturated
+
+
+def lit_colour(summary):
+    """Unshadowed colour per pixel, ``(H, W, C)`` float32.
+
+    The channel means scaled by the ratio of the lit level to the mean level
+    (the mask removes light from all channels alike).
+    """
+    if summary.channel_sum is None:
+        raise ValueError("summary has no channel sums: feed the tracker (T, H, W, C) blocks")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # a pixel with no light at all (mean 0) has no colour, not an infinite one
+        scale = np.where(summary.mean_level > 0, summary.lit_level / summary.mean_level, 0.0)
+        lit_image = summary.channel_sum / summary.n_frames * scale[..., None]
+    return np.nan_to_num(lit_image, nan=0.0).astype(np.float32)
+
+
+def cfa_site_colours(shape, pattern):
+    """Channel index (0 R, 1 G, 2 B) measured at each pixel of a Bayer mosaic.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)``.
+    pattern : str
+        CFA letters of the top-left 2x2 block in reading order, e.g. ``"RGGB"``.
+
+    Returns
+    -------
+    (H, W) int8 ndarray
+    """
+    if len(pattern) != 4 or set(pattern) - set("RGB"):
+        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB', got {pattern!r}")
+    tile = np.array(["RGB".index(ch) for ch in pattern], np.int8).reshape(2, 2)
+    rows = np.arange(shape[0])[:, None] % 2
+    cols = np.arange(shape[1])[None, :] % 2
+    return tile[rows, cols]
+
+
+def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_pattern=None,
+                       method_params=None, classify_params=None, progress=None):
+    """Shadow times of one sweep from its frames, streamed.
+
+    Parameters
+    ----------
+    blocks : iterable of (T, H, W, C) float ndarray
+        Linear frames in time order.
+    shape : tuple of int
+        ``(H, W)``.
+    method : str, optional
+        Key of :data:`SHADOW_TIME_METHODS`.
+    half_window : int, optional
+        Frames kept each side of the dip (see :class:`DipTracker`).
+    cfa_pattern : str, optional
+        Bayer pattern when the frames were demosaiced from RAW (e.g. ``"RGGB"``);
+        the shadow-boundary test then uses each site's measured channel.
+    method_params, classify_params : dict, optional
+        Options of the timing method and of :func:`classify_dips`.
+    progress : callable, optional
+        Called with the number of frames done.
+
+    Returns
+    -------
+    results : dict of (H, W) ndarrays
+        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
+    """
+    summary, _, _ = track_sweep(blocks, shape, half_window=half_window, progress=progress)
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+                                method_params=method_params, classify_params=classify_params)
+
+
+def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
+                         classify_params=None):
+    """Shadow times of one sweep from its tracked :class:`DipSummary`.
+
+    The second half of :func:`sweep_shadow_times`, for a summary obtained
+    otherwise, e.g. :func:`shadowcam.lab.dip_tracker.merge_partials` of time chunks
+    tracked in separate jobs (the result is then the same bit for bit).
+
+    Parameters
+    ----------
+    summary : DipSummary
+        With channel sums (the tracker was fed ``(T, H, W, C)`` blocks).
+    method, cfa_pattern, method_params, classify_params
+        As :func:`sweep_shadow_times`.
+
+    Returns
+    -------
+    results : dict of (H, W) ndarrays
+        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
+    """
+    lit_image = lit_colour(summary)
+    classify_params = dict(classify_params or {})
+    if cfa_pattern:
+        colour = cfa_site_colours(summary.lit_level.shape, cfa_pattern)
+        classify_params.update(
+            site_colour=colour,
+            site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],
+        )
+    results = shadow_times(summary, method=method, saturated=summary.saturated,
+                           method_params=method_params, **classify_params)
+    results["lit_image"] = lit_image
+    results["n_frames"] = summary.n_frames
+    return results
+
+
+_VARIABLE_ATTRS = {
+    "shadow_time": ("frame", "time the mask shadow's centre crosses the pixel"),
+    "entry_time": ("frame", "time the shadow enters the pixel (half depth)"),
+    "exit_time": ("frame", "time the shadow leaves the pixel (half depth)"),
+    "time_std": ("frame", "standard deviation of shadow_time (noise model)"),
+    "confidence": ("1", "confidence of shadow_time, exp(-std^2 / (2 * 0.25^2))"),
+    "contrast": ("1", "dip depth over the noise of a smoothed sample"),
+    "lit_level": ("linear", "unshadowed level of the channel sum"),
+    "noise": ("linear", "temporal noise standard deviation of the channel sum"),
+    "lit_image": ("linear", "unshadowed colour per channel"),
+}
+
+
+def shadow_time_dataset(per_sweep, *, channels=("R", "G", "B")):
+    """Assemble the ``shadow_time`` dataset from per-sweep results.
+
+    Parameters
+    ----------
+    per_sweep : dict of str to dict
+        Sweep name -> the dict returned by :func:`sweep_shadow_times`.
+    channels : sequence of str, optional
+
+    Returns
+    -------
+    xarray.Dataset
+        Variables over ``(sweep, row, col)`` (``lit_image`` over
+        ``(sweep, row, col, channel)``); ``reason`` carries CF
+        ``flag_values``/``flag_meanings``; attrs ``n_frames_<sweep>``.
+    """
+    import xarray as xr
+
+    if not per_sweep:
+        raise ValueError("per_sweep is empty: no sweep to assemble")
+    names = list(per_sweep)
+    data = {}
+    for key, (units, long_name) in _VARIABLE_ATTRS.items():
+        stacked = np.stack([per_sweep[n][key] for n in names])
+        dims = ("sweep", "row", "col", "channel") if stacked.ndim == 4 else ("sweep", "row", "col")
+        data[key] = (dims, stacked, {"units": units, "long_name": long_name})
+    data["reason"] = (("sweep", "row", "col"), np.stack([per_sweep[n]["reason"] for n in names]), {
+        "long_name": "why a pixel has no shadow time",
+        "flag_values": np.array(sorted(REASONS), np.uint8),
+        "flag_meanings": " ".join(REASONS[k] for k in sorted(REASONS)),
+    })
+    n_channels = data["lit_image"][1].shape[-1]
+    ds = xr.Dataset(data, coords={"sweep": names, "channel": list(channels)[:n_channels]})
+    for name in names:
+        ds.attrs[f"n_frames_{name}"] = int(per_sweep[name]["n_frames"])
+    return ds

@@ -1,0 +1,211 @@
+"""xarray datasets between the outdoor stages: assembly (dims, units, long names).
+
+Provenance attrs are attached by the CLI step that writes each dataset;
+encoding is left to the writer.
+
+Offers
+------
+photometry_dataset : per-frame shifts and gains, per-pixel masks and levels.
+photometry_arrays : the dict :class:`shadowcam.outdoor.tracking.EdgeTracker` takes, from that dataset.
+photometry_part_dataset : one time part of the first pass (per-frame values, running minimum).
+photometry_part_arrays : the dict :func:`shadowcam.outdoor.normalise.merge_parts` takes, from that dataset.
+edges_dataset : tracked edges over (time, col), keyframes, interpolation flags.
+arrival_dataset : the arrival-time map over (row, col) with reasons.
+pushbroom_dataset : the ridge pushbroom over (time, col, channel).
+"""
+
+import numpy as np
+import xarray as xr
+
+from shadowcam.outdoor.arrival import ARRIVAL_REASONS
+
+_CHANNELS = np.array(["R", "G", "B"], dtype=object)
+
+
+def _frame_coords(time_s, photometry=None):
+    time_s = np.asarray(time_s, dtype=np.float64)
+    coords = {
+        "time": ("time", np.arange(time_s.size), {"units": "frame", "long_name": "frame index"}),
+        "time_s": ("time", time_s, {"units": "s", "long_name": "frame time since the first frame"}),
+    }
+    if photometry is not None:
+        shift = np.asarray(photometry["shift"])
+        coords["shift_row"] = ("time", shift[:, 0], {"units": "pixel", "long_name": "estimated content shift along rows"})
+        coords["shift_col"] = ("time", shift[:, 1], {"units": "pixel", "long_name": "estimated content shift along cols"})
+        coords["gain"] = ("time", np.asarray(photometry["gain_lit"]),
+                          {"units": "1", "long_name": "lit gain relative to the first frame (exposure x sun + sky)"})
+    return coords
+
+
+def photometry_dataset(result, time_s, *, exposure_gain=None, sky_source="auto"):
+    """Assemble the first pass's result (:func:`shadowcam.outdoor.normalise.normalise_frames`).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``gain_sky``, ``kept_lit``, ``exposure_gain`` over ``time`` (coords
+        ``time_s``, ``shift_row``, ``shift_col``, ``gain``); ``sky``,
+        ``lit_at_start``, ``lit_level``, ``shadow_level`` over ``(row, col)``;
+        ``reference (row, col, channel)``; attrs ``shadow_ratio``, ``sky_source``.
+    """
+    n_frames = len(result["gain_lit"])
+    if np.size(time_s) != n_frames:
+        raise ValueError(f"time_s has {np.size(time_s)} values for {n_frames} frames")
+    exposure = np.full(n_frames, np.nan) if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
+    cam = ("row", "col")
+    data = {
+        "gain_sky": ("time", np.asarray(result["gain_sky"]), {"units": "1", "long_name": "sky-light gain relative to the first frame"}),
+        "kept_lit": ("time", np.asarray(result["kept_lit"]), {"units": "pixel", "long_name": "pixels used for the lit gain"}),
+        "exposure_gain": ("time", exposure, {"units": "1", "long_name": "gain from exposure metadata (NaN unknown)"}),
+        "sky": (cam, np.asarray(result["sky"], dtype=bool), {"long_name": "sky mask"}),
+        "lit_at_start": (cam, np.asarray(result["lit_at_start"], dtype=bool), {"long_name": "sunlit in the first frame"}),
+        "lit_level": (cam, result["lit_level"], {"units": "linear", "long_name": "luminance when lit, first-frame scale"}),
+        "shadow_level": (cam, result["shadow_level"], {"units": "linear", "long_name": "luminance in shadow / gain_sky"}),
+        "reference": (cam + ("channel",), result["reference"], {"units": "linear", "long_name": "first frame (reference of the registration)"}),
+    }
+    coords = _frame_coords(time_s, result)
+    coords["channel"] = _CHANNELS[: np.shape(result["reference"])[2]]
+    dataset = xr.Dataset(data, coords=coords)
+    dataset.attrs.update(shadow_ratio=float(result["shadow_ratio"]), sky_source=str(sky_source))
+    return dataset
+
+
+def photometry_arrays(dataset):
+    """Return the arrays of a photometry dataset as the dict the tracking pass takes."""
+    return {
+        "shift": np.stack([dataset["shift_row"].values, dataset["shift_col"].values], axis=1),
+        "gain_lit": dataset["gain"].values,
+        "gain_sky": dataset["gain_sky"].values,
+        "sky": dataset["sky"].values.astype(bool),
+        "lit_at_start": dataset["lit_at_start"].values.astype(bool),
+        "lit_level": dataset["lit_level"].values,
+        "shadow_level": dataset["shadow_level"].values,
+    }
+
+
+def photometry_part_dataset(part, time_s, *, exposure_gain=None, sky_source="auto"):
+    """Assemble one time part of the first pass (:func:`shadowcam.outdoor.normalise.normalise_part`).
+
+    Parameters
+    ----------
+    part : dict
+        :meth:`shadowcam.outdoor.normalise.SequenceNormaliser.partial`.
+    time_s : (T_part,) ndarray
+        Times of the part's frames, seconds.
+    exposure_gain : (T_part,) ndarray, optional
+    sky_source : str, optional
+
+    Returns
+    -------
+    xarray.Dataset
+        Over ``time`` (the part's frame indices): coords ``time_s``, ``shift_row``,
+        ``shift_col``, ``gain``; ``gain_sky``, ``kept_lit``, ``exposure_gain``; over
+        ``(row, col)``: ``shadow_min`` (linear), ``sky``, ``lit_at_start``;
+        ``reference (row, col, channel)`` only in the part holding frame 0.
+        Attrs ``first_frame``, ``sky_source``.
+    """
+    n_frames = len(part["gain_lit"])
+    first = int(part["first_frame"])
+    result = {**part, "shadow_ratio": np.nan, "lit_level": part["shadow_min"], "shadow_level": part["shadow_min"]}
+    dataset = photometry_dataset(result, time_s, exposure_gain=exposure_gain, sky_source=sky_source)
+    dataset = dataset.drop_vars(["lit_level", "shadow_level"]).assign_coords(time=np.arange(first, first + n_frames))
+    dataset["shadow_min"] = (("row", "col"), part["shadow_min"],
+                             {"units": "linear", "long_name": "minimum of 3-frame smoothed luminance / gain_sky over the part"})
+    if first != 0:
+        dataset = dataset.drop_vars(["reference", "channel"])
+    dataset.attrs.update(first_frame=first)
+    del dataset.attrs["shadow_ratio"]
+    return dataset
+
+
+def photometry_part_arrays(dataset):
+    """Return a part dataset (:func:`photometry_part_dataset`) as the dict ``merge_parts`` takes."""
+    return {
+        "first_frame": int(dataset.attrs["first_frame"]),
+        "shift": np.stack([dataset["shift_row"].values, dataset["shift_col"].values], axis=1),
+        "gain_lit": dataset["gain"].values,
+        "gain_sky": dataset["gain_sky"].values,
+        "kept_lit": dataset["kept_lit"].values,
+        "shadow_min": dataset["shadow_min"].values,
+        "sky": dataset["sky"].values.astype(bool),
+        "lit_at_start": dataset["lit_at_start"].values.astype(bool),
+        "reference": dataset["reference"].values if "reference" in dataset else None,
+    }
+
+
+def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpolated):
+    """Assemble the tracked edges.
+
+    Parameters
+    ----------
+    tracked : mapping
+        Result of :func:`shadowcam.outdoor.tracking.track_frames`.
+    photometry : mapping
+        :func:`photometry_arrays` (for the shift and gain coords).
+    time_s : (T,) ndarray
+    edge_row : (T, W) ndarray
+        Final edges after keyframe interpolation.
+    is_keyframe : (T,) bool ndarray
+    interpolated : (T, W) bool ndarray
+
+    Returns
+    -------
+    xarray.Dataset
+        ``edge_row``, ``edge_row_measured``, ``confidence``, ``n_transitions``,
+        ``interpolated`` over ``(time, col)``; ``is_keyframe``, ``band_fraction``
+        over ``time``; ``coverage_arrival_s`` over ``(row, col)``.
+    """
+    tc = ("time", "col")
+    rows = "pixel-edge coordinates: row r spans [r, r+1], centre r+0.5; lit above"
+    data = {
+        "edge_row": (tc, np.asarray(edge_row, np.float32),
+                     {"units": "pixel", "long_name": "shadow-edge row after keyframe interpolation", "comment": rows}),
+        "edge_row_measured": (tc, tracked["edge_row"], {"units": "pixel", "long_name": "shadow-edge row as measured", "comment": rows}),
+        "confidence": (tc, tracked["confidence"], {"units": "1", "long_name": "edge confidence (step-model fit)"}),
+        "n_transitions": (tc, tracked["n_transitions"], {"long_name": "lit-above / shadowed-below pairs in the column"}),
+        "interpolated": (tc, np.asarray(interpolated, bool), {"long_name": "edge interpolated between keyframes"}),
+        "is_keyframe": ("time", np.asarray(is_keyframe, bool), {"long_name": "frame whose edge is reliable"}),
+        "band_fraction": ("time", tracked["band_fraction"], {"units": "1", "long_name": "share of valid pixels in the frame-differencing band"}),
+        "coverage_arrival_s": (("row", "col"), tracked["coverage_arrival_s"],
+                               {"units": "s", "long_name": "first time the pixel's lit fraction drops below 0.5"}),
+    }
+    return xr.Dataset(data, coords=_frame_coords(time_s, photometry))
+
+
+def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverage_arrival_s, interval_s):
+    """Assemble the arrival map.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``arrival_time_s``, ``arrival_frame``, ``reason`` (CF flags),
+        ``edge_arrival_s``, ``coverage_arrival_s`` over ``(row, col)``;
+        attr ``median_interval_s``.
+    """
+    cam = ("row", "col")
+    codes = sorted(ARRIVAL_REASONS)
+    data = {
+        "arrival_time_s": (cam, np.asarray(arrival_s), {"units": "s", "long_name": "shadow arrival time since the first frame"}),
+        "arrival_frame": (cam, np.asarray(arrival_frame), {"units": "frame", "long_name": "arrival as fractional frame (piecewise linear in time_s)"}),
+        "reason": (cam, np.asarray(reason, np.uint8), {
+            "long_name": "how the arrival was obtained, or why there is none",
+            "flag_values": np.array(codes, np.uint8), "flag_meanings": " ".join(ARRIVAL_REASONS[c] for c in codes)}),
+        "edge_arrival_s": (cam, np.asarray(edge_arrival_s), {"units": "s", "long_name": "arrival from the tracked edge crossing the pixel centre"}),
+        "coverage_arrival_s": (cam, np.asarray(coverage_arrival_s), {"units": "s", "long_name": "arrival from the pixel's lit fraction crossing 0.5"}),
+    }
+    dataset = xr.Dataset(data)
+    dataset.attrs["median_interval_s"] = float(interval_s)
+    return dataset
+
+
+def pushbroom_dataset(pushbroom, edge_row, time_s):
+    """Assemble the ridge pushbroom ``(time, col, channel)`` with the edge row as a coord."""
+    pushbroom = np.asarray(pushbroom)
+    coords = _frame_coords(time_s)
+    coords["channel"] = _CHANNELS[: pushbroom.shape[2]]
+    coords["edge_row"] = (("time", "col"), np.asarray(edge_row, np.float32), {"units": "pixel", "long_name": "sampled edge row"})
+    data = {"pushbroom": (("time", "col", "channel"), pushbroom, {
+        "units": "linear", "long_name": "ridge pushbroom: first-frame colour along the shadow edge of each frame",
+        "comment": "row k = frame k at time_s[k]; column = image column; linear between the two pixel "
+                   "centres straddling the edge; NaN where the column has no edge"})}
+    return xr.Dataset(data, coords=coords)

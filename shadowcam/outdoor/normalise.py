@@ -1,0 +1,367 @@
+"""First streaming pass over an outdoor time-lapse: registration, gains, levels.
+
+Frames arrive one at a time in time order; the first is the reference. For
+each frame: estimate its lit gain on pixels lit in the reference (shift-insensitive
+median), mask the pixels the shadow reached, estimate the sub-pixel shift to
+the reference (:mod:`shadowcam.outdoor.registration`), resample, then estimate the lit
+and sky gains again on the aligned frame (:mod:`shadowcam.outdoor.photometric`) and
+update the per-pixel shadow level (running minimum of the 3-frame smoothed
+sky-normalised luminance). State is a few ``(H, W)`` arrays whatever the
+number of frames.
+
+Time parts (one job each): given frame 0, each frame's shift and gains depend
+on the previous frame only through the starting point of their searches (the
+gain prior, the shift's initial value), and the per-pixel minimum merges
+exactly. A part ``start:stop`` therefore first runs over ``overlap`` warm-up
+frames before `start` (searches started from the exposure metadata and zero
+shift; the 3-frame windows need two frames before `start`) and records
+``start .. stop - 1``; :func:`merge_parts` concatenates and takes the minimum.
+The parts equal the single job where the searches converge to the same
+solution from both starting points (measured on dev_ridge: see
+``tests/test_outdoor_normalise.py``).
+
+Offers
+------
+SequenceNormaliser : the streaming pass; :meth:`update` per frame, :meth:`result` (or :meth:`partial`).
+normalise_frames : run it over an iterable of frames (one job).
+normalise_part : run it over one time part (with warm-up frames before it).
+part_frames : the frames a time part reads.
+merge_parts : merge the parts' results (concatenation and per-pixel minimum).
+PartMerger : the same, one part at a time (memory independent of the number of parts).
+aligned_luminance : one frame's registered luminance from the pass's results.
+"""
+
+import numpy as np
+
+from shadowcam.outdoor.photometric import estimate_gain, lit_at_start, luminance
+from shadowcam.outdoor.registration import (apply_shift, block_all, block_mean, pyramid_levels, registration_factor,
+                                    shift_coarse_to_fine, static_weight)
+from shadowcam.outdoor.sky_mask import auto_sky_mask
+
+#: contrast (shadow / lit level) below which a pixel counts as having been shadowed
+SHADOWED_CONTRAST = 0.3
+#: per-frame results of the pass, concatenated over time parts
+_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit")
+
+
+class SequenceNormaliser:
+    """Streaming registration and photometric normalisation.
+
+    Parameters
+    ----------
+    sky : (H, W) bool ndarray, optional
+        Sky mask (manifest override); default: :func:`shadowcam.outdoor.sky_mask.auto_sky_mask`
+        of the first frame.
+    exposure_gain : (T,) ndarray, optional
+        Gains from exposure metadata (NaN where unknown); seed the gain search.
+    sky_params : dict, optional
+        Options of :func:`shadowcam.outdoor.sky_mask.auto_sky_mask`.
+    registration_size : int, optional
+        Shifts and gains are estimated on frames reduced by an integer factor
+        (:func:`shadowcam.outdoor.registration.block_mean`) to at most this many pixels
+        on the longer side; the shift is scaled back and the per-pixel levels
+        stay at full resolution. Frames this small or smaller are not reduced.
+    registration_levels : int, optional
+        Coarser levels (factor 2 each) of the coarse-to-fine registration on the
+        reduced frames (:func:`shadowcam.outdoor.registration.shift_coarse_to_fine`): a
+        shake of up to about ``4 * 2**levels`` reduced pixels from the previous
+        frame's is recovered; fewer levels on small frames.
+    registration_margin : int, optional
+        Pixels of the reduced frames left out around the moving shadow edge
+        (:func:`shadowcam.outdoor.registration.static_weight` ``margin``): the band-pass
+        response of a moved edge reaches about twice its outer scale (6) beyond
+        the edge's own width, so a soft edge (penumbra, optics blur, upsampling)
+        needs 6 plus its width in reduced pixels, or the shift is biased
+        along the edge's motion.
+    reference : (H, W, C) ndarray, optional
+        The first frame of the time-lapse, required when `first_index` > 0
+        (a time part: the frames fed start later).
+    first_index : int, optional
+        Index of the first frame fed to :meth:`update`. 0: it is the reference.
+        Otherwise the search for the first frame fed starts from the exposure
+        metadata (or gain 1) and zero shift, and converges over the frames
+        before `record_from` (the warm-up).
+    record_from : int, optional
+        Frames before this index are processed (warm-up) but not recorded,
+        and the running minimum uses the 3-frame windows ending at this frame
+        or later; ``record_from - first_index`` must be >= 2 when ``first_index > 0``.
+    """
+
+    def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
+                 registration_levels=2, registration_margin=6, reference=None, first_index=0, record_from=0):
+        self._sky = None if sky is None else np.asarray(sky, dtype=bool)
+        self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
+        self._sky_params = dict(sky_params or {})
+        self._registration_size = int(registration_size)
+        registration_factor((1, 1), max_size=self._registration_size)  # validates the option
+        self._registration_levels = int(registration_levels)
+        self._registration_margin = int(registration_margin)
+        if self._registration_margin < 1:
+            raise ValueError(f"registration_margin must be >= 1 pixel; got {registration_margin}")
+        pyramid_levels((1, 1), levels=self._registration_levels)  # validates the option
+        self._k, self.record_from = int(first_index), int(record_from)
+        if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
+            raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
+                             "0 <= first_index <= record_from - 2 (two warm-up frames), or both 0")
+        self.shifts, self.gain_lit, self.gain_sky, self.kept_lit = [], [], [], []
+        self._recent = []
+        self._last = None  # (shift, gain_lit, gain_sky) of the previous frame processed
+        if self._k > 0:
+            if reference is None:
+                raise ValueError("reference (the first frame) is required when first_index > 0")
+            self._start(np.asarray(reference, dtype=np.float32))
+            seed = self._exposure[self._k - 1] if self._exposure is not None and self._k - 1 < self._exposure.size \
+                else np.nan
+            seed = float(seed) if np.isfinite(seed) else 1.0
+            self._last = (np.zeros(2), seed, seed)
+
+    def _start(self, frame):
+        if frame.ndim != 3:
+            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
+        height, width = frame.shape[:2]
+        if self._sky is None:
+            self._sky = auto_sky_mask(frame, **self._sky_params)
+        elif self._sky.shape != (height, width):
+            raise ValueError(f"sky mask {self._sky.shape} does not match the frames ({height}, {width})")
+        self.reference = frame.astype(np.float32)
+        self.reference_luma = luminance(frame)
+        self.lit_at_start, _ = lit_at_start(self.reference_luma, valid=~self._sky)
+        self.shadowed_at_start = ~self._sky & ~self.lit_at_start
+        self._shadow_min = np.full((height, width), np.inf, dtype=np.float32)
+        # working size of registration and gains: masks hold where the whole block does
+        self.factor = registration_factor((height, width), max_size=self._registration_size)
+        self._small_reference = block_mean(self.reference_luma, self.factor)
+        self._small_lit = block_all(self.lit_at_start, self.factor)
+        self._small_valid = block_all(~self._sky, self.factor)
+        self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
+
+    def _prior(self, previous, k):
+        if self._exposure is not None and k < self._exposure.size and np.isfinite(self._exposure[k]):
+            return float(self._exposure[k]) * (previous / self._exposure[k - 1]
+                                              if np.isfinite(self._exposure[k - 1]) else 1.0)
+        return previous
+
+    def update(self, frame):
+        """Process the next frame ``(H, W, C)`` (frame 0 sets the reference)."""
+        frame = np.asarray(frame, dtype=np.float32)
+        if frame.ndim != 3:
+            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
+        k = self._k
+        if k == 0:
+            self._start(frame)
+            shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
+            kept = int(self._small_lit.sum())
+        else:
+            if frame.shape != self.reference.shape:
+                raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
+            last_shift, last_gain, last_sky = self._last
+            raw = luminance(frame)
+            factor, ref = self.factor, self._small_reference
+            small = block_mean(raw, factor)
+            rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
+            weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
+                                   margin=self._registration_margin)
+            shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
+                                            levels=self._registration_levels)
+            shift = shift * factor
+            luma = apply_shift(raw, shift)
+            del raw, small
+            small = block_mean(luma, factor)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed,
+                                        prior=last_sky * gain_lit / last_gain)
+            if not self._small_shadowed.any():
+                gain_sky = gain_lit
+        self._last = (np.asarray(shift, dtype=np.float64), float(gain_lit), float(gain_sky))
+        if k >= self.record_from:
+            self.shifts.append(self._last[0])
+            self.gain_lit.append(self._last[1])
+            self.gain_sky.append(self._last[2])
+            self.kept_lit.append(int(kept))
+        self._recent = (self._recent + [luma / np.float32(gain_sky)])[-3:]
+        if len(self._recent) == 3 and k >= self.record_from:
+            smooth = 0.25 * self._recent[0] + 0.5 * self._recent[1] + 0.25 * self._recent[2]
+            np.minimum(self._shadow_min, smooth, out=self._shadow_min)
+        self._k += 1
+
+    def partial(self):
+        """Return the recorded frames' results, to merge with :func:`merge_parts`.
+
+        Returns
+        -------
+        dict
+            ``first_frame`` (index of the first recorded frame), ``shift (T_part, 2)``,
+            ``gain_lit``, ``gain_sky``, ``kept_lit (T_part,)``, ``shadow_min (H, W)``
+            (running minimum over the part's 3-frame windows), ``sky``, ``lit_at_start``
+            ``(H, W)`` and ``reference (H, W, C)`` (frame 0; the same in every part).
+        """
+        if not self.shifts:
+            raise ValueError("no frames were recorded (feed frames up to and past record_from)")
+        return {
+            "first_frame": self.record_from,
+            "shift": np.array(self.shifts),
+            "gain_lit": np.array(self.gain_lit),
+            "gain_sky": np.array(self.gain_sky),
+            "kept_lit": np.array(self.kept_lit),
+            "shadow_min": self._shadow_min,
+            "sky": self._sky,
+            "lit_at_start": self.lit_at_start,
+            "reference": self.reference,
+        }
+
+    def result(self):
+        """Return the pass's results (a dict of arrays; see :func:`normalise_frames`)."""
+        return merge_parts([self.partial()])
+
+
+class PartMerger:
+    """Merge the time parts of the first pass one at a time (exactly: concatenation and minimum).
+
+    State: the per-frame curves, the running per-pixel minimum and frame 0's
+    arrays (a few ``(H, W)`` arrays), whatever the number of parts; a part can be
+    released once added.
+    """
+
+    def __init__(self):
+        self._curves = {key: [] for key in _CURVES}
+        self._shadow_min = self._sky = self._lit = self._reference = None
+        self._next = 0
+
+    def add(self, part):
+        """Add the next part (:meth:`SequenceNormaliser.partial`; parts in time order from frame 0)."""
+        if part["first_frame"] != self._next:
+            raise ValueError(f"parts must cover consecutive frames from 0; a part starts at frame "
+                             f"{part['first_frame']}, expected {self._next}")
+        self._next += len(part["gain_lit"])
+        for key in _CURVES:
+            self._curves[key].append(np.asarray(part[key]))
+        if self._shadow_min is None:
+            self._shadow_min = np.array(part["shadow_min"], dtype=np.float32)
+            self._sky, self._lit = np.asarray(part["sky"], dtype=bool), np.asarray(part["lit_at_start"], dtype=bool)
+        else:
+            np.minimum(self._shadow_min, part["shadow_min"], out=self._shadow_min)
+        if self._reference is None and part.get("reference") is not None:
+            self._reference = part["reference"]
+
+    def result(self):
+        """Return the merged result (a dict; see :func:`normalise_frames`)."""
+        if self._shadow_min is None:
+            raise ValueError("parts must hold at least one part")
+        if self._next < 3:
+            raise ValueError(f"an outdoor time-lapse needs at least 3 frames; got {self._next}")
+        if self._reference is None:
+            raise ValueError("no part holds the reference frame (frame 0)")
+        sky, lit, shadow_min = self._sky, self._lit, self._shadow_min
+        ref = luminance(self._reference)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            contrast = np.where(ref > 0, shadow_min / ref, np.inf)
+        shadowed = lit & (contrast < SHADOWED_CONTRAST)
+        ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
+        shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
+        lit_level = np.where(lit, ref, shadow_min / ratio)
+        return {
+            **{key: np.concatenate(values) for key, values in self._curves.items()},
+            "sky": sky,
+            "lit_at_start": lit,
+            "lit_level": lit_level.astype(np.float32),
+            "shadow_level": shadow_level.astype(np.float32),
+            "shadow_ratio": ratio,
+            "reference": self._reference,
+        }
+
+
+def merge_parts(parts):
+    """Merge the results of time parts of the first pass (exactly: concatenation and minimum).
+
+    Parameters
+    ----------
+    parts : sequence of dict
+        :meth:`SequenceNormaliser.partial` of consecutive parts covering frames
+        ``0 .. T-1`` (any order; ``reference`` is needed in one of them). To
+        hold one part at a time, feed :class:`PartMerger` instead.
+
+    Returns
+    -------
+    dict
+        As :func:`normalise_frames`.
+    """
+    merger = PartMerger()
+    for part in sorted(parts, key=lambda part: part["first_frame"]):
+        merger.add(part)
+    return merger.result()
+
+
+def normalise_frames(frames, **options):
+    """Run :class:`SequenceNormaliser` over `frames`.
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, C) ndarray
+        In time order (e.g. flattened :func:`shadowcam.io.frame_store.iter_frame_chunks`).
+    **options
+        Keyword options of :class:`SequenceNormaliser`.
+
+    Returns
+    -------
+    dict
+        ``shift (T, 2)`` (row, col; pixels), ``gain_lit (T,)``, ``gain_sky (T,)``,
+        ``kept_lit (T,)`` (pixels used for the lit gain), ``sky``,
+        ``lit_at_start (H, W)`` bool, ``lit_level``, ``shadow_level (H, W)``
+        (luminance of the reference frame's scale: lit in the reference, and
+        sky-lit, normalised by ``gain_sky``), ``shadow_ratio`` (median
+        shadow / lit level) and ``reference (H, W, C)``.
+    """
+    normaliser = SequenceNormaliser(**options)
+    for frame in frames:
+        normaliser.update(frame)
+    return normaliser.result()
+
+
+def normalise_part(frames, *, start, stop, reference=None, overlap=2, **options):
+    """First pass over one time part ``start .. stop - 1`` (a job of its own).
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, C) ndarray
+        Frames ``max(0, start - overlap) .. stop - 1`` in time order
+        (:func:`part_frames` gives the range).
+    start, stop : int
+        Frames recorded by this part.
+    reference : (H, W, C) ndarray, optional
+        Frame 0 (needed when ``start - overlap > 0``).
+    overlap : int, optional
+        Warm-up frames before `start` (>= 2: the 3-frame windows of the running
+        minimum, and the gain and shift searches start from the previous frame's).
+    **options
+        Other keyword options of :class:`SequenceNormaliser`.
+
+    Returns
+    -------
+    dict
+        :meth:`SequenceNormaliser.partial`, to merge with :func:`merge_parts`.
+    """
+    first, stop = part_frames(start, stop, overlap=overlap)
+    normaliser = SequenceNormaliser(reference=reference if first > 0 else None, first_index=first,
+                                    record_from=start, **options)
+    fed = 0
+    for frame in frames:
+        normaliser.update(frame)
+        fed += 1
+    if fed != stop - first:
+        raise ValueError(f"part {start}:{stop} with overlap {overlap} needs frames {first}..{stop - 1} "
+                         f"({stop - first}); got {fed}")
+    return normaliser.partial()
+
+
+def part_frames(start, stop, *, overlap=2):
+    """Return ``(first, stop)``: the frames a part ``start:stop`` reads (warm-up included)."""
+    if not 0 <= start < stop:
+        raise ValueError(f"part start {start} and stop {stop}: need 0 <= start < stop")
+    if overlap < 2:
+        raise ValueError(f"overlap must be >= 2 frames; got {overlap}")
+    return max(0, start - overlap), stop
+
+
+def aligned_luminance(frame, shift):
+    """Registered luminance ``(H, W)`` float32 of `frame` ``(H, W, C)`` given its shift (row, col)."""
+    return apply_shift(luminance(frame), shift)

@@ -1,0 +1,199 @@
+"""The outdoor edge-tracking pass in column strips, merged exactly.
+
+The second outdoor pass (:mod:`shadowcam.outdoor.tracking`) cannot be split
+in time (its per-pixel lit level, the column's last edge and a pending
+coverage crossing reach arbitrarily far back), but it can be split in space.
+Its spatial dependencies across columns are:
+
+* the registration shift: cubic resampling reads columns ``floor(c + shift_col) - 1
+  .. + 2``, so ``ceil(max |shift_col|) + 2`` columns (bits independent of the cut:
+  :func:`shadowcam.outdoor.translation.translate_cubic_Keys1981`);
+* the frame-differencing band: the coverage drop is widened by ``margin``
+  columns (:func:`shadowcam.outdoor.frame_difference.difference_band`);
+* ``band_fraction``, a whole-frame mean: reassembled exactly from per-strip
+  integer counts (band pixels and valid pixels of the strip's own columns).
+
+Everything else is per pixel (luminance, coverage, lit-level update, coverage
+crossing) or per column (the edge search, its tracking prior and the area
+estimator, which sums rows). A strip of columns ``[c0, c1)`` therefore streams
+every frame over the window ``[c0 - halo, c1 + halo)`` and keeps only its own
+columns. The band of a halo column next to the window's cut can be wrong; that
+changes the halo column's edge and lit level and, through the next frames'
+band, can creep inward by up to ``margin`` columns a frame where columns have
+several transitions. The default halo adds :data:`GUARD_COLUMNS` for that, and
+each strip also keeps the column on either side of its own, which the
+neighbouring strip owns: :func:`merge_strips` refuses to merge strips that do
+not agree there (then raise the halo). On the seeded synthetic scene and on
+dev_ridge the strips equal the single job bit for bit already with a guard of 0.
+
+Offers
+------
+strip_bounds : column ranges of n equal strips.
+strip_halo : halo columns needed for a photometry's shifts and the tracking options.
+strip_window : the columns a strip reads (its own plus the halo, clipped to the frame).
+track_strip : run the tracking pass on one strip.
+merge_strips : join strips into the single job's result.
+"""
+
+import math
+
+import numpy as np
+
+from shadowcam.outdoor.tracking import EdgeTracker
+
+#: extra halo columns against the band errors creeping in from the window's cut
+GUARD_COLUMNS = 8
+#: per-frame (time, col) results of the pass
+COLUMN_KEYS = ("edge_row", "confidence", "n_transitions")
+
+
+def strip_bounds(width, n_strips):
+    """Return ``[(c0, c1), ...]``: `n_strips` contiguous column ranges covering ``[0, width)``."""
+    if not 1 <= int(n_strips) <= int(width):
+        raise ValueError(f"n_strips must be between 1 and the frame width {width}; got {n_strips}")
+    edges = np.linspace(0, int(width), int(n_strips) + 1).round().astype(int)
+    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
+
+
+def strip_halo(shift, *, margin=2, guard=GUARD_COLUMNS):
+    """Return the halo (columns each side of a strip) for the tracking pass.
+
+    Parameters
+    ----------
+    shift : (T, 2) ndarray
+        Per-frame ``(shift_row, shift_col)`` of the photometry (pixels).
+    margin : int, optional
+        Frame-differencing widening (the tracking option of the same name).
+    guard : int, optional
+        Extra columns (see the module notes).
+
+    Returns
+    -------
+    int
+        ``ceil(max |shift_col|) + 2 + margin + guard``.
+    """
+    shift = np.asarray(shift, dtype=np.float64)
+    if shift.ndim != 2 or shift.shape[1] != 2 or not np.all(np.isfinite(shift)):
+        raise ValueError(f"shift must be a finite (T, 2) array; got shape {shift.shape}")
+    if margin < 0 or guard < 0:
+        raise ValueError(f"margin and guard must be >= 0; got {margin}, {guard}")
+    largest = float(np.abs(shift[:, 1]).max()) if shift.size else 0.0
+    return int(math.ceil(largest)) + 2 + int(margin) + int(guard)
+
+
+def strip_window(cols, halo, width):
+    """Return ``(a, b)``: the columns strip `cols` ``(c0, c1)`` reads, ``[c0 - halo, c1 + halo)`` clipped."""
+    c0, c1 = (int(c) for c in cols)
+    if not 0 <= c0 < c1 <= width:
+        raise ValueError(f"cols must be (c0, c1) with 0 <= c0 < c1 <= {width}; got {cols}")
+    if halo < 0:
+        raise ValueError(f"halo must be >= 0; got {halo}")
+    return max(0, c0 - int(halo)), min(int(width), c1 + int(halo))
+
+
+def _window_photometry(photometry, window):
+    a, b = window
+    return {key: (value[:, a:b] if np.ndim(value) == 2 and key not in ("shift",) else value)
+            for key, value in photometry.items()}
+
+
+def track_strip(frames, photometry, time_s, *, cols, halo=None, **options):
+    """Run the tracking pass on the columns `cols` of the frames.
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, C) or (H, b - a, C) ndarray
+        In time order: whole frames, or only the strip's window ``(a, b)``
+        (:func:`strip_window`; reading only those columns is what saves memory).
+    photometry : mapping
+        Whole-frame photometry (:class:`shadowcam.outdoor.tracking.EdgeTracker`).
+    time_s : (T,) ndarray
+    cols : (2,) tuple of int
+        The strip's own columns ``[c0, c1)``.
+    halo : int, optional
+        Columns read each side; default :func:`strip_halo` of the photometry's shifts.
+    **options
+        Keyword options of :class:`~shadowcam.outdoor.tracking.EdgeTracker`.
+
+    Returns
+    -------
+    dict
+        ``cols (c0, c1)``, ``kept (k0, k1)`` (the strip's columns plus one each side,
+        clipped: the columns of the arrays), ``width``; ``edge_row``, ``confidence``,
+        ``n_transitions`` ``(T, k1 - k0)``; ``coverage_arrival_s (H, k1 - k0)``;
+        ``band_count (T,)`` int64 and ``valid_count`` (band and valid pixels of the
+        strip's own columns).
+    """
+    height, width = np.shape(photometry["sky"])
+    if halo is None:
+        halo = strip_halo(photometry["shift"], margin=options.get("margin", 2))
+    window = strip_window(cols, halo, width)
+    (c0, c1), (a, b) = cols, window
+    kept = (max(0, c0 - 1), min(width, c1 + 1))
+    tracker = EdgeTracker(_window_photometry(photometry, window), time_s, count_cols=(c0 - a, c1 - a), **options)
+    for frame in frames:
+        if frame.shape[1] == width and width != b - a:
+            frame = frame[:, a:b]
+        elif frame.shape[1] != b - a:
+            raise ValueError(f"frames must be {width} columns wide or the strip's window {window}; "
+                             f"got shape {frame.shape}")
+        tracker.update(frame)
+    result = tracker.result()
+    local = np.s_[:, kept[0] - a:kept[1] - a]
+    strip = {key: result[key][local] for key in (*COLUMN_KEYS, "coverage_arrival_s")}
+    strip.update(cols=(int(c0), int(c1)), kept=kept, width=int(width), band_count=tracker.band_count,
+                 valid_count=tracker.valid_count)
+    return strip
+
+
+def _same(x, y):
+    return np.array_equal(x, y, equal_nan=np.issubdtype(np.asarray(x).dtype, np.floating))
+
+
+def merge_strips(strips):
+    """Join column strips (:func:`track_strip`) into the single job's result.
+
+    Parameters
+    ----------
+    strips : sequence of dict
+        Strips covering the frame's columns without gaps or overlap (any order).
+
+    Returns
+    -------
+    dict
+        As :func:`shadowcam.outdoor.tracking.track_frames`: ``edge_row``,
+        ``confidence``, ``n_transitions`` ``(T, W)``, ``band_fraction (T,)``
+        (float32 of the summed band count over the summed valid count, which is
+        how the single job's mean rounds), ``coverage_arrival_s (H, W)``.
+
+    Raises
+    ------
+    ValueError
+        When the strips do not tile the frame, or two neighbours disagree on the
+        columns next to their boundary (the halo was too narrow for the sequence).
+    """
+    strips = sorted(strips, key=lambda s: s["cols"][0])
+    if not strips:
+        raise ValueError("strips is empty; give the results of track_strip")
+    width = strips[0]["width"]
+    starts = [s["cols"][0] for s in strips]
+    stops = [s["cols"][1] for s in strips]
+    if starts[0] != 0 or stops[-1] != width or starts[1:] != stops[:-1] or {s["width"] for s in strips} != {width}:
+        raise ValueError(f"strips must tile columns [0, {width}) without gaps or overlap; got {list(zip(starts, stops))}")
+    for left, right in zip(strips[:-1], strips[1:]):
+        boundary = left["cols"][1]
+        for key in (*COLUMN_KEYS, "coverage_arrival_s"):
+            mine = left[key][:, boundary - 1 - left["kept"][0]:boundary + 1 - left["kept"][0]]
+            theirs = right[key][:, boundary - 1 - right["kept"][0]:boundary + 1 - right["kept"][0]]
+            if not _same(mine, theirs):
+                raise ValueError(
+                    f"strips {left['cols']} and {right['cols']} disagree on {key} at columns "
+                    f"{boundary - 1}-{boundary}: the halo is too narrow for this sequence; raise it")
+    merged = {key: np.concatenate([s[key][:, s["cols"][0] - s["kept"][0]:s["cols"][1] - s["kept"][0]]
+                                   for s in strips], axis=1)
+              for key in (*COLUMN_KEYS, "coverage_arrival_s")}
+    band = np.sum([s["band_count"] for s in strips], axis=0).astype(np.float64)
+    valid = float(sum(s["valid_count"] for s in strips))
+    merged["band_fraction"] = (band / valid if valid else np.zeros_like(band)).astype(np.float32)
+    return {key: merged[key] for key in ("edge_row", "confidence", "n_transitions", "band_fraction",
+                                         "coverage_arrival_s")}

@@ -1,0 +1,164 @@
+"""Second streaming pass over an outdoor time-lapse: coverage, edges, crossings.
+
+With the shifts, gains and per-pixel levels of the first pass
+(:mod:`shadowcam.outdoor.normalise`), each frame becomes a coverage image
+(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`); frame differencing
+against the previous coverage gives the band where the edge moved
+(:mod:`shadowcam.outdoor.frame_difference`); the edge of every column is located with
+sub-pixel precision (:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions
+in the band or near the column's most recent edge (tracking) and the per-pixel
+coverage crossing is accumulated (:class:`shadowcam.outdoor.arrival.CoverageCrossing`).
+The lit level of each pixel follows slow shading changes (the sun moves) while
+the pixel is fully lit and well above the edge. Memory is a few ``(H, W)``
+arrays plus the ``(T, W)`` edges.
+
+Every step but the frame differencing's widening (``margin`` columns) and the
+registration shift (:func:`shadowcam.outdoor.translation.translate_cubic_Keys1981`,
+whose bits do not depend on where the frame is cut) works column by column,
+so column strips of the frames can be tracked as separate jobs and merged
+exactly (:mod:`shadowcam.outdoor.strips`).
+
+Offers
+------
+EdgeTracker : the streaming pass; :meth:`update` per frame, :meth:`result`.
+track_frames : run it over an iterable of frames.
+"""
+
+import numpy as np
+
+from shadowcam.outdoor.arrival import CoverageCrossing
+from shadowcam.outdoor.edge_tracking import column_edges
+from shadowcam.outdoor.frame_difference import difference_band
+from shadowcam.outdoor.photometric import coverage, luminance
+from shadowcam.outdoor.translation import translate_cubic_Keys1981
+
+
+class EdgeTracker:
+    """Streaming coverage, frame differencing, edge tracking and coverage crossing.
+
+    Parameters
+    ----------
+    photometry : mapping
+        ``shift (T, 2)``, ``gain_lit (T,)``, ``gain_sky (T,)``, ``sky``,
+        ``lit_at_start``, ``lit_level``, ``shadow_level`` ``(H, W)``
+        (the result of :func:`shadowcam.outdoor.normalise.normalise_frames`).
+    time_s : (T,) ndarray
+        Frame times in seconds.
+    half_window : int, optional
+        Half window of the edge's area estimator (rows).
+    min_drop, margin : float, int, optional
+        Frame-differencing options (:func:`shadowcam.outdoor.frame_difference.difference_band`).
+    max_step : float, optional
+        Rows the edge may move between frames and still count as tracked.
+    lit_update : float, optional
+        Weight of the current frame in the running lit level (0 = fixed).
+    update_distance : float, optional
+        The lit level is updated only this many rows or more above the edge.
+    count_cols : (2,) tuple of int, optional
+        Columns ``[c0, c1)`` of the frames over which :attr:`band_count` (pixels in
+        the band, per frame) and :attr:`valid_count` (valid pixels) are counted
+        (default all): the exact partial sums of ``band_fraction`` for a column strip.
+    """
+
+    def __init__(self, photometry, time_s, *, half_window=3, min_drop=0.2, margin=2, max_step=3.0,
+                 lit_update=0.3, update_distance=4.0, count_cols=None):
+        self.shift = np.asarray(photometry["shift"], dtype=np.float64)
+        self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
+        self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
+        self.time_s = np.asarray(time_s, dtype=np.float64)
+        n_frames = self.time_s.size
+        if not (self.shift.shape == (n_frames, 2) and self.gain_lit.shape == self.gain_sky.shape == (n_frames,)):
+            raise ValueError(
+                f"photometry shift {self.shift.shape}, gain_lit {self.gain_lit.shape}, gain_sky "
+                f"{self.gain_sky.shape} do not match time_s ({n_frames} frames)"
+            )
+        if not 0 <= lit_update <= 1:
+            raise ValueError(f"lit_update must be in [0, 1]; got {lit_update}")
+        self.valid = ~np.asarray(photometry["sky"], dtype=bool)
+        self.lit_at_start = np.asarray(photometry["lit_at_start"], dtype=bool)
+        self.lit_level = np.array(photometry["lit_level"], dtype=np.float32)
+        self.shadow_level = np.asarray(photometry["shadow_level"], dtype=np.float32)
+        height, width = self.valid.shape
+        self.options = dict(half_window=half_window, max_step=max_step)
+        self.band_options = dict(min_drop=min_drop, margin=margin)
+        self.lit_update, self.update_distance = float(lit_update), float(update_distance)
+        self.edge_row = np.full((n_frames, width), np.nan, dtype=np.float32)
+        self.confidence = np.zeros((n_frames, width), dtype=np.float32)
+        self.n_transitions = np.zeros((n_frames, width), dtype=np.int16)
+        self.band_fraction = np.zeros(n_frames, dtype=np.float32)
+        c0, c1 = (0, width) if count_cols is None else (int(c) for c in count_cols)
+        if not 0 <= c0 < c1 <= width:
+            raise ValueError(f"count_cols must be (c0, c1) with 0 <= c0 < c1 <= {width}; got {count_cols}")
+        self._counted = np.s_[:, c0:c1]
+        self.band_count = np.zeros(n_frames, dtype=np.int64)
+        self.valid_count = int(self.valid[self._counted].sum())
+        self.crossing = CoverageCrossing((height, width), eligible=self.lit_at_start & self.valid)
+        self._previous = None
+        self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
+        self._k = 0
+        self._centre = np.arange(height, dtype=np.float32)[:, None] + 0.5
+
+    def update(self, frame):
+        """Process the next frame ``(H, W, C)``."""
+        k = self._k
+        if k >= self.time_s.size:
+            raise ValueError(f"more frames than frame times ({self.time_s.size})")
+        luma = translate_cubic_Keys1981(luminance(frame), self.shift[k]) / np.float32(self.gain_lit[k])
+        shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
+        cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
+        band = None
+        if self._previous is not None:
+            band = difference_band(self._previous, cover, valid=self.valid, **self.band_options)
+            self.band_fraction[k] = band[self.valid].mean() if self.valid.any() else 0.0
+            self.band_count[k] = np.count_nonzero(band[self._counted] & self.valid[self._counted])
+        self.edge_row[k], self.confidence[k], self.n_transitions[k] = column_edges(
+            cover, valid=self.valid, band=band, previous=self._last_edge if k else None, **self.options)
+        found = np.isfinite(self.edge_row[k])
+        self._last_edge[found] = self.edge_row[k][found]
+        self.crossing.update(cover, self.time_s[k])
+        if self.lit_update > 0:
+            with np.errstate(invalid="ignore"):
+                far = ~(self._centre > self.edge_row[k][None, :] - self.update_distance)
+            update = self.lit_at_start & (cover > 0.9) & far
+            blended = (1 - self.lit_update) * self.lit_level + self.lit_update * luma
+            np.copyto(self.lit_level, blended, where=update)
+        self._previous = cover
+        self._k += 1
+
+    def result(self):
+        """Return the pass's results (see :func:`track_frames`)."""
+        if self._k != self.time_s.size:
+            raise ValueError(f"got {self._k} frames but {self.time_s.size} frame times")
+        return {
+            "edge_row": self.edge_row,
+            "confidence": self.confidence,
+            "n_transitions": self.n_transitions,
+            "band_fraction": self.band_fraction,
+            "coverage_arrival_s": self.crossing.arrival_s,
+        }
+
+
+def track_frames(frames, photometry, time_s, **options):
+    """Run :class:`EdgeTracker` over `frames`.
+
+    Parameters
+    ----------
+    frames : iterable of (H, W, C) ndarray
+        In time order.
+    photometry : mapping
+        See :class:`EdgeTracker`.
+    time_s : (T,) ndarray
+    **options
+        Keyword options of :class:`EdgeTracker`.
+
+    Returns
+    -------
+    dict
+        ``edge_row (T, W)`` (pixel-edge rows, NaN = none), ``confidence (T, W)``,
+        ``n_transitions (T, W)``, ``band_fraction (T,)`` (share of valid pixels in
+        the frame-differencing band) and ``coverage_arrival_s (H, W)``.
+    """
+    tracker = EdgeTracker(photometry, time_s, **options)
+    for frame in frames:
+        tracker.update(frame)
+    return tracker.result()

@@ -1,0 +1,198 @@
+"""Report figures of the outdoor pipeline: the equivalent of the paper's Fig. 18.
+
+Every function takes arrays and returns a :class:`matplotlib.figure.Figure`
+(see :mod:`shadowcam.report.figures` for the conventions: linear images shown with a
+percentile white point and display gamma, NaN drawn grey). The sky is masked
+(drawn grey) in every camera-space figure.
+
+Offers
+------
+display_step : decimation step of large images for display.
+keyframes_figure : frames with their tracked edge overlaid.
+edge_over_time_figure : edge rows of every column over time (time x col image) and sample curves.
+arrival_map_figure : the arrival-time map in minutes, sky masked.
+pushbroom_figure : the ridge pushbroom beside the real view.
+"""
+
+import numpy as np
+from matplotlib import colormaps
+
+from shadowcam.report.figures import NAN_GREY, _new_figure, display_rgb
+
+
+#: images are shown at most this many pixels wide / high (a 24 MP frame is decimated)
+DISPLAY_SIZE = 1600
+
+
+def display_step(shape, *, max_size=DISPLAY_SIZE):
+    """Decimation step that brings an ``(H, W)`` image to at most `max_size` pixels a side."""
+    return max(1, -(-max(int(n) for n in shape[:2]) // int(max_size)))
+
+
+def _extent(shape, step):
+    """imshow extent of an image decimated by `step`, in full-resolution pixel coordinates."""
+    return (-0.5, shape[1] * step - 0.5, shape[0] * step - 0.5, -0.5)
+
+
+def _masked_rgb(image, sky, step=1):
+    """Display RGB of `image` (already decimated by `step`), sky grey."""
+    rgb = display_rgb(image)
+    sky = np.asarray(sky, dtype=bool)[::step, ::step]
+    rgb[sky[: rgb.shape[0], : rgb.shape[1]]] = NAN_GREY
+    return rgb
+
+
+def keyframes_figure(frames, edge_rows, times_s, *, sky, is_keyframe=None, size=None, step=1):
+    """Frames with the tracked edge of each drawn on it.
+
+    Parameters
+    ----------
+    frames : sequence of (H, W, 3) ndarray
+        Linear frames (e.g. divided by their gain so they look alike).
+    edge_rows : sequence of (W,) ndarray
+        Edge row per column of each frame (pixel-edge coordinates).
+    times_s : sequence of float
+    sky : (H, W) bool ndarray
+    is_keyframe : sequence of bool, optional
+        Marks non-keyframes (edge interpolated) in the titles.
+    size : (float, float), optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    n = len(frames)
+    if n == 0 or len(edge_rows) != n or len(times_s) != n:
+        raise ValueError(f"frames, edge_rows and times_s must have the same non-zero length; got "
+                         f"{n}, {len(edge_rows)}, {len(times_s)}")
+    cols = min(3, n)
+    rows = int(np.ceil(n / cols))
+    figure = _new_figure(size or (4.0 * cols, 3.0 * rows))
+    for i, (frame, edge, t) in enumerate(zip(frames, edge_rows, times_s)):
+        axes = figure.add_subplot(rows, cols, i + 1)
+        axes.imshow(_masked_rgb(frame, sky, step), interpolation="nearest", origin="upper",
+                    extent=_extent(np.shape(frame), step))
+        x = np.arange(len(edge)) + 0.5
+        axes.plot(x, np.asarray(edge) - 0.5, color="red", linewidth=1.0)  # imshow: centre of row r at r
+        mark = "" if is_keyframe is None or is_keyframe[i] else " (interpolated)"
+        axes.set_title(f"t = {t / 60:.1f} min{mark}", fontsize="small")
+        axes.set_xticks([])
+        axes.set_yticks([])
+    figure.tight_layout()
+    return figure
+
+
+def edge_over_time_figure(edge_row, time_s, *, reference=None, sky=None, n_curves=12, size=(11.0, 4.0)):
+    """The tracked edge over time: edge row as a (time x col) image, and curves on the view.
+
+    Parameters
+    ----------
+    edge_row : (T, W) ndarray
+    time_s : (T,) ndarray
+    reference : (H, W, 3) ndarray, optional
+        View on which `n_curves` edges are drawn, coloured by time.
+    sky : (H, W) bool ndarray, optional
+    n_curves : int, optional
+    size : (float, float), optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    edge = np.asarray(edge_row, dtype=np.float64)
+    times = np.asarray(time_s, dtype=np.float64)
+    if edge.ndim != 2 or times.shape != (edge.shape[0],):
+        raise ValueError(f"edge_row must be (T, W) and time_s (T,); got {edge.shape}, {times.shape}")
+    figure = _new_figure(size)
+    panels = 2 if reference is not None else 1
+    axes = figure.add_subplot(1, panels, 1)
+    shown = axes.imshow(np.ma.masked_invalid(edge), aspect="auto", origin="lower", interpolation="nearest",
+                        cmap=colormaps["viridis"].with_extremes(bad=NAN_GREY),
+                        extent=(0, edge.shape[1], times[0] / 60, times[-1] / 60))
+    axes.set_xlabel("col")
+    axes.set_ylabel("time (min)")
+    axes.set_title("edge row over time")
+    figure.colorbar(shown, ax=axes, label="edge row (pixel)")
+    if reference is not None:
+        axes = figure.add_subplot(1, panels, 2)
+        step = display_step(reference.shape)
+        axes.imshow(_masked_rgb(reference[::step, ::step], np.zeros(reference.shape[:2], bool) if sky is None
+                                else sky, step), interpolation="nearest", origin="upper",
+                    extent=_extent(reference[::step, ::step].shape, step))
+        cmap = colormaps["plasma"]
+        for k in np.linspace(0, edge.shape[0] - 1, n_curves).astype(int):
+            axes.plot(np.arange(edge.shape[1]) + 0.5, edge[k] - 0.5, color=cmap(k / max(edge.shape[0] - 1, 1)),
+                      linewidth=0.8)
+        axes.set_title(f"{n_curves} edges, early (dark) to late (yellow)")
+        axes.set_xticks([])
+        axes.set_yticks([])
+    figure.tight_layout()
+    return figure
+
+
+def arrival_map_figure(arrival_s, *, sky, size=(6.5, 4.5)):
+    """The arrival-time map in minutes; sky and pixels without arrival grey.
+
+    Parameters
+    ----------
+    arrival_s : (H, W) ndarray
+    sky : (H, W) bool ndarray
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    arrival = np.asarray(arrival_s, dtype=np.float64) / 60.0
+    if arrival.ndim != 2:
+        raise ValueError(f"arrival_s must be (H, W); got {arrival.shape}")
+    arrival = np.where(np.asarray(sky, dtype=bool), np.nan, arrival)
+    figure = _new_figure(size)
+    axes = figure.add_subplot()
+    step = display_step(arrival.shape)
+    shown = axes.imshow(np.ma.masked_invalid(arrival[::step, ::step]),
+                        cmap=colormaps["viridis"].with_extremes(bad=NAN_GREY), interpolation="nearest",
+                        origin="upper", extent=_extent(arrival[::step, ::step].shape, step))
+    axes.set_title("shadow arrival (sky, never / always shadowed: grey)")
+    axes.set_xlabel("col")
+    axes.set_ylabel("row")
+    figure.colorbar(shown, ax=axes, label="arrival time (min)")
+    figure.tight_layout()
+    return figure
+
+
+def pushbroom_figure(view, pushbroom, time_s, *, sky, size=(11.0, 4.5)):
+    """The ridge pushbroom (time upward) beside the real view.
+
+    Parameters
+    ----------
+    view : (H, W, 3) ndarray
+        The real view (first frame).
+    pushbroom : (T, W, 3) ndarray
+        Rows at `time_s` (e.g. resampled to evenly spaced times).
+    time_s : (T,) ndarray
+    sky : (H, W) bool ndarray
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    pushbroom = np.asarray(pushbroom)
+    times = np.asarray(time_s, dtype=np.float64)
+    if pushbroom.ndim != 3 or times.shape != (pushbroom.shape[0],):
+        raise ValueError(f"pushbroom must be (T, W, 3) and time_s (T,); got {pushbroom.shape}, {times.shape}")
+    figure = _new_figure(size)
+    axes = figure.add_subplot(1, 2, 1)
+    step = display_step(view.shape)
+    axes.imshow(_masked_rgb(view[::step, ::step], sky, step), interpolation="nearest", origin="upper",
+                extent=_extent(view[::step, ::step].shape, step))
+    axes.set_title("real view (first frame)")
+    axes.set_xlabel("col")
+    axes.set_ylabel("row")
+    axes = figure.add_subplot(1, 2, 2)
+    axes.imshow(display_rgb(pushbroom[:, ::step]), interpolation="nearest", origin="lower", aspect="auto",
+                extent=(0, pushbroom.shape[1], times[0] / 60, times[-1] / 60))
+    axes.set_title("ridge pushbroom (colour along the edge)")
+    axes.set_xlabel("col")
+    axes.set_ylabel("time (min)")
+    figure.tight_layout()
+    return figure

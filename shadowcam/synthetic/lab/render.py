@@ -1,0 +1,550 @@
+"""Render synthetic lab sweep captures with exact ground truth (direct illumination only).
+
+The scene is static, so primary rays and scene shadow rays are cast once
+(``trace_light_paths``): every (pixel sub-sample, light sample) pair that carries light
+becomes a *light path* with its radiance contribution. A wire of radius r blocks a path
+during an analytic interval of frames (``raycast.wire_occlusion_interval``), so a whole
+sweep is the reference image minus the contributions of the paths blocked in each frame,
+accumulated with a difference array over time (no per-frame ray casting at all). Partial
+wire coverage of a pixel's sub-samples gives a smooth dip.
+
+Radiometry: radiance ``L = f_r I cos_L / d_L^2`` (point / area samples of intensity I) or
+``f_r E cos_L`` (distant light, irradiance E), with the reciprocal BRDF of
+``scene.Material``; a point must face both the light and the viewer.
+
+Offers
+------
+LightPaths : the static light paths of one view (see ``trace_light_paths``).
+trace_light_paths : cast primary and shadow rays once for a camera, light and objects.
+render_image : (rows, cols, 3) image of a view from its light paths.
+sweep_frames : (T, rows, cols, 3) frames of one wire sweep from the light paths
+    (optionally with the wire pushed off its plane per frame: non-planar motion).
+pixel_centre_ground_truth : exact per-pixel GT (P, lit, shadow times, cosines, distances).
+plane_homography : camera (col, row) pixel-centre index -> back-plane (x, y) homography.
+render_reciprocal : the reciprocal render (pinhole at the light, point light at the camera).
+CaptureRenderer, prepare_capture : a whole capture (u, v, cal_u, cal_v sweeps, reference,
+    ground-truth xarray Dataset) with sweeps rendered on demand.
+SWEEP_INDEX : sweep name -> index used to seed sensor noise.
+"""
+
+import json
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+import xarray as xr
+
+from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_scene, occluded, wire_occlusion_interval
+from shadowcam.synthetic.lab.scene import (
+    DistantLight,
+    OrthographicCamera,
+    PinholeCamera,
+    PointLight,
+    calibration_scene,
+    camera_rays,
+    dual_camera,
+    light_samples,
+    project,
+    wire_shadow_time,
+)
+
+log = logging.getLogger(__name__)
+
+#: sweep name -> index used in noise seeds ``[seed, index, frame]`` (reference: 9)
+SWEEP_INDEX = {"u": 0, "v": 1, "cal_u": 2, "cal_v": 3, "reference": 9}
+
+_CHUNK = 1 << 18  # rays per batch
+
+
+@dataclass(frozen=True)
+class LightPaths:
+    """Static light transport of one view: one entry per lit (sub-sample, light sample) pair.
+
+    Attributes
+    ----------
+    shape : (rows, cols)
+    pixel : (n,) int64 flat pixel index ``row * cols + col``
+    points : (n, 3) float64 scene point of the sub-sample
+    light : (n, 3) float64 light sample position (or unit direction for a distant light)
+    radiance : (n, 3) float64 contribution to the pixel value (already divided by the
+        number of sub-samples per pixel)
+    distant : bool
+    """
+
+    shape: tuple
+    pixel: np.ndarray
+    points: np.ndarray
+    light: np.ndarray
+    radiance: np.ndarray
+    distant: bool
+
+
+def _subpixel_grid(rows, cols, supersample):
+    """Pixel-edge (x, y) of a supersample x supersample grid of stratum centres per pixel."""
+    k = np.arange(supersample)
+    offsets = (k + 0.5) / supersample
+    r, c, oy, ox = np.meshgrid(np.arange(rows), np.arange(cols), offsets, offsets,
+                               indexing="ij")
+    return (c + ox).ravel(), (r + oy).ravel()
+
+
+def _view_dirs(camera, points):
+    if isinstance(camera, OrthographicCamera):
+        return np.broadcast_to(-camera.R[2], points.shape)
+    rel = camera.center - points
+    return rel / np.linalg.norm(rel, axis=1, keepdims=True)
+
+
+def _brdf(objects, object_id, albedo, normal, to_light, to_view):
+    """(N, 3) BRDF value ``albedo/pi + ks (s+8)/(8 pi) (n.h)^s`` (reciprocal)."""
+    f = albedo / np.pi
+    spec = np.array([o.material.specular for o in objects])[object_id]
+    if np.any(spec > 0):
+        shin = np.array([o.material.shininess for o in objects])[object_id]
+        h = to_light + to_view
+        h /= np.linalg.norm(h, axis=1, keepdims=True)
+        nh = np.clip((normal * h).sum(axis=1), 0.0, None)
+        f = f + (spec * (shin + 8) / (8 * np.pi) * nh**shin)[:, None]
+    return f
+
+
+def _shade(objects, hits_sel, camera, light):
+    """Per light sample: (to_light_end, radiance (n, 3)) for the hit points in `hits_sel`.
+
+    `hits_sel` is (point, normal, object_id, albedo). Yields one entry per light sample;
+    radiance is 0 where the point does not face the light/viewer or is occluded.
+    """
+    points, normal, object_id, albedo = hits_sel
+    positions, directions, weights = light_samples(light)
+    to_view = _view_dirs(camera, points)
+    cos_c = (normal * to_view).sum(axis=1)
+    n_samples = len(weights)
+    for k in range(n_samples):
+        if directions is not None:
+            to_light = np.broadcast_to(directions[k], points.shape)
+            dist = np.full(len(points), np.inf)
+            falloff = np.ones(len(points))
+            end = to_light
+        else:
+            rel = positions[k] - points
+            dist = np.linalg.norm(rel, axis=1)
+            to_light = rel / dist[:, None]
+            falloff = 1.0 / dist**2
+            end = np.broadcast_to(positions[k], points.shape)
+        cos_l = (normal * to_light).sum(axis=1)
+        ok = (cos_l > 0) & (cos_c > 0)
+        idx = np.flatnonzero(ok)
+        start = points[idx] + SURFACE_OFFSET * normal[idx]
+        blocked = occluded(objects, start, to_light[idx], dist[idx])
+        ok[idx[blocked]] = False
+        f = _brdf(objects, object_id, albedo, normal, to_light, to_view)
+        radiance = f * (weights[k] * (cos_l * falloff)[:, None])
+        radiance[~ok] = 0.0
+        yield end, radiance, ok
+
+
+def trace_light_paths(objects, camera, light, *, supersample=4):
+    """Cast primary rays and scene shadow rays once for a view.
+
+    Parameters
+    ----------
+    objects : sequence of scene objects
+    camera : PinholeCamera or OrthographicCamera
+    light : PointLight, AreaLight or DistantLight
+    supersample : int
+        Sub-samples per pixel side (stratum centres of a regular grid; 1 = pixel centre).
+
+    Returns
+    -------
+    LightPaths
+    """
+    supersample = int(supersample)
+    if supersample < 1:
+        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+    rows, cols = camera.height, camera.width
+    x, y = _subpixel_grid(rows, cols, supersample)
+    per_pixel = supersample * supersample
+    parts = {"pixel": [], "points": [], "light": [], "radiance": []}
+    for start in range(0, len(x), _CHUNK):
+        sl = slice(start, start + _CHUNK)
+        origins, dirs = camera_rays(camera, x[sl], y[sl])
+        hits = intersect_scene(objects, origins, dirs)
+        sel = np.flatnonzero(hits.hit)
+        pixel = (start + sel) // per_pixel
+        data = (hits.point[sel], hits.normal[sel], hits.object_id[sel], hits.albedo[sel])
+        for end, radiance, ok in _shade(objects, data, camera, light):
+            parts["pixel"].append(pixel[ok])
+            parts["points"].append(data[0][ok])
+            parts["light"].append(np.asarray(end)[ok])
+            parts["radiance"].append(radiance[ok] / per_pixel)
+    cat = {k: np.concatenate(v) if v else np.zeros((0, 3)) for k, v in parts.items()}
+    return LightPaths(shape=(rows, cols), pixel=cat["pixel"].astype(np.int64),
+                      points=cat["points"], light=cat["light"], radiance=cat["radiance"],
+                      distant=isinstance(light, DistantLight))
+
+
+def _pixel_sums(paths):
+    n_pix = paths.shape[0] * paths.shape[1]
+    return np.stack([np.bincount(paths.pixel, weights=paths.radiance[:, c], minlength=n_pix)
+                     for c in range(3)], axis=-1)
+
+
+def render_image(paths):
+    """Return the (rows, cols, 3) float32 radiance image of `paths` (no wire)."""
+    return _pixel_sums(paths).reshape(*paths.shape, 3).astype(np.float32)
+
+
+def _offset_rate(paths, sweep, mask):
+    """Shift of each path's blocked interval, in frames per scene unit of wire offset along
+    the mask normal: the wire at ``p(k) + e n`` blocks path (P, L) when
+    ``|t_c - k - e (n.w) / (v.w)| < half_width`` (``w = normalize(s x d)`` as in
+    ``raycast.wire_occlusion_interval``). Zero for a distant light (n parallel to s)."""
+    seg = paths.light if paths.distant else paths.light - paths.points
+    w = np.cross(seg, sweep.direction)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        w /= np.linalg.norm(w, axis=1, keepdims=True)
+        return (w @ mask.normal) / (w @ sweep.velocity)
+
+
+def sweep_frames(paths, sweep, mask, *, path_offsets=None):
+    """Frames of one wire sweep.
+
+    Frame k shows the wire at ``p(k) = p0 + k v``; a light path is dark in frame k when the
+    wire blocks it, i.e. ``|k - t_c| < half_width`` (``raycast.wire_occlusion_interval``).
+
+    Parameters
+    ----------
+    paths : LightPaths
+    sweep : WireSweep
+    mask : MaskPlane
+    path_offsets : (T,) array_like, optional
+        Non-planar mask motion: in frame k the wire is displaced by ``path_offsets[k]``
+        (scene units) along the mask normal ``n`` (the light's aim direction), i.e. it
+        sits at ``p(k) + path_offsets[k] n``. Exact for an infinite wire (the finite
+        wire's coverage is that of the planar path). None = planar motion.
+
+    Returns
+    -------
+    (T, rows, cols, 3) float32 ndarray
+        Linear radiance, T = ``sweep.frames``.
+    """
+    n_frames = sweep.frames
+    n_pix = paths.shape[0] * paths.shape[1]
+    t_c, half = wire_occlusion_interval(paths.points, paths.light, sweep, mask,
+                                        distant=paths.distant)
+    reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
+    if path_offsets is not None:
+        offsets = np.asarray(path_offsets, dtype=np.float64)
+        if offsets.shape != (n_frames,) or not np.all(np.isfinite(offsets)):
+            raise ValueError(f"path_offsets: expected {n_frames} finite offsets (one per "
+                             f"frame), got shape {offsets.shape}")
+        return _frames_with_offsets(paths, t_c, half, _offset_rate(paths, sweep, mask),
+                                    offsets, reference)
+    with np.errstate(invalid="ignore"):
+        first = np.floor(t_c - half) + 1  # strict inequality: open interval
+        last = np.ceil(t_c + half) - 1
+    first = np.clip(np.nan_to_num(first, nan=n_frames), 0, n_frames)
+    last = np.clip(np.nan_to_num(last, nan=-1), -1, n_frames - 1)
+    keep = np.isfinite(t_c) & (first <= last)
+    base = paths.pixel[keep] * (n_frames + 1)
+    index = np.concatenate([base + first[keep].astype(np.int64),
+                            base + last[keep].astype(np.int64) + 1])
+    frames = np.empty((n_frames, n_pix, 3), dtype=np.float32)
+    for c in range(3):
+        w = paths.radiance[keep, c]
+        diff = np.bincount(index, weights=np.concatenate([w, -w]),
+                           minlength=n_pix * (n_frames + 1))
+        deficit = np.cumsum(diff.reshape(n_pix, n_frames + 1), axis=1)[:, :n_frames]
+        frames[:, :, c] = np.clip(reference[:, c] - deficit.T, 0.0, None)
+    return frames.reshape(n_frames, *paths.shape, 3)
+
+
+def _frames_with_offsets(paths, t_c, half, rate, offsets, reference):
+    """Frame by frame: path blocked in frame k when ``|t_c - k - offsets[k] rate| < half``."""
+    n_pix = reference.shape[0]
+    frames = np.empty((len(offsets), n_pix, 3), dtype=np.float32)
+    ok = np.isfinite(t_c) & np.isfinite(rate)
+    t_c, half, rate = t_c[ok], half[ok], rate[ok]
+    pixel, radiance = paths.pixel[ok], paths.radiance[ok]
+    for k, offset in enumerate(offsets):
+        blocked = np.abs(t_c - k - offset * rate) < half
+        for c in range(3):
+            deficit = np.bincount(pixel[blocked], weights=radiance[blocked, c], minlength=n_pix)
+            frames[k, :, c] = np.clip(reference[:, c] - deficit, 0.0, None)
+    return frames.reshape(len(offsets), *paths.shape, 3)
+
+
+def _pixel_centres(camera):
+    return _subpixel_grid(camera.height, camera.width, 1)
+
+
+def _surface_terms(objects, points, normal, hit, eye_camera, light):
+    """cos_L, cos_C, dist_L, dist_C and scene visibility of the light centre, (N,) each."""
+    n = len(points)
+    centre = light.direction if isinstance(light, DistantLight) else light.center
+    if isinstance(light, DistantLight):
+        to_light = np.broadcast_to(centre, points.shape)
+        dist_l = np.full(n, np.inf)
+    else:
+        rel = centre - points
+        dist_l = np.linalg.norm(rel, axis=1)
+        to_light = rel / dist_l[:, None]
+    to_view = _view_dirs(eye_camera, points)
+    dist_c = (np.full(n, np.inf) if isinstance(eye_camera, OrthographicCamera)
+              else np.linalg.norm(eye_camera.center - points, axis=1))
+    with np.errstate(invalid="ignore"):
+        cos_l = (normal * to_light).sum(axis=1)
+        cos_c = (normal * to_view).sum(axis=1)
+    faces = hit & (cos_l > 0) & (cos_c > 0)
+    idx = np.flatnonzero(faces)
+    blocked = occluded(objects, points[idx] + SURFACE_OFFSET * normal[idx], to_light[idx],
+                       dist_l[idx])
+    lit = faces.copy()
+    lit[idx[blocked]] = False
+    return cos_l, cos_c, dist_l, dist_c, lit
+
+
+def pixel_centre_ground_truth(objects, camera, light, mask, sweeps):
+    """Exact ground truth at camera pixel centres.
+
+    Parameters
+    ----------
+    objects : sequence of scene objects
+    camera : PinholeCamera
+    light : PointLight, AreaLight or DistantLight (area lights use their centre)
+    mask : MaskPlane
+    sweeps : dict of str to WireSweep
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``P``, ``N`` (rows, cols, 3); ``hit``, ``lit`` (rows, cols) bool (lit: faces light and
+        camera, light centre visible, wire excluded); ``cos_L``, ``cos_C``, ``dist_L``,
+        ``dist_C``, ``depth``; ``object_id``; and for every sweep name s: ``t_<s>``
+        (fractional frame, NaN where not lit, not covered by the finite wire or outside
+        [0, T-1]) and ``t_<s>_all`` (unrestricted).
+    """
+    rows, cols = camera.height, camera.width
+    x, y = _pixel_centres(camera)
+    origins, dirs = camera_rays(camera, x, y)
+    hits = intersect_scene(objects, origins, dirs)
+    cos_l, cos_c, dist_l, dist_c, lit = _surface_terms(objects, hits.point, hits.normal,
+                                                       hits.hit, camera, light)
+    _, depth = project(camera, hits.point)
+    out = {"P": hits.point, "N": hits.normal, "hit": hits.hit, "lit": lit, "cos_L": cos_l,
+           "cos_C": cos_c, "dist_L": dist_l, "dist_C": dist_c, "depth": depth,
+           "object_id": hits.object_id}
+    distant = isinstance(light, DistantLight)
+    centre = light.direction if distant else light.center
+    light_pts = np.broadcast_to(centre, hits.point.shape)
+    for name, sweep in sweeps.items():
+        t_all = wire_shadow_time(hits.point, sweep, light)
+        t_cov, _ = wire_occlusion_interval(np.nan_to_num(hits.point), light_pts, sweep, mask,
+                                           distant=distant)
+        ok = lit & np.isfinite(t_cov) & (t_all >= 0) & (t_all <= sweep.frames - 1)
+        out[f"t_{name}_all"] = t_all
+        out[f"t_{name}"] = np.where(ok, t_all, np.nan)
+    return {k: np.asarray(v).reshape(rows, cols, *np.shape(v)[1:]) for k, v in out.items()}
+
+
+def plane_homography(camera, plane):
+    """Homography from camera pixel-centre index (col, row) to back-plane coordinates (x, y).
+
+    Parameters
+    ----------
+    camera : PinholeCamera
+    plane : BackPlane
+
+    Returns
+    -------
+    (3, 3) float64 ndarray
+        ``H`` with ``[x, y, 1] ~ H [col, row, 1]``, normalised so ``H[2, 2] = 1``.
+    """
+    if not isinstance(camera, PinholeCamera):
+        raise ValueError("camera: the plane homography needs a PinholeCamera")
+    shift = np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [0.0, 0.0, 1.0]])  # index -> edge
+    A = camera.R.T @ np.linalg.inv(camera.K) @ shift  # pixel index -> ray direction
+    n, p0, c = plane.normal, plane.center, camera.center
+    # (n.d)(X - p0) = [(c - p0) n^T + (n.(p0 - c)) I] d  for X on the ray c + s d
+    M = np.outer(c - p0, n) + (n @ (p0 - c)) * np.eye(3)
+    H = np.stack([plane.axis_x @ M @ A, plane.axis_y @ M @ A, n @ A])
+    return H / H[2, 2]
+
+
+def render_reciprocal(objects, camera, light, mask, *, supersample=4):
+    """The reciprocal render and the dual-pixel geometry.
+
+    The view from the dual camera (``scene.dual_camera``: pinhole at the light centre, or
+    orthographic for a distant light) lit by a point light at the camera centre with the
+    light's intensity (irradiance for a distant light); its pixel grid is the dual grid.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``reciprocal`` (n_v, n_u, 3) float32; ``dual_P`` (n_v, n_u, 3); ``dual_hit``,
+        ``dual_cam_visible`` (n_v, n_u) bool (dual_P faces the camera, is unoccluded from the
+        camera centre and projects inside the image); ``dual_cam_xy`` (n_v, n_u, 2) camera
+        (col, row) pixel-centre index of dual_P (NaN where not visible).
+    """
+    dual = dual_camera(mask, light)
+    strength = light.irradiance if isinstance(light, DistantLight) else light.intensity
+    swapped = PointLight(camera.center, strength)
+    paths = trace_light_paths(objects, dual, swapped, supersample=supersample)
+    reciprocal = render_image(paths)
+    x, y = _pixel_centres(dual)
+    origins, dirs = camera_rays(dual, x, y)
+    hits = intersect_scene(objects, origins, dirs)
+    _, cos_c, _, _, visible = _surface_terms(objects, hits.point, hits.normal, hits.hit,
+                                             dual, swapped)
+    xy, depth = project(camera, np.nan_to_num(hits.point))
+    inside = ((depth > 0) & (xy[:, 0] >= 0) & (xy[:, 0] <= camera.width)
+              & (xy[:, 1] >= 0) & (xy[:, 1] <= camera.height))
+    visible &= inside
+    cam_xy = np.where(visible[:, None], xy - 0.5, np.nan)
+    shape = (dual.height, dual.width)
+    return {"reciprocal": reciprocal, "dual_P": hits.point.reshape(*shape, 3),
+            "dual_hit": hits.hit.reshape(shape), "dual_cam_visible": visible.reshape(shape),
+            "dual_cam_xy": cam_xy.reshape(*shape, 2)}
+
+
+def _geometry_attrs(scene):
+    """JSON description of camera, light, mask plane and sweeps (like meta.json)."""
+    cam, light, mask = scene.camera, scene.light, scene.mask
+    light_d = {"type": type(light).__name__}
+    for key in ("position", "direction", "intensity", "irradiance", "normal", "size", "shape"):
+        if hasattr(light, key):
+            value = getattr(light, key)
+            light_d[key] = value.tolist() if isinstance(value, np.ndarray) else value
+    return json.dumps({
+        "camera": {"K": cam.K.tolist(), "R_world_to_cam": cam.R.tolist(),
+                   "center": cam.center.tolist(), "width": cam.width, "height": cam.height,
+                   "convention": "X_cam = R (X - center); pixel (row r, col c) centre at "
+                                 "pixel-edge (c + 0.5, r + 0.5)"},
+        "light": light_d,
+        "mask_plane": {"M0": mask.origin.tolist(), "n": mask.normal.tolist(),
+                       "e_u": mask.e_u.tolist(), "e_v": mask.e_v.tolist(),
+                       "delta": mask.delta, "N_u": mask.n_u, "N_v": mask.n_v,
+                       "f_light_to_mask_plane": mask.focal},
+        "sweeps": {k: {"p0": s.p0.tolist(), "v": s.velocity.tolist(),
+                       "d": s.direction.tolist(), "frames": s.frames, "radius": s.radius,
+                       "length": s.length} for k, s in scene.sweeps.items()},
+    })
+
+
+class CaptureRenderer:
+    """A rendered capture: reference, ground truth, and sweeps rendered on demand.
+
+    Build it with ``prepare_capture``. ``frames(name)`` returns the (T, rows, cols, 3)
+    float32 linear frames of sweep ``u``, ``v``, ``cal_u`` or ``cal_v``.
+    """
+
+    def __init__(self, scene, paths, cal_paths, reference, ground_truth, homography):
+        self.scene = scene
+        self.reference = reference
+        self.ground_truth = ground_truth
+        self.homography = homography
+        self._paths = {"u": paths, "v": paths}
+        if cal_paths is not None:
+            self._paths.update(cal_u=cal_paths, cal_v=cal_paths)
+
+    @property
+    def sweep_names(self):
+        """Names of the sweeps this capture renders."""
+        return tuple(self._paths)
+
+    def frames(self, name, *, path_offsets=None):
+        """(T, rows, cols, 3) float32 frames of sweep `name` (see ``sweep_frames`` for
+        `path_offsets`, the non-planar wire motion)."""
+        if name not in self._paths:
+            raise ValueError(f"name: no sweep {name!r}; available: {self.sweep_names}")
+        sweep = self.scene.sweeps[name.removeprefix("cal_")]
+        return sweep_frames(self._paths[name], sweep, self.scene.mask,
+                            path_offsets=path_offsets)
+
+
+def prepare_capture(scene, *, supersample=4, calibration=True):
+    """Cast the static rays of a capture and compute its exact ground truth.
+
+    Parameters
+    ----------
+    scene : Scene
+    supersample : int
+        Sub-samples per pixel side for the camera and the reciprocal renders.
+    calibration : bool
+        Also prepare the calibration sweeps ``cal_u``, ``cal_v`` over the scene's back
+        plane alone.
+
+    Returns
+    -------
+    CaptureRenderer
+        With ``reference`` (rows, cols, 3) float32, ``ground_truth`` (xarray.Dataset, the
+        standard GT names of docs/architecture.md plus P, N, cosines, distances, calibration
+        GT) and ``homography`` ((3, 3), or None without calibration).
+    """
+    cam, light, mask = scene.camera, scene.light, scene.mask
+    paths = trace_light_paths(scene.objects, cam, light, supersample=supersample)
+    reference = render_image(paths)
+    log.info("traced %d light paths for %dx%d pixels", len(paths.pixel), cam.height, cam.width)
+    gt = pixel_centre_ground_truth(scene.objects, cam, light, mask, scene.sweeps)
+    recip = render_reciprocal(scene.objects, cam, light, mask, supersample=supersample)
+    f32 = np.float32
+    rc, vu = ("row", "col"), ("v", "u")
+    data = {
+        "t_u": (rc, gt["t_u"].astype(f32), "frame", "analytic shadow time of sweep u (dual u)"),
+        "t_v": (rc, gt["t_v"].astype(f32), "frame", "analytic shadow time of sweep v (dual v)"),
+        "t_u_all": (rc, gt["t_u_all"].astype(f32), "frame", "t_u without lit/range limits"),
+        "t_v_all": (rc, gt["t_v_all"].astype(f32), "frame", "t_v without lit/range limits"),
+        "lit": (rc, gt["lit"], "1", "pixel-centre point faces light and camera, light visible"),
+        "hit": (rc, gt["hit"], "1", "pixel-centre ray hits geometry"),
+        "P": (rc + ("xyz",), gt["P"].astype(f32), "scene_unit", "world point at pixel centre"),
+        "N": (rc + ("xyz",), gt["N"].astype(f32), "1", "surface normal at P"),
+        "depth": (rc, gt["depth"].astype(f32), "scene_unit", "camera z of P"),
+        "cos_L": (rc, gt["cos_L"].astype(f32), "1", "cosine between normal and light dir"),
+        "cos_C": (rc, gt["cos_C"].astype(f32), "1", "cosine between normal and camera dir"),
+        "dist_L": (rc, gt["dist_L"].astype(f32), "scene_unit", "distance P to light centre"),
+        "dist_C": (rc, gt["dist_C"].astype(f32), "scene_unit", "distance P to camera centre"),
+        "reference_linear": (rc + ("channel",), reference, "radiance",
+                             "linear render without the wire"),
+        "reciprocal": (vu + ("channel",), recip["reciprocal"], "radiance",
+                       "reciprocal render: pinhole at the light, point light at the camera"),
+        "dual_P": (vu + ("xyz",), recip["dual_P"].astype(f32), "scene_unit",
+                   "world point at dual pixel centre"),
+        "dual_cam_visible": (vu, recip["dual_cam_visible"], "1",
+                             "dual_P visible from the camera centre and inside the image"),
+        "dual_cam_xy": (vu + ("cam_xy",), recip["dual_cam_xy"].astype(f32), "pixel",
+                        "camera (col, row) pixel-centre index of dual_P"),
+    }
+    homography = None
+    cal_paths = None
+    if calibration:
+        cal = calibration_scene(scene)
+        cal_paths = trace_light_paths(cal.objects, cam, light, supersample=supersample)
+        cgt = pixel_centre_ground_truth(cal.objects, cam, light, mask, scene.sweeps)
+        plane = cal.back_plane
+        homography = plane_homography(cam, plane)
+        xy = plane.plane_coords(cgt["P"].reshape(-1, 3)).reshape(cam.height, cam.width, 2)
+        data.update({
+            "t_cal_u": (rc, cgt["t_u"].astype(f32), "frame",
+                        "analytic shadow time of calibration sweep cal_u"),
+            "t_cal_v": (rc, cgt["t_v"].astype(f32), "frame",
+                        "analytic shadow time of calibration sweep cal_v"),
+            "plane_xy": (rc + ("plane_axis",), xy.astype(f32), "scene_unit",
+                         "back-plane coordinates (x, y) at pixel centre (calibration scene)"),
+            "calibration_homography": (("h_row", "h_col"), homography, "1",
+                                       "camera (col, row) pixel-centre index -> plane (x, y)"),
+        })
+    ds = xr.Dataset(
+        {k: (dims, val, {"units": units, "long_name": name})
+         for k, (dims, val, units, name) in data.items()},
+        coords={"row": np.arange(cam.height), "col": np.arange(cam.width),
+                "u": np.arange(mask.n_u, dtype=np.float64),
+                "v": np.arange(mask.n_v, dtype=np.float64),
+                "channel": ["R", "G", "B"], "xyz": ["x", "y", "z"]},
+        attrs={"scene": scene.name, "seed": scene.seed, "supersample": int(supersample),
+               "geometry": _geometry_attrs(scene),
+               "convention": "arrays indexed [row, col] at pixel centres; dual pixel "
+                             "(row j, col i) centre <-> u = i, v = j"},
+    )
+    ds["u"].attrs.update(units="dual_pixel", long_name="dual column (u = t_u)")
+    ds["v"].attrs.update(units="dual_pixel", long_name="dual row (v = t_v)")
+    return CaptureRenderer(scene, paths, cal_paths, reference, ds, homography)

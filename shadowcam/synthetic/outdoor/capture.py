@@ -1,0 +1,269 @@
+"""A whole synthetic outdoor time-lapse: noise-free frames with nuisances, and its ground truth.
+
+Image formation (as dev_ridge, README 2.4, plus an optional cloud shadow)::
+
+    L_k  = frame_radiance(t_k)                       (sun + fading sky + sky dome; cloud on sun)
+    E_k  = exposure_gain_k * shift_k(L_k)             (what reaches the sensor, in radiance units)
+
+The sensor (:mod:`shadowcam.synthetic.sensor`: Poisson-Gaussian noise, RGGB mosaic) and the files are
+the caller's business (``shadowcam render``).
+
+Offers
+------
+NUISANCES : switch -> default (auto_exposure, shake_px, cloud, irregular_timing, dropped_frames).
+OutdoorCapture : times, per-frame records, noise-free sensor-plane frames ``E_k`` and the
+    ground-truth Dataset.
+render_outdoor_capture : render a capture of an :class:`~shadowcam.synthetic.outdoor.render.OutdoorScene`.
+edge_speed : fraction of vertically adjacent class-3 pixel pairs the edge crosses in under a
+    frame (edge faster than 1 px / frame there).
+"""
+
+import json
+from dataclasses import dataclass
+
+import numpy as np
+
+from shadowcam.synthetic.outdoor import nuisance as nz
+from shadowcam.synthetic.outdoor import truth as gt
+from shadowcam.synthetic.outdoor.render import frame_radiance, sample_grid, sky_colour, trace_samples
+from shadowcam.synthetic.outdoor.sun import elevation_azimuth, sun_colour
+
+#: nuisance switches and their defaults (all on)
+NUISANCES = {"auto_exposure": True, "shake_px": 1.0, "cloud": True, "irregular_timing": True,
+             "dropped_frames": 2}
+#: the cloud shadow: depth (1 - minimum transmittance) and Gaussian radius on the ground (m)
+CLOUD_DEPTH = 0.5
+CLOUD_SIGMA_M = 150.0
+
+
+@dataclass(frozen=True, eq=False)
+class OutdoorCapture:
+    """Rendered outdoor capture (noise-free, before the sensor).
+
+    Attributes
+    ----------
+    frames : (K, rows, cols, 3) float32 ndarray
+        ``E_k``: gain x shifted radiance (radiance units).
+    ground_truth : xarray.Dataset
+        Variables of :data:`shadowcam.synthetic.outdoor.truth.DEFINITIONS` and more (dims ``time``,
+        ``row``, ``col``, ``channel``, ``subpixel``).
+    """
+
+    frames: np.ndarray
+    ground_truth: object
+
+    @property
+    def times_s(self):
+        """(K,) frame times, seconds since frame 0."""
+        return self.ground_truth["times_s"].values
+
+
+def _cloud_path(scene, seed):
+    """Seeded straight drift of the cloud shadow: from the valley over the cliff toward the
+    plateau (+a), across a band of the view (b), during the whole sequence."""
+    rng = np.random.default_rng([int(seed), 53])
+    a0, b0 = -700.0, rng.uniform(-700.0, 100.0)
+    va, vb = 1600.0 / scene.duration_s, rng.uniform(-0.05, 0.05)
+    start = scene.terrain.to_xy(a0, b0)
+    end = scene.terrain.to_xy(a0 + va * scene.duration_s, b0 + vb * scene.duration_s)
+    velocity = (np.asarray(end) - np.asarray(start)) / scene.duration_s
+    return np.asarray(start), velocity
+
+
+def _pixel_mean(values, shape, s2):
+    return values.reshape(shape[0], shape[1], s2, *values.shape[1:]).mean(axis=2)
+
+
+def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances):
+    """Render the frames and the ground truth of a sunset time-lapse.
+
+    Parameters
+    ----------
+    scene : shadowcam.synthetic.outdoor.render.OutdoorScene
+    frames : int, keyword-only
+        Number of kept frames.
+    supersample : int, keyword-only
+        Samples per pixel side (the ``subpixel`` GT uses the same samples).
+    seed : int, keyword-only
+        Seed of the nuisances.
+    **nuisances
+        Keys of :data:`NUISANCES`.
+
+    Returns
+    -------
+    OutdoorCapture
+    """
+    import xarray as xr
+
+    unknown = set(nuisances) - set(NUISANCES)
+    if unknown:
+        raise ValueError(f"nuisances: unknown switch(es) {sorted(unknown)}; known: {sorted(NUISANCES)}")
+    opts = dict(NUISANCES, **nuisances)
+    if int(supersample) < 1:
+        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+    rows, cols = scene.camera.height, scene.camera.width
+    s = int(supersample)
+    s2 = s * s
+
+    times, nominal, dropped = nz.capture_times(
+        scene.duration_s, frames, seed=seed, irregular=bool(opts["irregular_timing"]),
+        dropped=int(opts["dropped_frames"]))
+    samples = trace_samples(scene, *sample_grid(rows, cols, s))
+    centres = trace_samples(scene, *sample_grid(rows, cols))
+
+    # ground truth: pixel centres and sub-pixel samples
+    t_centre, lit_centre, first = gt.arrival_times(centres, scene.sun, times)
+    t_sub, lit_sub, _ = gt.arrival_times(samples, scene.sun, times)
+    classes = gt.classify(lit_centre, first, centres.sky)
+    cls = classes["shadow_class"]
+    arrival = np.where(cls == 3, t_centre, np.nan)
+    T_img = t_centre.reshape(rows, cols)
+    sky_img = centres.sky.reshape(rows, cols)
+
+    # frames
+    cloud_on = bool(opts["cloud"])
+    start_xy, velocity_xy = _cloud_path(scene, seed)
+    hit = ~samples.sky
+    radiance, clean, cloud_att = [], [], []
+    for k, t in enumerate(times):
+        trans = np.ones(len(samples.sky))
+        if cloud_on:
+            trans[hit] = nz.cloud_transmittance(samples.position[hit, :2], t, start_xy=start_xy,
+                                                velocity_xy=velocity_xy, depth=CLOUD_DEPTH,
+                                                sigma_m=CLOUD_SIGMA_M)
+        L, L_clear = frame_radiance(samples, scene, t, shape=(rows, cols), supersample=s,
+                                    lit=lit_sub[k], cloud=trans if cloud_on else None)
+        radiance.append(L)
+        clean.append(L_clear)
+        cloud_att.append(_pixel_mean(trans, (rows, cols), s2).astype(np.float32))
+    radiance = np.stack(radiance)
+    clean = np.stack(clean)
+    levels = np.array([nz.metered_level(L) for L in radiance])
+    gain, ae_ev = nz.auto_exposure(levels, seed=seed, enabled=bool(opts["auto_exposure"]))
+    dx, dy = nz.shake_offsets(len(times), seed=seed, max_px=float(opts["shake_px"]))
+    sensor_frames = np.stack([
+        (gain[k] * nz.apply_shake(radiance[k], dx[k], dy[k])).astype(np.float32)
+        for k in range(len(times))])
+
+    # pushbroom ground truth
+    reference = clean[0]
+    edge_y, n_trans, edge_row = gt.pushbroom_edge(T_img, sky_img, times)
+    frac = edge_y - edge_row - 0.5
+    below_ok = np.zeros_like(edge_row, dtype=bool)
+    has = edge_row >= 0
+    kk, cc = np.nonzero(has)
+    below_ok[has] = T_img[edge_row[has] + 1, cc] != -np.inf  # not shadowed at start
+    pb_front = gt.sample_rows(reference, edge_row, frac, below_ok)
+    pb_live = np.full_like(pb_front, np.nan)
+    pb_live[kk, cc] = clean[kk, edge_row[has], cc]
+    pb_bin, pb_count = gt.pushbroom_bins(T_img, cls.reshape(rows, cols), reference, times)
+
+    sun_dirs = scene.sun.direction(times)
+    elev, azim = elevation_azimuth(sun_dirs)
+    cause = np.zeros(rows * cols, dtype=np.uint8)
+    idx = np.flatnonzero(cls == 3)
+    if idx.size:
+        d_after = scene.sun.direction(t_centre[idx])
+        facing = np.einsum("ij,ij->i", centres.normal[idx], d_after) > 0
+        cause[idx] = np.where(facing, 1, 2)
+
+    sub_img = t_sub.reshape(rows, cols, s2).astype(np.float32)
+    sub_sky = samples.sky.reshape(rows, cols, s2)
+    with np.errstate(invalid="ignore"):
+        half = np.median(t_sub.reshape(rows, cols, s2), axis=2)
+    half[sub_sky.any(axis=2) | ~np.isfinite(half)] = np.nan
+    offsets = np.stack(np.meshgrid((np.arange(s) + 0.5) / s, (np.arange(s) + 0.5) / s,
+                                   indexing="ij")[::-1], axis=-1).reshape(s2, 2)
+
+    img = (rows, cols)
+    rc, rcc, trc = ("row", "col"), ("row", "col", "channel"), ("time", "row", "col")
+    tc, tcc = ("time", "col"), ("time", "col", "channel")
+
+    def var(dims, data, units, long_name):
+        return xr.Variable(dims, data, {"units": units, "long_name": long_name})
+
+    position = centres.position.reshape(rows, cols, 3).astype(np.float32)
+    position[sky_img] = np.nan
+    data = {
+        "shadow_class": var(rc, cls.reshape(img), "1", "0 sky, 1 never shadowed, 2 shadowed at start, 3 shadow arrives"),
+        "sky_mask": var(rc, centres.sky.reshape(img), "1", "pixel-centre ray misses the terrain"),
+        "never_shadowed": var(rc, classes["never_shadowed"].reshape(img), "1", "lit in every frame"),
+        "shadowed_at_start": var(rc, classes["shadowed_at_start"].reshape(img), "1", "unlit in frame 0"),
+        "always_shadowed": var(rc, classes["always_shadowed"].reshape(img), "1", "unlit in every frame"),
+        "relit_after_arrival": var(rc, classes["relit_after_arrival"].reshape(img), "1", "lit again after the first shadowed frame"),
+        "cause": var(rc, cause.reshape(img), "1", "class 3: 1 cast shadow, 2 attached shadow"),
+        "arrival_time_s": var(rc, arrival.reshape(img), "s", "time the sun is first blocked at the pixel centre"),
+        "arrival_frame": var(rc, gt.fractional_frame(arrival, times).reshape(img), "frame", "arrival time as a fractional frame index"),
+        "first_shadowed_frame": var(rc, first.reshape(img).astype(np.int32), "frame", "first frame with the pixel centre unlit (-1 never)"),
+        "lit_center": var(trc, lit_centre.reshape(len(times), rows, cols), "1", "pixel-centre point lit by the sun at frame k"),
+        "subpixel_arrival_time_s": var(("row", "col", "subpixel"), sub_img, "s", "arrival time of the render samples (+inf never, -inf at start, NaN sky)"),
+        "subpixel_offsets": var(("subpixel", "xy"), offsets.astype(np.float32), "pixel", "sample offsets (x, y) from the pixel corner"),
+        "arrival_time_half_coverage_s": var(rc, half, "s", "median of the sub-pixel arrival times"),
+        "arrival_frame_half_coverage": var(rc, gt.fractional_frame(half, times), "frame", "half-coverage arrival as a fractional frame index"),
+        "subpixel_sky_fraction": var(rc, sub_sky.mean(axis=2).astype(np.float32), "1", "fraction of the sub-pixel samples that are sky"),
+        "sky_fraction": var(rc, sub_sky.mean(axis=2).astype(np.float32), "1", "fraction of the rendered pixel footprint that is sky"),
+        "position_world": var(rcc, position, "m", "terrain point at the pixel centre (x east, y north, z up)"),
+        "normal_shading": var(rcc, np.where(sky_img[..., None], np.nan, centres.normal.reshape(rows, cols, 3)).astype(np.float32), "1", "shading normal at the pixel centre"),
+        "depth_z": var(rc, centres.depth_z.reshape(img).astype(np.float32), "m", "camera z of the pixel-centre point"),
+        "reference_radiance": var(rcc, reference, "1", "noise-free radiance of frame 0 (no cloud, gain, shake, noise)"),
+        "times_s": var(("time",), times, "s", "capture time since frame 0"),
+        "nominal_index": var(("time",), nominal.astype(np.int32), "1", "slot in the nominal schedule"),
+        "sun_dirs": var(("time", "xyz"), sun_dirs, "1", "unit vector toward the sun (east, north, up)"),
+        "sun_elevation_deg": var(("time",), elev, "degree", "sun elevation"),
+        "sun_azimuth_deg": var(("time",), azim, "degree", "sun compass azimuth"),
+        "sun_rgb": var(("time", "channel"), sun_colour(elev, reference_elevation_deg=scene.start_elevation_deg), "1", "sun colour"),
+        "sky_rgb": var(("time", "channel"), sky_colour(elev, start_elevation_deg=scene.start_elevation_deg), "1", "radiance of the uniform sky light"),
+        "exposure_gain": var(("time",), gain, "1", "true total exposure gain (steps x flicker)"),
+        "ae_ev": var(("time",), ae_ev, "EV", "auto-exposure step part"),
+        "metered_level": var(("time",), levels, "1", "centre-weighted mean radiance metered by auto-exposure"),
+        "shake_dx_px": var(("time",), dx, "pixel", "camera shake: content moves by +dx (columns)"),
+        "shake_dy_px": var(("time",), dy, "pixel", "camera shake: content moves by +dy (rows)"),
+        "cloud_attenuation": var(trc, np.stack(cloud_att), "1", "mean cloud-shadow transmittance of the sun term over the pixel"),
+        "cloud_center_xy": var(("time", "xy"), start_xy + np.outer(times, velocity_xy), "m", "centre of the cloud shadow on the ground"),
+        "pb_edge_y": var(tc, edge_y, "pixel", "shadow-edge row coordinate per column"),
+        "pb_n_transitions": var(tc, n_trans, "1", "lit-above/shadowed-below pairs per column"),
+        "pb_front": var(tcc, pb_front, "1", "ground-truth ridge pushbroom"),
+        "pb_front_live": var(tcc, pb_live, "1", "pushbroom from each frame's own noise-free radiance"),
+        "pb_bin": var(tcc, pb_bin, "1", "mean reference radiance of pixels swept between frames"),
+        "pb_bin_count": var(tc, pb_count, "1", "pixels in pb_bin"),
+    }
+    camera = scene.camera
+    ds = xr.Dataset(data, coords={"time": np.arange(len(times)), "channel": ["R", "G", "B"]})
+    ds.attrs.update({
+        "definitions": json.dumps(gt.DEFINITIONS),
+        "scene": "ridge",
+        "K": json.dumps(camera.K.tolist()),
+        "R_world_to_cv": json.dumps(camera.R.tolist()),
+        "t_world_to_cv": json.dumps((-camera.R @ camera.center).tolist()),
+        "camera_center": json.dumps(camera.center.tolist()),
+        "latitude_deg": scene.sun.latitude_deg,
+        "declination_deg": scene.sun.declination_deg,
+        "hour_angle0_deg": scene.sun.hour_angle0_deg,
+        "dropped_nominal_indices": json.dumps(dropped.tolist()),
+        "nuisances": json.dumps(opts),
+        "cloud": json.dumps({"enabled": cloud_on, "model": "1 - depth exp(-|p_xy - c(t)|^2 / (2 sigma^2))",
+                             "depth": CLOUD_DEPTH, "sigma_m": CLOUD_SIGMA_M,
+                             "start_xy": start_xy.tolist(),
+                             "velocity_xy_m_per_s": velocity_xy.tolist()}),
+        "class_counts": json.dumps({name: int((cls == c).sum()) for c, name in gt.SHADOW_CLASSES.items()}
+                                   | {"relit_after_arrival": int(classes["relit_after_arrival"].sum()),
+                                      "always_shadowed": int(classes["always_shadowed"].sum())}),
+        "supersample": s,
+    })
+    return OutdoorCapture(frames=sensor_frames, ground_truth=ds)
+
+
+def edge_speed(arrival_frame, shadow_class):
+    """Fraction of vertically adjacent class-3 pairs whose arrival frames differ by < 1
+    (the edge crosses that pixel step in under one frame) and the median frames per pixel.
+
+    Returns
+    -------
+    fast_fraction, median_frames_per_px : float
+    """
+    a = np.asarray(arrival_frame, dtype=np.float64)
+    both = (shadow_class[:-1] == 3) & (shadow_class[1:] == 3)
+    diff = np.abs(a[:-1] - a[1:])[both]
+    if diff.size == 0:
+        return float("nan"), float("nan")
+    return float((diff < 1.0).mean()), float(np.median(diff))

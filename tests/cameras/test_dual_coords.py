@@ -1,0 +1,157 @@
+"""Tests of shadowcam.cameras.dual_coords: uniform model and calibration-plane fit."""
+
+import json
+
+import numpy as np
+import pytest
+
+from shadowcam.cameras.dual_coords import (
+    DUAL_COORD_METHODS,
+    DUAL_COORD_MODELS,
+    apply_homography,
+    dual_coords_calibration,
+    dual_coords_dataset,
+    dual_coords_uniform,
+    fit_time_to_plane,
+)
+
+# camera (col, row) -> plane (x, y): a mildly projective view of the plane
+CAM_TO_PLANE = np.array([[0.011, 0.0012, -0.3], [-0.0009, 0.0105, -0.25], [1e-4, 2e-4, 1.0]])
+
+
+def _plane_points(rows=48, cols=64):
+    r, c = np.mgrid[0:rows, 0:cols]
+    xy = apply_homography(CAM_TO_PLANE, np.column_stack([c.ravel(), r.ravel()]).astype(float))
+    return xy.reshape(rows, cols, 2)
+
+
+def _times_from_plane(xy, time_to_plane):
+    """Exact shadow times of plane points when (t_u, t_v) -> (x, y) is `time_to_plane`."""
+    flat = xy.reshape(-1, 2)
+    t = apply_homography(np.linalg.inv(time_to_plane), flat)
+    return t.reshape(xy.shape)
+
+
+# (t_u, t_v) -> (x, y): affine truth and projective truth (frames 0..~60)
+AFFINE_TRUTH = np.array([[0.0105, 0.0011, -0.31], [-0.0013, 0.0098, -0.24], [0.0, 0.0, 1.0]])
+PROJECTIVE_TRUTH = np.array([[0.0105, 0.0011, -0.31], [-0.0013, 0.0098, -0.24], [0.004, -0.003, 1.0]])
+
+
+def test_uniform_default_is_one_dual_pixel_per_frame():
+    rng = np.random.default_rng(0)
+    t_u = rng.uniform(0, 95, (10, 12)).astype(np.float32)
+    t_v = rng.uniform(0, 95, (10, 12)).astype(np.float32)
+    t_u[0, 0] = np.nan
+    u, v, valid, info = dual_coords_uniform(t_u, t_v, n_frames=(96, 96))
+    assert u.dtype == np.float32
+    np.testing.assert_array_equal(u[valid], t_u[valid])
+    np.testing.assert_array_equal(v[valid], t_v[valid])
+    assert not valid[0, 0] and np.isnan(u[0, 0])
+    assert (info["dual_width"], info["dual_height"]) == (96, 96)
+
+
+def test_uniform_stretch_maps_frame_edges_to_grid_edges():
+    t_u = np.array([[-0.5, 95.5, 47.5]], dtype=np.float32)
+    t_v = np.array([[-0.5, 95.5, 10.0]], dtype=np.float32)
+    u, v, valid, info = dual_coords_uniform(t_u, t_v, n_frames=(96, 96), dual_shape=(48, 192),
+                                            min_spread=0)
+    np.testing.assert_allclose(u[0, :2], [-0.5, 191.5], atol=1e-5)
+    np.testing.assert_allclose(v[0, :2], [-0.5, 47.5], atol=1e-5)
+    np.testing.assert_allclose(u[0, 2], 95.5, atol=1e-5)  # the middle stays in the middle
+
+
+def test_uniform_flags_parallel_sweeps():
+    t = np.linspace(0, 90, 200).reshape(10, 20)
+    with pytest.raises(ValueError, match="collinear"):
+        dual_coords_uniform(t, 0.5 * t + 3 + 1e-3 * np.sin(t), n_frames=(96, 96))
+
+
+def test_uniform_names_a_sweep_whose_times_never_change():
+    t = np.linspace(0, 90, 200).reshape(10, 20)
+    with pytest.raises(ValueError, match="sweep v .* too short"):
+        dual_coords_uniform(t, np.full_like(t, 2.0), n_frames=(96, 5))
+
+
+@pytest.mark.parametrize("truth, expected", [(AFFINE_TRUTH, "affine"),
+                                             (PROJECTIVE_TRUTH, "homography")])
+def test_calibration_fit_picks_simplest_sufficient_model(truth, expected):
+    xy = _plane_points().reshape(-1, 2)
+    times = _times_from_plane(xy, truth)
+    fit = fit_time_to_plane(times, xy, unit_scale=0.01)
+    assert fit.name == expected
+    names = [c["name"] for c in fit.candidates]
+    assert names == ["affine", "homography", "tps"]
+    assert sum(c["chosen"] for c in fit.candidates) == 1
+    assert fit.residual_rms < 1e-6  # exact data: exact recovery (in 0.01-plane units)
+    if expected == "homography":
+        affine = next(c for c in fit.candidates if c["name"] == "affine")
+        assert affine["cv_rms"] > 0.1  # the projective part is visible to the affine model
+    np.testing.assert_allclose(fit.model.matrix / fit.model.matrix[2, 2], truth, rtol=1e-7,
+                               atol=1e-10)
+
+
+def test_calibration_end_to_end_recovers_plane_window_coordinates():
+    cal_xy = _plane_points()
+    cal_t = _times_from_plane(cal_xy, PROJECTIVE_TRUTH)
+    # scene: other times inside the calibrated range
+    rng = np.random.default_rng(3)
+    scene_xy = cal_xy + rng.uniform(-0.02, 0.02, cal_xy.shape)
+    scene_t = _times_from_plane(scene_xy, PROJECTIVE_TRUTH)
+    window = (-0.3, -0.25, 0.5, 0.35)
+    u, v, valid, reason, info = dual_coords_calibration(
+        scene_t[..., 0], scene_t[..., 1], cal_t_u=cal_t[..., 0], cal_t_v=cal_t[..., 1],
+        homography=CAM_TO_PLANE, dual_shape=(60, 80), plane_window=window,
+        extrapolation_margin=1e9)
+    assert info["model"] == "homography"
+    assert valid.all() and (reason == 0).all()
+    exp_u = (scene_xy[..., 0] - window[0]) / 0.01 - 0.5
+    exp_v = (scene_xy[..., 1] - window[1]) / 0.01 - 0.5
+    np.testing.assert_allclose(u, exp_u, atol=1e-3)  # float32 output of ~80 px
+    np.testing.assert_allclose(v, exp_v, atol=1e-3)
+    ds = dual_coords_dataset(u, v, valid, info=info, method="calibration", reason=reason)
+    assert ds.attrs["model"] == "homography"
+    assert [c["name"] for c in json.loads(ds.attrs["candidates"])] == ["affine", "homography", "tps"]
+    assert ds["u"].dims == ("row", "col") and ds["u"].dtype == np.float32
+
+
+def test_calibration_marks_extrapolated_scene_times():
+    cal_xy = _plane_points()
+    cal_t = _times_from_plane(cal_xy, AFFINE_TRUTH)
+    scene_t = cal_t.copy()
+    scene_t[0, 0, 0] = cal_t[..., 0].max() + 20  # far outside the calibrated range
+    u, v, valid, reason, _ = dual_coords_calibration(
+        scene_t[..., 0], scene_t[..., 1], cal_t_u=cal_t[..., 0], cal_t_v=cal_t[..., 1],
+        homography=CAM_TO_PLANE, dual_shape=(50, 50))
+    assert reason[0, 0] == 2 and not valid[0, 0] and np.isnan(u[0, 0])
+    assert valid.sum() == valid.size - 1
+
+
+def test_too_few_calibration_points_raise():
+    xy = _plane_points()[:2, :3].reshape(-1, 2)[:7]  # 7 points < 6 + 2
+    with pytest.raises(ValueError, match="too few"):
+        fit_time_to_plane(_times_from_plane(xy, AFFINE_TRUTH), xy)
+
+
+def test_collinear_calibration_points_raise():
+    xy = _plane_points()[10].reshape(-1, 2)  # one camera row: points on a line of the plane
+    xy = np.column_stack([xy[:, 0], 0.3 * xy[:, 0] + 0.1])
+    with pytest.raises(ValueError, match="collinear"):
+        fit_time_to_plane(_times_from_plane(xy, AFFINE_TRUTH), xy)
+
+
+def test_nearly_parallel_sweeps_raise():
+    xy = _plane_points().reshape(-1, 2)
+    # sweep directions on the plane 5 degrees apart: t_u = x / d, t_v = (x cos5 + y sin5) / d
+    angle = np.radians(5.0)
+    t = np.column_stack([xy[:, 0], xy[:, 0] * np.cos(angle) + xy[:, 1] * np.sin(angle)]) / 0.01
+    with pytest.raises(ValueError, match="parallel"):
+        fit_time_to_plane(t, xy, min_spread=0.0)  # the angle check, not the spread check
+    with pytest.raises(ValueError, match="collinear"):
+        fit_time_to_plane(t, xy, min_spread=0.2)
+
+
+def test_tables():
+    assert list(DUAL_COORD_MODELS) == ["affine", "homography", "tps"]
+    assert [m.n_params for m in DUAL_COORD_MODELS.values()] == sorted(
+        m.n_params for m in DUAL_COORD_MODELS.values())
+    assert set(DUAL_COORD_METHODS) == {"uniform", "calibration"}

@@ -1,0 +1,50 @@
+"""Frame times: the auto source order (metadata, file names, sidecar), intervals and gaps."""
+
+import json
+
+import numpy as np
+import pytest
+
+from test_decode import write_image  # noqa: E402  (tests dir is on sys.path)
+from test_manifest import make_capture, rewrite
+from shadowcam.io.frame_times import auto_candidates, find_gaps, median_interval
+from shadowcam.io.manifest import checksums_for, load_manifest
+
+
+def test_auto_prefers_metadata_then_file_names_then_sidecar(tmp_path):
+    names = ("img_0.0s.png", "img_61.5s.png", "img_180.0s.png")
+    path, doc = make_capture(tmp_path, names=names, with_checksums=False)
+    (tmp_path / "data" / "stamps.json").write_text(json.dumps({"times_s": [0.0, 60.0, 120.0]}))
+    # PNGs carry no EXIF time: file names win over the sidecar
+    doc["timing"] = {"source": "auto", "regex": r"_(?P<time_s>\d+\.\d+)s", "file": "stamps.json", "key": "times_s"}
+    rewrite(path, doc)
+    doc["checksums"] = checksums_for(path)
+    assert load_manifest(rewrite(path, doc))["sweeps"]["u"]["times_s"] == [0.0, 61.5, 180.0]
+    # without a regex: the sidecar
+    doc["timing"] = {"source": "auto", "file": "stamps.json", "key": "times_s"}
+    assert load_manifest(rewrite(path, doc))["sweeps"]["u"]["times_s"] == [0.0, 60.0, 120.0]
+    # nothing usable: the error lists what was tried
+    doc["timing"] = {"source": "auto"}
+    with pytest.raises(ValueError, match="metadata: .*no EXIF DateTimeOriginal"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_auto_uses_exif_times_when_every_file_has_one(tmp_path):
+    data = tmp_path / "data" / "u"
+    data.mkdir(parents=True)
+    for k, stamp in enumerate(["2024:05:01 18:59:00", "2024:05:01 19:00:05", "2024:05:01 19:02:00"]):
+        write_image(data / f"f_{k}.tif", np.zeros((4, 4, 3), np.uint16), **{"Exif:DateTimeOriginal": stamp})
+    doc = {"name": "m", "kind": "outdoor", "light": "distant", "root": "data", "sweeps": {"t": {"files": "u/*.tif"}},
+           "timing": {"source": "auto", "regex": r"f_(?P<index>\d+)"}}
+    path = rewrite(tmp_path / "m.yaml", doc)
+    doc["checksums"] = checksums_for(path)
+    assert load_manifest(rewrite(path, doc))["sweeps"]["t"]["times_s"] == [0.0, 65.0, 180.0]
+
+
+def test_candidates_intervals_and_gaps():
+    assert [c["source"] for c in auto_candidates({"source": "auto", "file": "s.json"})] == ["metadata", "sidecar"]
+    times = np.array([0.0, 55.0, 108.0, 220.0, 275.0, 330.0])  # one frame dropped after frame 2
+    assert median_interval(times) == pytest.approx(55.0)
+    assert find_gaps(times) == [{"after_frame": 2, "interval_s": 112.0, "missing_frames": 1}]
+    with pytest.raises(ValueError, match="increase"):
+        median_interval(times[::-1])

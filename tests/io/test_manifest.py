@@ -1,0 +1,225 @@
+"""Tests of shadowcam.io.manifest: validation, file resolution, timing, checksums, CLI."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from test_decode import write_image  # noqa: E402  (tests dir is on sys.path)
+
+from shadowcam.cli import main
+from shadowcam.io.manifest import (
+    checksums_for,
+    format_checksums,
+    load_manifest,
+    manifest_files,
+    natural_key,
+    verify_checksums,
+)
+
+REPO = Path(__file__).resolve().parents[2]
+SHARED = Path("/work/shared/data/lab-dev")
+
+
+def make_capture(tmp_path, *, names=("f1.png", "f2.png", "f10.png"), with_checksums=True, **overrides):
+    """A capture folder data/ and a manifest manifests/cap.yaml with root ../data."""
+    data = tmp_path / "data"
+    (data / "u").mkdir(parents=True)
+    rng = np.random.default_rng(5)
+    for name in names:
+        write_image(data / "u" / name, rng.integers(0, 65536, (6, 8, 3)).astype(np.uint16))
+    write_image(data / "ref.png", np.full((6, 8, 3), 1000, np.uint16))
+    doc = {
+        "name": "cap",
+        "kind": "lab",
+        "light": "point",
+        "root": "../data",
+        "sweeps": {"u": {"files": "u/*.png", "axis": "u"}},
+        "reference": "ref.png",
+        "timing": {"source": "rate", "rate_hz": 2.0},
+        "provenance": "test",
+        "licence": "CC0-1.0",
+    }
+    doc.update(overrides)
+    path = tmp_path / "manifests" / "cap.yaml"
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(yaml.safe_dump(doc))
+    if with_checksums:
+        doc["checksums"] = checksums_for(path)
+        path.write_text(yaml.safe_dump(doc))
+    return path, doc
+
+
+def rewrite(path, doc):
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+def test_natural_key_orders_numbers():
+    assert sorted(["f10.png", "f2.png", "f1.png"], key=natural_key) == ["f1.png", "f2.png", "f10.png"]
+
+
+def test_load_resolves_root_paths_times(tmp_path):
+    path, _ = make_capture(tmp_path)
+    manifest = load_manifest(path)
+    root = (tmp_path / "data").resolve()
+    assert manifest["root"] == str(root)
+    assert manifest["sweeps"]["u"]["paths"] == [str(root / "u" / n) for n in ("f1.png", "f2.png", "f10.png")]
+    assert manifest["sweeps"]["u"]["times_s"] == [0.0, 0.5, 1.0]  # 2 Hz
+    assert manifest["reference_paths"] == [str(root / "ref.png")]
+    assert set(manifest_files(manifest)) == {"u/f1.png", "u/f2.png", "u/f10.png", "ref.png"}
+    assert len(verify_checksums(manifest)) == 4
+
+
+def test_json_manifest_loads(tmp_path):
+    path, doc = make_capture(tmp_path)
+    json_path = path.with_suffix(".json")
+    json_path.write_text(json.dumps(doc))
+    assert load_manifest(json_path)["sweeps"]["u"]["times_s"] == [0.0, 0.5, 1.0]
+
+
+def test_synthetic_manifest_validates(tmp_path):
+    doc = {
+        "name": "syn", "kind": "lab", "light": "point",
+        "synthetic": {"scene": "tabletop", "seed": 1, "height": 64, "width": 64, "frames": 32,
+                      "format": "dng", "bit_depth": 12, "noise": True, "calibration": False},
+        "dual": {"width": 32, "height": 32},
+    }
+    manifest = load_manifest(rewrite(tmp_path / "syn.yaml", doc))
+    assert manifest["sweeps"] == {} and manifest["synthetic"]["seed"] == 1
+
+
+def test_extra_key_is_named(tmp_path):
+    path, doc = make_capture(tmp_path)
+    doc["sweeps"]["u"]["fles"] = "x"
+    doc["colour"] = "red"
+    with pytest.raises(ValueError) as info:
+        load_manifest(rewrite(path, doc))
+    assert "'fles' was unexpected" in str(info.value) and "'colour' was unexpected" in str(info.value)
+    assert "sweeps.u" in str(info.value) and str(path) in str(info.value)
+
+
+def test_missing_root_named(tmp_path):
+    path, doc = make_capture(tmp_path)
+    doc["root"] = "../nowhere"
+    with pytest.raises(ValueError, match="nowhere.*not a folder"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_glob_matching_nothing_named(tmp_path):
+    path, doc = make_capture(tmp_path)
+    doc["sweeps"]["v"] = {"files": "v/*.dng"}
+    with pytest.raises(ValueError, match=r"sweeps\.v\.files 'v/\*\.dng' matches no file"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_missing_reference_file_named(tmp_path):
+    path, _ = make_capture(tmp_path)
+    (tmp_path / "data" / "ref.png").unlink()
+    with pytest.raises(ValueError, match="ref.png"):
+        load_manifest(path)
+
+
+def test_file_not_in_checksums_named(tmp_path):
+    path, doc = make_capture(tmp_path)
+    del doc["checksums"]["u/f2.png"]
+    with pytest.raises(ValueError, match=r"not listed in checksums: u/f2\.png.*shadowcam checksum"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_bad_checksum_names_file_expected_actual(tmp_path):
+    path, doc = make_capture(tmp_path)
+    manifest = load_manifest(path)
+    target = tmp_path / "data" / "u" / "f10.png"
+    target.write_bytes(target.read_bytes() + b"\0")
+    with pytest.raises(ValueError) as info:
+        verify_checksums(manifest, ["u"])
+    message = str(info.value)
+    assert "f10.png" in message and doc["checksums"]["u/f10.png"] in message
+    from shadowcam.io.provenance import file_sha256
+
+    assert file_sha256(target) in message
+    # the reference group is still fine
+    assert list(verify_checksums(manifest, ["reference"])) == ["ref.png"]
+
+
+def test_file_removed_after_load_named(tmp_path):
+    path, _ = make_capture(tmp_path)
+    manifest = load_manifest(path)
+    (tmp_path / "data" / "u" / "f1.png").unlink()
+    with pytest.raises(ValueError, match=r"f1\.png.*does not exist"):
+        verify_checksums(manifest)
+
+
+def test_timing_from_filename(tmp_path):
+    path, _ = make_capture(
+        tmp_path, names=("img_0.000s.png", "img_0.250s.png", "img_1.500s.png"),
+        timing={"source": "filename", "regex": r"_(?P<time_s>\d+\.\d+)s"},
+    )
+    assert load_manifest(path)["sweeps"]["u"]["times_s"] == [0.0, 0.25, 1.5]
+    path, doc = make_capture(tmp_path / "b", timing={"source": "filename", "regex": r"f(?P<index>\d+)", "rate_hz": 4.0})
+    assert load_manifest(path)["sweeps"]["u"]["times_s"] == [0.25, 0.5, 2.5]
+    doc["timing"]["regex"] = r"g(?P<index>\d+)"
+    with pytest.raises(ValueError, match="f1.png.*does not match timing.regex"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_timing_from_exif_metadata_with_subseconds(tmp_path):
+    data = tmp_path / "data" / "u"
+    data.mkdir(parents=True)
+    stamps = [("2024:05:01 18:59:59", "500"), ("2024:05:01 19:00:00", "750"), ("2024:05:01 19:00:02", "")]
+    for k, (stamp, sub) in enumerate(stamps):
+        write_image(data / f"{k}.tif", np.zeros((4, 4, 3), np.uint16),
+                    **{"Exif:DateTimeOriginal": stamp, "Exif:SubsecTimeOriginal": sub})
+    doc = {"name": "m", "kind": "outdoor", "light": "distant", "root": "data",
+           "sweeps": {"t": {"files": "u/*.tif"}}, "timing": {"source": "metadata"}}
+    path = rewrite(tmp_path / "m.yaml", doc)
+    doc["checksums"] = checksums_for(path)
+    times = load_manifest(rewrite(path, doc))["sweeps"]["t"]["times_s"]
+    np.testing.assert_allclose(times, [0.0, 1.25, 2.5], atol=1e-6)
+
+
+def test_timing_from_sidecar(tmp_path):
+    path, doc = make_capture(tmp_path, with_checksums=False)
+    side = tmp_path / "data" / "stamps.json"
+    side.write_text(json.dumps({"times_s": {"u": [0.0, 0.9, 2.1]}}))
+    doc["timing"] = {"source": "sidecar", "file": "stamps.json", "key": "times_s"}
+    rewrite(path, doc)
+    doc["checksums"] = checksums_for(path)
+    assert "stamps.json" in doc["checksums"]  # the sidecar is a referenced file too
+    assert load_manifest(rewrite(path, doc))["sweeps"]["u"]["times_s"] == [0.0, 0.9, 2.1]
+    side.write_text(json.dumps({"times_s": {"u/f1.png": 1.0, "f2.png": 2.0, "u/f10.png": 3.0}}))
+    doc["checksums"] = checksums_for(path)
+    assert load_manifest(rewrite(path, doc))["sweeps"]["u"]["times_s"] == [1.0, 2.0, 3.0]
+    side.write_text(json.dumps({"times_s": [0.0, 1.0]}))
+    doc["checksums"] = checksums_for(path)
+    with pytest.raises(ValueError, match="2 times for sweep 'u' but it has 3 files"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_checksum_cli_block_pastes_into_manifest(tmp_path, capsys):
+    path, doc = make_capture(tmp_path, with_checksums=False)
+    with pytest.raises(ValueError, match="not listed in checksums"):
+        load_manifest(path)
+    assert main(["checksum", "--manifest", str(path)]) == 0
+    block = capsys.readouterr().out
+    assert block.startswith("checksums:\n")
+    path.write_text(path.read_text() + block)
+    manifest = load_manifest(path)
+    assert len(verify_checksums(manifest)) == 4
+    assert yaml.safe_load(format_checksums(manifest["checksums"])) == {"checksums": manifest["checksums"]}
+
+
+@pytest.mark.skipif(not SHARED.is_dir(), reason="shared dev data not present")
+@pytest.mark.parametrize("name, suffix", [("dev_spheres", ".png"), ("dev_spheres_raw", ".dng")])
+def test_shared_dev_manifests(name, suffix):
+    manifest = load_manifest(REPO / "data_manifest" / f"{name}.yaml")
+    assert manifest["name"] == name
+    for sweep in ("u", "v"):
+        paths = manifest["sweeps"][sweep]["paths"]
+        assert [Path(p).name for p in paths] == [f"{k:06d}{suffix}" for k in range(96)]
+        assert manifest["sweeps"][sweep]["times_s"] == [float(k) for k in range(96)]  # frame t = file index
+    noise = "raw12" if suffix == ".dng" else "noise_free"
+    assert manifest["ground_truth"] == {"format": "mitsuba_lab_npz", "file": "gt.npz", "noise": noise}
+    assert len(verify_checksums(manifest)) == 2 * 96 + 2

@@ -1,0 +1,163 @@
+"""First outdoor pass at scale: registration on reduced frames, and time parts merged.
+
+* A translation of a frame is a translation by ``1 / factor`` of its block means, so the
+  shift estimated on reduced frames and scaled back matches the true shift (multi-scale
+  texture, known sub-pixel shifts).
+* Time parts (each after two warm-up frames) merged by concatenation and minimum equal the
+  single job within the registration's stopping tolerance (1e-3 px): the searches of a part
+  start from the exposure metadata and zero shift instead of the previous frame's values
+  and converge to the same solution within that tolerance; a part that starts at frame 0
+  is the single job, bit for bit. The merge step (``outdoor-merge-photometry``), reading
+  the part datasets one at a time, gives :func:`merge_parts`'s result bit for bit.
+* A shake of 14-18 px between frames (7-9 px on the reduced frames, beyond one
+  Lucas-Kanade level) is recovered coarse to fine.
+* A soft shadow edge (8 px ramp) biases the shift along its motion unless the mask margin
+  around it covers its width (6 + 8 px); a static camera then registers to 0.
+"""
+
+import cv2
+import numpy as np
+import pytest
+import xarray as xr
+
+from outdoor_scene import make_timelapse
+from shadowcam.cli import main
+from shadowcam.io.images import write_netcdf
+from shadowcam.outdoor.datasets import photometry_part_dataset
+from shadowcam.outdoor.normalise import merge_parts, normalise_frames, normalise_part, part_frames
+from shadowcam.outdoor.registration import (apply_shift, block_all, block_mean, registration_factor,
+                                    shift_lucas_kanade_LucasKanade1981)
+
+NUISANCES = dict(shake=0.5, noise=True, gain_steps=True, jitter=0.2, drop=(7, 15), sun_fade=0.6)
+
+
+def _texture(shape=(512, 640), seed=1):
+    rng = np.random.default_rng(seed)
+    tex = np.zeros(shape, np.float32)
+    for sigma in (1, 2, 4, 8, 16):  # power at every scale, like natural terrain
+        tex += cv2.GaussianBlur(rng.random(shape).astype(np.float32), (0, 0), sigma) * np.float32(sigma ** 0.5)
+    return 0.3 + tex / tex.max()
+
+
+def test_registration_factor_and_block_means():
+    assert registration_factor((4000, 6000)) == 4 and registration_factor((128, 192)) == 1
+    assert registration_factor((4000, 6000), max_size=1000) == 6
+    with pytest.raises(ValueError, match="registration_size"):
+        registration_factor((10, 10), max_size=8)
+    image = np.arange(6 * 9, dtype=np.float32).reshape(6, 9)
+    small = block_mean(image, 3)
+    assert small.shape == (2, 3) and small.dtype == np.float32
+    np.testing.assert_allclose(small, image.reshape(2, 3, 3, 3).mean(axis=(1, 3)), rtol=1e-6)
+    assert block_mean(image, 1) is image
+    mask = np.ones((6, 9), bool)
+    mask[0, 0] = False
+    np.testing.assert_array_equal(block_all(mask, 3), [[False, True, True], [True, True, True]])
+
+
+@pytest.mark.parametrize("shift", [(1.3, -2.1), (-0.4, 0.7), (3.0, 2.5)])
+@pytest.mark.parametrize("factor", [2, 4])
+def test_shift_on_reduced_frames_scales_back(shift, factor):
+    reference = _texture()
+    frame = apply_shift(reference, (-shift[0], -shift[1]))  # content moved by +shift
+    estimate, _ = shift_lucas_kanade_LucasKanade1981(block_mean(frame, factor), block_mean(reference, factor))
+    # 128 x 160 working image at factor 4: ~0.03 reduced pixels of precision
+    np.testing.assert_allclose(estimate * factor, shift, atol=0.15)  # pixels
+
+
+def _parts(frames, size, overlap=2):
+    parts = []
+    for start in range(0, len(frames), size):
+        stop = min(start + size, len(frames))
+        first, _ = part_frames(start, stop, overlap=overlap)
+        parts.append(normalise_part(iter(frames[first:stop]), start=start, stop=stop,
+                                    reference=frames[0], overlap=overlap))
+    return parts
+
+
+def test_time_parts_merge_to_the_single_job():
+    scene = make_timelapse(seed=4, **NUISANCES)
+    frames = scene["frames"]
+    single = normalise_frames(iter(frames))
+    parts = _parts(frames, 7)
+    merged = merge_parts(parts[::-1])  # any order
+    np.testing.assert_allclose(merged["shift"], single["shift"], rtol=0, atol=1e-3)  # LK stopping tolerance, px
+    np.testing.assert_allclose(merged["gain_lit"], single["gain_lit"], rtol=1e-4)
+    np.testing.assert_allclose(merged["gain_sky"], single["gain_sky"], rtol=1e-4)
+    for key in ("lit_level", "shadow_level"):
+        # a shift 1e-3 px apart resamples a textured pixel by up to ~1e-3 of its value
+        np.testing.assert_allclose(merged[key], single[key], rtol=1e-3)
+    for key in ("sky", "lit_at_start", "reference"):
+        np.testing.assert_array_equal(merged[key], single[key])
+    # the first part starts at frame 0: bit for bit the single job's first frames
+    np.testing.assert_array_equal(parts[0]["shift"], single["shift"][:7])
+    np.testing.assert_array_equal(parts[0]["gain_lit"], single["gain_lit"][:7])
+    # one part covering everything is the single job, bit for bit
+    whole = merge_parts(_parts(frames, len(frames)))
+    for key, value in single.items():
+        np.testing.assert_array_equal(whole[key], value)
+    # the merged result keeps the accuracy of the single job's registration
+    np.testing.assert_allclose(merged["shift"], scene["shift"] - scene["shift"][0], atol=0.05)
+
+
+def test_parts_must_cover_the_frames_and_warm_up():
+    scene = make_timelapse(seed=3, n_frames=12)
+    parts = _parts(scene["frames"], 4)
+    with pytest.raises(ValueError, match="consecutive"):
+        merge_parts([parts[0], parts[2]])
+    with pytest.raises(ValueError, match="overlap"):
+        part_frames(4, 8, overlap=1)
+    with pytest.raises(ValueError, match="frames 2..7"):
+        normalise_part(iter(scene["frames"][3:8]), start=4, stop=8, reference=scene["frames"][0])
+    with pytest.raises(ValueError, match="reference"):
+        normalise_part(iter(scene["frames"][2:8]), start=4, stop=8)
+
+
+def test_large_shake_on_reduced_frames_is_recovered_coarse_to_fine():
+    reference = _texture()
+    reference[400:] *= 0.1  # a static shadow below row 400: the rest is lit
+    rgb = np.stack([reference, 0.9 * reference, 0.7 * reference], axis=-1)
+    shake = np.array([[0.0, 0.0], [8.4, -11.3], [-3.1, 2.7], [6.5, 9.2]])  # rows, cols; 14-18 px jumps
+    frames = [apply_shift(rgb, -s) for s in shake]  # content moves by +shake
+    options = dict(sky=np.zeros(reference.shape, bool), registration_size=320)  # factor 2
+    result = normalise_frames(iter(frames), registration_levels=2, **options)
+    # pixels of the full frames; ~0.03 reduced px on this texture (block means alias its finest scale)
+    np.testing.assert_allclose(result["shift"], shake, atol=0.1)
+    single = normalise_frames(iter(frames), registration_levels=0, **options)
+    assert np.abs(single["shift"] - shake).max() > 5  # one level: out of range
+
+
+def test_merge_step_reads_the_part_datasets_and_equals_merge_parts(tmp_path):
+    scene = make_timelapse(seed=5, n_frames=14, **NUISANCES)
+    frames, time_s = scene["frames"], scene["time_s"]
+    parts = _parts(frames, 5)
+    paths = []
+    for part in parts[::-1]:  # any order on the command line
+        first, count = part["first_frame"], len(part["gain_lit"])
+        path = tmp_path / f"{first}.nc"
+        write_netcdf(photometry_part_dataset(part, time_s[first:first + count]), path)
+        paths.append(str(path))
+    main(["outdoor-merge-photometry", "--parts", *paths, "--out", str(tmp_path / "photometry.nc")])
+    expected = merge_parts(parts)
+    with xr.open_dataset(tmp_path / "photometry.nc", engine="h5netcdf") as merged:
+        np.testing.assert_array_equal(merged["shift_row"].values, expected["shift"][:, 0])
+        np.testing.assert_array_equal(merged["gain"].values, expected["gain_lit"])
+        np.testing.assert_array_equal(merged["time_s"].values, time_s)
+        np.testing.assert_array_equal(merged["shadow_level"].values, expected["shadow_level"])
+        np.testing.assert_array_equal(merged["lit_level"].values, expected["lit_level"])
+    # a missing part is refused (exit status 2, the CLI's input error)
+    assert main(["outdoor-merge-photometry", "--parts", paths[0], paths[2], "--out", str(tmp_path / "gap.nc")]) == 2
+    assert not (tmp_path / "gap.nc").exists()
+
+
+def test_soft_shadow_edge_needs_a_margin_of_its_width():
+    # a scene upsampled 8x: the moving shadow edge is an 8 px ramp, the camera does not move
+    scene = make_timelapse(n_frames=8, seed=2, speed=1.0)
+    factor = 8
+    frames = [cv2.resize(f, (64 * factor, 64 * factor), interpolation=cv2.INTER_LINEAR) for f in scene["frames"]]
+    sky = np.repeat(np.repeat(scene["sky"], factor, axis=0), factor, axis=1)
+    sharp = normalise_frames(iter(frames), sky=sky)  # margin 6: for a sharp edge
+    soft = normalise_frames(iter(frames), sky=sky, registration_margin=6 + factor)
+    assert np.abs(sharp["shift"][:, 0]).max() > 0.1  # the edge's motion leaks into the shift (rows)
+    np.testing.assert_allclose(soft["shift"], 0, atol=0.01)  # pixels; the true shift is 0
+    with pytest.raises(ValueError, match="registration_margin"):
+        normalise_frames(iter(frames), registration_margin=0)

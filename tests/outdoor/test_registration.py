@@ -1,0 +1,99 @@
+"""Registration: sub-pixel translations recovered, the moving shadow edge masked out, large
+shifts recovered coarse to fine."""
+
+import cv2
+import numpy as np
+import pytest
+
+from shadowcam.outdoor.registration import (apply_shift, bandpass_log, pyramid_levels, shift_coarse_to_fine,
+                                    shift_lucas_kanade_LucasKanade1981, static_weight)
+
+
+def _texture(seed=0, shape=(64, 80)):
+    rng = np.random.default_rng(seed)
+    noise = rng.random(shape).astype(np.float32)
+    return 0.2 + cv2.GaussianBlur(noise, (0, 0), 1.5) * 2
+
+
+@pytest.mark.parametrize("shift", [(0.3, -0.45), (-0.8, 0.6), (0.05, 0.0)])
+def test_recovers_known_subpixel_shift(shift):
+    ref = _texture()
+    frame = apply_shift(ref, (-shift[0], -shift[1]))  # content moves by +shift
+    estimate, residual = shift_lucas_kanade_LucasKanade1981(frame, ref)
+    np.testing.assert_allclose(estimate, shift, atol=0.02)
+    assert residual < 0.05
+
+
+def test_apply_shift_keeps_dtype_and_zero_shift_is_identity():
+    ref = _texture()
+    assert apply_shift(ref, (0.3, 0.2)).dtype == np.float32
+    np.testing.assert_array_equal(apply_shift(ref, (0, 0)), ref)
+    with pytest.raises(ValueError, match="image"):
+        apply_shift(np.ones(5), (0, 0))
+
+
+def test_moving_shadow_is_masked_and_does_not_bias_the_shift():
+    ref = _texture(1)
+    lit = np.ones_like(ref, bool)
+    ref_lit = ref.copy()
+    ref_lit[40:] *= 0.1  # shadow in the reference below row 40
+    frame = ref.copy()
+    frame[25:] *= 0.1  # the shadow climbed 15 rows
+    true = (0.4, -0.3)
+    frame = apply_shift(frame * 1.3, (-true[0], -true[1]))
+    lit_ref = np.zeros_like(lit)
+    lit_ref[:40] = True
+    weight = static_weight(frame, ref_lit, lit_reference=lit_ref, gain=1.3)
+    assert weight[30:40].sum() == 0  # newly shadowed rows excluded
+    assert weight[10:15, 10:70].all()
+    estimate, _ = shift_lucas_kanade_LucasKanade1981(frame, ref_lit, weight=weight)
+    np.testing.assert_allclose(estimate, true, atol=0.08)  # residual: band-pass tail of the old edge
+    unmasked, _ = shift_lucas_kanade_LucasKanade1981(frame, ref_lit)
+    assert np.abs(unmasked - true).max() > 3 * np.abs(estimate - true).max()
+
+
+def test_bandpass_removes_gain():
+    ref = _texture(2)
+    np.testing.assert_allclose(bandpass_log(ref * 3.0), bandpass_log(ref), atol=0.02)
+
+
+def _multiscale_texture(shape=(256, 320), seed=3):
+    """Texture with power at every scale (like terrain), so that every pyramid level has detail."""
+    rng = np.random.default_rng(seed)
+    tex = np.zeros(shape, np.float32)
+    for sigma in (1, 2, 4, 8, 16):
+        tex += cv2.GaussianBlur(rng.random(shape).astype(np.float32), (0, 0), sigma) * np.float32(sigma ** 0.5)
+    return 0.3 + tex / tex.max()
+
+
+@pytest.mark.parametrize("shift", [(9.3, -11.6), (-7.25, 6.8)])
+def test_coarse_to_fine_recovers_a_shift_beyond_one_level(shift):
+    ref = _multiscale_texture()
+    frame = apply_shift(ref, (-shift[0], -shift[1]))  # content moves by +shift
+    single, single_residual = shift_lucas_kanade_LucasKanade1981(frame, ref)
+    assert not np.isfinite(single_residual) or np.abs(single - shift).max() > 1  # one level: out of range
+    estimate, residual = shift_coarse_to_fine(frame, ref, levels=2)
+    np.testing.assert_allclose(estimate, shift, atol=0.02)  # pixels, exact shift known
+    assert residual < 0.05
+
+
+def test_coarse_to_fine_keeps_the_single_level_solution_for_small_shifts():
+    ref = _multiscale_texture(seed=4)
+    shift = (0.4, -0.7)
+    frame = apply_shift(ref, (-shift[0], -shift[1]))
+    weight = np.zeros(ref.shape, np.float32)
+    weight[8:-8, 8:-8] = 1
+    single = shift_lucas_kanade_LucasKanade1981(frame, ref, weight=weight)
+    pyramid = shift_coarse_to_fine(frame, ref, weight=weight, levels=2)
+    np.testing.assert_array_equal(pyramid[0], single[0])  # same search from the same start
+    np.testing.assert_allclose(pyramid[0], shift, atol=0.02)
+
+
+def test_pyramid_levels_stop_at_the_minimum_size():
+    assert pyramid_levels((1000, 1500), levels=2) == 2
+    assert pyramid_levels((128, 192), levels=2) == 1  # 64 rows is the smallest level
+    assert pyramid_levels((100, 100), levels=3) == 0
+    with pytest.raises(ValueError, match="levels"):
+        pyramid_levels((100, 100), levels=-1)
+    with pytest.raises(ValueError, match="weight"):
+        shift_coarse_to_fine(np.ones((80, 80)), np.ones((80, 80)), weight=np.ones((8, 8)))

@@ -1,0 +1,58 @@
+"""Real-size outdoor sample: the source shake is undone, the sample's own shake is applied as recorded.
+
+* Steadying a frame shaken by a known offset (the renderer's cubic spline) gives the unshaken
+  frame back (interior, to the spline's round-trip error).
+* The sample shake is seeded, within its bound and on OpenCV's 1/32 px grid.
+* A real-size mosaic made with a shake ``(dx, dy)`` shows the content moved by exactly that
+  much: registration of two noisy mosaics recovers the difference of their shakes.
+"""
+
+import cv2
+import numpy as np
+import pytest
+
+from shadowcam.synthetic.outdoor.nuisance import apply_shake
+from shadowcam.synthetic.outdoor.sample import SHAKE_STEP_PX, sample_mosaic, sample_shake, steady_frame
+from shadowcam.outdoor.registration import shift_lucas_kanade_LucasKanade1981
+from shadowcam.synthetic.sensor import SensorModel
+
+
+def _scene(shape=(48, 64), seed=0):
+    rng = np.random.default_rng(seed)
+    grey = cv2.GaussianBlur(rng.random(shape).astype(np.float32), (0, 0), 1.2)
+    grey = 0.2 + 0.6 * (grey - grey.min()) / np.ptp(grey)
+    return np.stack([grey, 0.9 * grey, 0.7 * grey], axis=-1)
+
+
+def test_steady_frame_undoes_the_recorded_shake():
+    image = _scene()
+    shaken = apply_shake(image, 0.63, -0.41)
+    assert np.abs(shaken - image)[4:-4, 4:-4].max() > 0.05  # the shake is visible
+    steady = steady_frame(shaken, dx=0.63, dy=-0.41)
+    np.testing.assert_allclose(steady[4:-4, 4:-4], image[4:-4, 4:-4], atol=0.01)
+    with pytest.raises(ValueError, match="image"):
+        steady_frame(image[..., 0], dx=0, dy=0)
+
+
+def test_sample_shake_is_seeded_bounded_and_on_the_warp_grid():
+    dx, dy = sample_shake(200, seed=3, max_px=2.0)
+    again = sample_shake(200, seed=3, max_px=2.0)
+    np.testing.assert_array_equal(dx, again[0])
+    assert np.hypot(dx, dy).max() <= 2.0 + SHAKE_STEP_PX  # bound, up to the grid rounding
+    assert np.hypot(dx, dy).max() > 1.0 and np.sqrt(np.mean(dx**2 + dy**2)) < 1.0  # sub-pixel, gusts to 2 px
+    np.testing.assert_array_equal(np.round(dx / SHAKE_STEP_PX) * SHAKE_STEP_PX, dx)
+    assert not np.array_equal(dx, sample_shake(200, seed=4)[0])
+
+
+def test_mosaic_content_moves_by_the_recorded_shake():
+    image = _scene((120, 160), seed=1)  # colour = grey x (1, 0.9, 0.7)
+    sensor = SensorModel(bit_depth=14, black_level=512, gain=1.0, read_noise=3.0)
+    size = dict(rows=480, cols=640, sensor=sensor, scale=20000.0)
+    shakes = [(0.0, 0.0), (1.25, -0.6875)]  # (dx, dy), pixels of the sample
+    mosaics = [sample_mosaic(image, seed=[0, k], shake=s, **size) for k, s in enumerate(shakes)]
+    # dividing each RGGB site by its channel's colour gives the grey scene at full resolution
+    colour = np.array([[1.0, 0.9], [0.9, 0.7]], np.float32)
+    greys = [(m.astype(np.float32) - sensor.black_level) / np.tile(colour, (240, 320)) for m in mosaics]
+    estimate, _ = shift_lucas_kanade_LucasKanade1981(greys[1], greys[0])
+    true = np.array([shakes[1][1] - shakes[0][1], shakes[1][0] - shakes[0][0]])  # (row, col)
+    np.testing.assert_allclose(estimate, true, atol=0.02)  # pixels of the sample
