@@ -1,6 +1,5 @@
 """Tests of shadowcam.cameras.dual_view: mesh warp and IDW resampling into the dual grid."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +14,6 @@ from shadowcam.cameras.dual_view import (
     resample_dual_view,
 )
 
-DEV = Path("/work/shared/data/lab-dev/dev_spheres/gt.npz")
 
 
 def _planar_mapping(homography, rows=64, cols=64):
@@ -152,9 +150,8 @@ def test_camera_colours_and_dataset():
     assert out["dual_view"].dtype == np.float32 and out.attrs["resampling"] == "mesh"
 
 
-@pytest.mark.skipif(not DEV.exists(), reason="shared dev data not available")
-def test_mesh_warp_of_exact_gt_reproduces_reciprocal_render():
-    gt = np.load(DEV)
+def test_mesh_warp_of_exact_gt_reproduces_reciprocal_render(shared_data):
+    gt = np.load(shared_data / "lab-dev" / "dev_spheres" / "gt.npz")
     # README 1.7: camera and reciprocal radiance of a Lambertian point differ by
     # (cos_L / dist_L^2) / (cos_C / dist_C^2); undo it on the camera side
     ratio = (gt["cos_C"] / gt["dist_C"] ** 2) / (gt["cos_L"] / gt["dist_L"] ** 2)

@@ -1,7 +1,6 @@
 """Tests of shadowcam.io.decode: linear RAW / PNG / TIFF decoding to float32 RGB."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import OpenImageIO as oiio
@@ -10,9 +9,7 @@ import pytest
 from shadowcam.io.cfa import bayer_pattern, demosaic_bilinear, opencv_bayer_code
 from shadowcam.io.decode import frame_info, iter_frames, read_frame
 
-from dng_files import write_dng
 
-SHARED = Path("/work/shared/data/lab-dev")
 PATTERNS = ("RGGB", "BGGR", "GRBG", "GBRG")
 
 
@@ -25,19 +22,6 @@ def mosaic_of(rgb, pattern):
     rows, cols = np.indices(rgb.shape[:2])
     site_channel = channels[rows % 2, cols % 2]
     return np.take_along_axis(rgb, site_channel[..., None], axis=2)[..., 0], site_channel
-
-
-def write_image(path, pixels, **attributes):
-    """Write `pixels` (H, W, C) in their own integer/float type with OpenImageIO."""
-    type_name = {"float32": "float", "float16": "half"}.get(str(pixels.dtype), str(pixels.dtype))
-    spec = oiio.ImageSpec(pixels.shape[1], pixels.shape[0], pixels.shape[2], type_name)
-    for key, value in attributes.items():
-        spec.attribute(key, value)
-    out = oiio.ImageOutput.create(str(path))
-    assert out.open(str(path), spec), oiio.geterror()
-    assert out.write_image(pixels)
-    out.close()
-    return path
 
 
 # --------------------------------------------------------------------------- Bayer maths
@@ -92,10 +76,10 @@ def test_demosaic_validates_inputs():
 
 
 @pytest.mark.parametrize("pattern", ["RGGB", "GBRG"])
-def test_dng_decodes_linearly_exact_at_cfa_sites(tmp_path, pattern):
+def test_dng_decodes_linearly_exact_at_cfa_sites(tmp_path, pattern, write_pidng):
     rng = np.random.default_rng(11)
     raw = rng.integers(0, 4096, size=(32, 48)).astype(np.uint16)  # includes values below black
-    path = write_dng(tmp_path / "frame.dng", raw, pattern=pattern, exposure=[1, 250], stamp="2024:05:01 18:00:07")
+    path = write_pidng(tmp_path / "frame.dng", raw, pattern=pattern, exposure=[1, 250], stamp="2024:05:01 18:00:07")
     image, info = read_frame(path, return_info=True)
     assert image.dtype == np.float32 and image.shape == (32, 48, 3)
     _, site_channel = mosaic_of(np.zeros((32, 48, 3)), pattern)
@@ -114,7 +98,7 @@ def test_dng_decodes_linearly_exact_at_cfa_sites(tmp_path, pattern):
 # --------------------------------------------------------------------------- PNG / TIFF
 
 
-def test_png16_scaled_by_65535_exactly(tmp_path):
+def test_png16_scaled_by_65535_exactly(tmp_path, write_image):
     rng = np.random.default_rng(3)
     pixels = rng.integers(0, 65536, size=(20, 16, 3)).astype(np.uint16)
     path = write_image(tmp_path / "f.png", pixels)
@@ -125,7 +109,7 @@ def test_png16_scaled_by_65535_exactly(tmp_path):
     assert (info["height"], info["width"], info["bit_depth"], info["white_level"]) == (20, 16, 16, 65535.0)
 
 
-def test_grey_8bit_and_float_tiff(tmp_path):
+def test_grey_8bit_and_float_tiff(tmp_path, write_image):
     grey = np.arange(12, dtype=np.uint8).reshape(3, 4, 1) * 20
     image = read_frame(write_image(tmp_path / "g.png", grey))
     np.testing.assert_array_equal(image, np.repeat(grey / np.float32(255), 3, axis=2).astype(np.float32))
@@ -140,7 +124,7 @@ def test_missing_file_names_it(tmp_path):
         read_frame(tmp_path / "nothere.png")
 
 
-def test_frames_of_different_size_raise_naming_both(tmp_path):
+def test_frames_of_different_size_raise_naming_both(tmp_path, write_image):
     a = write_image(tmp_path / "a.png", np.zeros((8, 8, 3), np.uint16))
     b = write_image(tmp_path / "b.png", np.zeros((8, 10, 3), np.uint16))
     frames = iter_frames([a, a, b])
@@ -151,19 +135,15 @@ def test_frames_of_different_size_raise_naming_both(tmp_path):
 
 # --------------------------------------------------------------------------- shared dev data
 
-needs_shared = pytest.mark.skipif(not SHARED.is_dir(), reason="shared dev data not present")
-
-
 def _shadow_free(gt):
     """Pixels the wire cannot touch in u frame 0: shadow time > 3 frames away (dip ~2 frames)."""
     return np.abs(gt["t_u_all"]) > 3
 
 
-@needs_shared
-def test_shared_png_frame0_matches_reference_linear():
-    gt = np.load(SHARED / "dev_spheres/gt.npz")
-    scale = json.loads((SHARED / "dev_spheres/meta.json").read_text())["encoding"]["png_scale"]
-    image = read_frame(SHARED / "dev_spheres/frames_u/000000.png").astype(np.float64)
+def test_shared_png_frame0_matches_reference_linear(shared_data):
+    gt = np.load(shared_data / "lab-dev" / "dev_spheres/gt.npz")
+    scale = json.loads((shared_data / "lab-dev" / "dev_spheres/meta.json").read_text())["encoding"]["png_scale"]
+    image = read_frame(shared_data / "lab-dev" / "dev_spheres/frames_u/000000.png").astype(np.float64)
     mask = _shadow_free(gt)
     assert mask.mean() > 0.9
     # value = round(radiance * png_scale); value/65535 decoded: error <= 0.5 DN
@@ -171,16 +151,15 @@ def test_shared_png_frame0_matches_reference_linear():
     err_dn = np.abs(image * 65535 - gt["reference_linear"].astype(np.float64) * scale)[mask]
     assert err_dn.max() <= 0.505
     # and the reference frame itself everywhere
-    ref = read_frame(SHARED / "dev_spheres/reference.png").astype(np.float64)
+    ref = read_frame(shared_data / "lab-dev" / "dev_spheres/reference.png").astype(np.float64)
     assert np.abs(ref * 65535 - gt["reference_linear"] * scale).max() <= 0.505
 
 
-@needs_shared
-def test_shared_dng_frame0_matches_reference_linear_within_noise():
+def test_shared_dng_frame0_matches_reference_linear_within_noise(shared_data):
     """Own-channel values follow the README noise model around k_e * radiance."""
-    gt = np.load(SHARED / "dev_spheres_raw/gt.npz")
-    noise = json.loads((SHARED / "dev_spheres_raw/meta.json").read_text())["noise_model"]
-    image = read_frame(SHARED / "dev_spheres_raw/frames_u/000000.dng")
+    gt = np.load(shared_data / "lab-dev" / "dev_spheres_raw/gt.npz")
+    noise = json.loads((shared_data / "lab-dev" / "dev_spheres_raw/meta.json").read_text())["noise_model"]
+    image = read_frame(shared_data / "lab-dev" / "dev_spheres_raw/frames_u/000000.dng")
     _, site_channel = mosaic_of(np.zeros((192, 192, 3)), "RGGB")
     own = np.take_along_axis(image, site_channel[..., None], axis=2)[..., 0].astype(np.float64)
     radiance = np.take_along_axis(gt["reference_linear"], site_channel[..., None], axis=2)[..., 0]

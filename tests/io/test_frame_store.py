@@ -7,7 +7,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from test_decode import write_image  # noqa: E402  (tests dir is on sys.path)
 
 from shadowcam.cli import main
 from shadowcam.io.frame_store import (
@@ -21,14 +20,6 @@ from shadowcam.io.frame_store import (
 from shadowcam.io.manifest import checksums_for
 
 
-def make_frames(folder, count, *, shape=(12, 10, 3), seed=0, **attributes):
-    folder.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng(seed)
-    pixels = rng.integers(0, 65536, (count,) + shape).astype(np.uint16)
-    paths = [write_image(folder / f"{k:04d}.tif", pixels[k], **attributes) for k in range(count)]
-    return paths, pixels.astype(np.float32) / np.float32(65535)
-
-
 def test_default_chunk_frames():
     assert default_chunk_frames((192, 192, 3)) == CHUNK_BYTES // (192 * 192 * 3 * 4) == 151
     assert default_chunk_frames((6000, 4000, 3)) == 1  # a 24 MP frame exceeds 64 MiB alone
@@ -36,7 +27,7 @@ def test_default_chunk_frames():
         default_chunk_frames((0, 3, 3))
 
 
-def test_round_trip_and_chunks(tmp_path):
+def test_round_trip_and_chunks(tmp_path, make_frames):
     paths, expected = make_frames(tmp_path / "in", 7, ExposureTime=0.004)
     times = np.array([0.0, 0.5, 1.1, 1.5, 2.0, 2.5, 3.0])
     out = write_frames(paths, tmp_path / "u.zarr", times_s=times, attrs={"input_checksums": {"a": "b"}, "sweep": "u"},
@@ -62,7 +53,7 @@ def test_round_trip_and_chunks(tmp_path):
     assert not (tmp_path / "u.zarr.tmp").exists()
 
 
-def test_reference_store_is_mean_of_frames(tmp_path):
+def test_reference_store_is_mean_of_frames(tmp_path, make_frames):
     paths, expected = make_frames(tmp_path / "ref", 2)
     ds = open_frames(write_reference(paths, tmp_path / "reference.zarr", attrs={"sweep": "reference"}))
     assert ds["image"].dims == ("row", "col", "channel")
@@ -70,7 +61,7 @@ def test_reference_store_is_mean_of_frames(tmp_path):
     assert ds.attrs["n_frames_averaged"] == 2
 
 
-def test_failed_write_leaves_no_store_and_keeps_old(tmp_path):
+def test_failed_write_leaves_no_store_and_keeps_old(tmp_path, write_image, make_frames):
     paths, _ = make_frames(tmp_path / "in", 4)
     out = write_frames(paths[:2], tmp_path / "u.zarr", times_s=[0, 1])
     odd = write_image(tmp_path / "in" / "odd.tif", np.zeros((12, 11, 3), np.uint16))
@@ -82,7 +73,7 @@ def test_failed_write_leaves_no_store_and_keeps_old(tmp_path):
         open_frames(tmp_path / "v.zarr")
 
 
-def test_input_validation(tmp_path):
+def test_input_validation(tmp_path, make_frames):
     paths, _ = make_frames(tmp_path / "in", 2)
     with pytest.raises(ValueError, match="times_s"):
         write_frames(paths, tmp_path / "u.zarr", times_s=[0.0])
@@ -101,7 +92,7 @@ def _peak_bytes(paths, out):
         tracemalloc.stop()
 
 
-def test_memory_bounded_by_chunk_not_frame_count(tmp_path):
+def test_memory_bounded_by_chunk_not_frame_count(tmp_path, make_frames):
     shape = (64, 64, 3)
     frame_bytes = int(np.prod(shape)) * 4
     paths, _ = make_frames(tmp_path / "in", 200, shape=shape)
@@ -124,7 +115,7 @@ def test_memory_bounded_by_chunk_not_frame_count(tmp_path):
     assert total > 0 and ds.sizes["time"] == 200
 
 
-def test_decode_cli_verifies_then_writes(tmp_path):
+def test_decode_cli_verifies_then_writes(tmp_path, write_image, make_frames):
     paths, expected = make_frames(tmp_path / "data" / "u", 5)
     write_image(tmp_path / "data" / "ref.tif", np.full((12, 10, 3), 32768, np.uint16))
     doc = {"name": "cap", "kind": "lab", "light": "point", "root": "data",

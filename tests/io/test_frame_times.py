@@ -5,13 +5,11 @@ import json
 import numpy as np
 import pytest
 
-from test_decode import write_image  # noqa: E402  (tests dir is on sys.path)
-from test_manifest import make_capture, rewrite
 from shadowcam.io.frame_times import auto_candidates, find_gaps, median_interval
 from shadowcam.io.manifest import checksums_for, load_manifest
 
 
-def test_auto_prefers_metadata_then_file_names_then_sidecar(tmp_path):
+def test_auto_prefers_metadata_then_file_names_then_sidecar(tmp_path, make_capture, rewrite):
     names = ("img_0.0s.png", "img_61.5s.png", "img_180.0s.png")
     path, doc = make_capture(tmp_path, names=names, with_checksums=False)
     (tmp_path / "data" / "stamps.json").write_text(json.dumps({"times_s": [0.0, 60.0, 120.0]}))
@@ -29,7 +27,7 @@ def test_auto_prefers_metadata_then_file_names_then_sidecar(tmp_path):
         load_manifest(rewrite(path, doc))
 
 
-def test_auto_uses_exif_times_when_every_file_has_one(tmp_path):
+def test_auto_uses_exif_times_when_every_file_has_one(tmp_path, write_image, rewrite):
     data = tmp_path / "data" / "u"
     data.mkdir(parents=True)
     for k, stamp in enumerate(["2024:05:01 18:59:00", "2024:05:01 19:00:05", "2024:05:01 19:02:00"]):

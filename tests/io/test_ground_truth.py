@@ -4,12 +4,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import write_manifest
 
 from shadowcam.io.ground_truth import REQUIRED, check_ground_truth, load_ground_truth, mitsuba_lab_npz_to_dataset
 
 REPO = Path(__file__).resolve().parents[2]
-SHARED = Path("/work/shared/data/lab-dev")
 
 
 def lab_arrays(height=6, width=7, n_v=4, n_u=5, seed=0):
@@ -46,17 +44,17 @@ def test_lab_npz_conversion_dims_and_values():
         mitsuba_lab_npz_to_dataset(arrays)
 
 
-def _manifest(tmp_path, fmt, file):
+def _manifest(write_manifest, tmp_path, fmt, file):
     doc = {"name": "g", "kind": "lab", "light": "point", "root": ".", "sweeps": {"u": {"files": "u.png"}},
            "timing": {"source": "rate", "rate_hz": 1.0}, "ground_truth": {"format": fmt, "file": file}}
     (tmp_path / "u.png").write_bytes(b"")  # a sweep file (not decoded here)
     return write_manifest(tmp_path / "g.yaml", doc)
 
 
-def test_load_lab_npz_via_manifest_verifies_checksum(tmp_path):
+def test_load_lab_npz_via_manifest_verifies_checksum(tmp_path, write_manifest):
     arrays = lab_arrays()
     np.savez(tmp_path / "gt.npz", **arrays)
-    path = _manifest(tmp_path, "mitsuba_lab_npz", "gt.npz")
+    path = _manifest(write_manifest, tmp_path, "mitsuba_lab_npz", "gt.npz")
     ds = load_ground_truth(path)
     np.testing.assert_array_equal(ds["t_v"].values, arrays["t_v"])
     assert ds.attrs["source_format"] == "mitsuba_lab_npz" and len(ds.attrs["source_sha256"]) == 64
@@ -65,15 +63,15 @@ def test_load_lab_npz_via_manifest_verifies_checksum(tmp_path):
         load_ground_truth(path)
 
 
-def test_load_shadowcam_nc_round_trip_and_missing_variable(tmp_path):
+def test_load_shadowcam_nc_round_trip_and_missing_variable(tmp_path, write_manifest):
     standard = mitsuba_lab_npz_to_dataset(lab_arrays())
     standard[list(REQUIRED)].to_netcdf(tmp_path / "ground_truth.nc", engine="h5netcdf")
-    ds = load_ground_truth(_manifest(tmp_path, "shadowcam_nc", "ground_truth.nc"))
+    ds = load_ground_truth(_manifest(write_manifest, tmp_path, "shadowcam_nc", "ground_truth.nc"))
     for name in REQUIRED:
         np.testing.assert_array_equal(ds[name].values, standard[name].values)
     standard[["t_u", "t_v", "lit"]].to_netcdf(tmp_path / "bad.nc", engine="h5netcdf")
     with pytest.raises(ValueError, match=r"bad\.nc.*reciprocal"):
-        load_ground_truth(_manifest(tmp_path, "shadowcam_nc", "bad.nc"))
+        load_ground_truth(_manifest(write_manifest, tmp_path, "shadowcam_nc", "bad.nc"))
 
 
 def test_check_ground_truth_rejects_transposed_dual():
@@ -82,7 +80,7 @@ def test_check_ground_truth_rejects_transposed_dual():
         check_ground_truth(ds.assign(dual_cam_visible=ds["dual_cam_visible"].transpose("u", "v")))
 
 
-@pytest.mark.skipif(not SHARED.is_dir(), reason="shared dev data not present")
+@pytest.mark.usefixtures("shared_data")  # the repository manifest reads the shared dev data
 @pytest.mark.parametrize("name", ["dev_spheres", "dev_spheres_raw"])
 def test_shared_dev_ground_truth_counts(name):
     ds = load_ground_truth(REPO / "data_manifest" / f"{name}.yaml")
@@ -111,14 +109,14 @@ def _outdoor_arrays(height=4, width=5, frames=3):
     return arrays
 
 
-def test_outdoor_npz_and_netcdf_give_the_same_standard_form(tmp_path):
+def test_outdoor_npz_and_netcdf_give_the_same_standard_form(tmp_path, write_manifest):
     from shadowcam.io.ground_truth import check_outdoor_ground_truth, mitsuba_outdoor_npz_to_dataset
 
     arrays = _outdoor_arrays()
     np.savez(tmp_path / "gt.npz", **arrays)
-    from_npz = load_ground_truth(_manifest(tmp_path, "mitsuba_outdoor_npz", "gt.npz"))
+    from_npz = load_ground_truth(_manifest(write_manifest, tmp_path, "mitsuba_outdoor_npz", "gt.npz"))
     from_npz.drop_attrs().to_netcdf(tmp_path / "ground_truth.nc", engine="h5netcdf")
-    from_nc = load_ground_truth(_manifest(tmp_path, "shadowcam_outdoor_nc", "ground_truth.nc"))
+    from_nc = load_ground_truth(_manifest(write_manifest, tmp_path, "shadowcam_outdoor_nc", "ground_truth.nc"))
     for name in ("shadow_class", "sky_mask", "arrival_time_s", "times_s", "pb_edge_y"):
         np.testing.assert_array_equal(from_nc[name].values, from_npz[name].values)
         assert from_nc[name].dims == from_npz[name].dims
@@ -131,7 +129,7 @@ def test_outdoor_npz_and_netcdf_give_the_same_standard_form(tmp_path):
         mitsuba_outdoor_npz_to_dataset(broken)
 
 
-@pytest.mark.skipif(not (SHARED.parent / "outdoor-dev" / "dev_ridge").is_dir(), reason="shared dev data not present")
+@pytest.mark.usefixtures("shared_data")  # the repository manifest reads the shared dev data
 def test_dev_ridge_ground_truth_counts():
     ds = load_ground_truth(REPO / "data_manifest" / "dev_ridge.yaml")
     assert (ds.sizes["row"], ds.sizes["col"], ds.sizes["time"]) == (128, 192, 120)

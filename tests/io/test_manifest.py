@@ -6,7 +6,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from test_decode import write_image  # noqa: E402  (tests dir is on sys.path)
 
 from shadowcam.cli import main
 from shadowcam.io.manifest import (
@@ -19,48 +18,13 @@ from shadowcam.io.manifest import (
 )
 
 REPO = Path(__file__).resolve().parents[2]
-SHARED = Path("/work/shared/data/lab-dev")
-
-
-def make_capture(tmp_path, *, names=("f1.png", "f2.png", "f10.png"), with_checksums=True, **overrides):
-    """A capture folder data/ and a manifest manifests/cap.yaml with root ../data."""
-    data = tmp_path / "data"
-    (data / "u").mkdir(parents=True)
-    rng = np.random.default_rng(5)
-    for name in names:
-        write_image(data / "u" / name, rng.integers(0, 65536, (6, 8, 3)).astype(np.uint16))
-    write_image(data / "ref.png", np.full((6, 8, 3), 1000, np.uint16))
-    doc = {
-        "name": "cap",
-        "kind": "lab",
-        "light": "point",
-        "root": "../data",
-        "sweeps": {"u": {"files": "u/*.png", "axis": "u"}},
-        "reference": "ref.png",
-        "timing": {"source": "rate", "rate_hz": 2.0},
-        "provenance": "test",
-        "licence": "CC0-1.0",
-    }
-    doc.update(overrides)
-    path = tmp_path / "manifests" / "cap.yaml"
-    path.parent.mkdir(exist_ok=True)
-    path.write_text(yaml.safe_dump(doc))
-    if with_checksums:
-        doc["checksums"] = checksums_for(path)
-        path.write_text(yaml.safe_dump(doc))
-    return path, doc
-
-
-def rewrite(path, doc):
-    path.write_text(yaml.safe_dump(doc))
-    return path
 
 
 def test_natural_key_orders_numbers():
     assert sorted(["f10.png", "f2.png", "f1.png"], key=natural_key) == ["f1.png", "f2.png", "f10.png"]
 
 
-def test_load_resolves_root_paths_times(tmp_path):
+def test_load_resolves_root_paths_times(tmp_path, make_capture):
     path, _ = make_capture(tmp_path)
     manifest = load_manifest(path)
     root = (tmp_path / "data").resolve()
@@ -72,14 +36,14 @@ def test_load_resolves_root_paths_times(tmp_path):
     assert len(verify_checksums(manifest)) == 4
 
 
-def test_json_manifest_loads(tmp_path):
+def test_json_manifest_loads(tmp_path, make_capture):
     path, doc = make_capture(tmp_path)
     json_path = path.with_suffix(".json")
     json_path.write_text(json.dumps(doc))
     assert load_manifest(json_path)["sweeps"]["u"]["times_s"] == [0.0, 0.5, 1.0]
 
 
-def test_synthetic_manifest_validates(tmp_path):
+def test_synthetic_manifest_validates(tmp_path, rewrite):
     doc = {
         "name": "syn", "kind": "lab", "light": "point",
         "synthetic": {"scene": "tabletop", "seed": 1, "height": 64, "width": 64, "frames": 32,
@@ -90,7 +54,7 @@ def test_synthetic_manifest_validates(tmp_path):
     assert manifest["sweeps"] == {} and manifest["synthetic"]["seed"] == 1
 
 
-def test_extra_key_is_named(tmp_path):
+def test_extra_key_is_named(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path)
     doc["sweeps"]["u"]["fles"] = "x"
     doc["colour"] = "red"
@@ -100,35 +64,35 @@ def test_extra_key_is_named(tmp_path):
     assert "sweeps.u" in str(info.value) and str(path) in str(info.value)
 
 
-def test_missing_root_named(tmp_path):
+def test_missing_root_named(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path)
     doc["root"] = "../nowhere"
     with pytest.raises(ValueError, match="nowhere.*not a folder"):
         load_manifest(rewrite(path, doc))
 
 
-def test_glob_matching_nothing_named(tmp_path):
+def test_glob_matching_nothing_named(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path)
     doc["sweeps"]["v"] = {"files": "v/*.dng"}
     with pytest.raises(ValueError, match=r"sweeps\.v\.files 'v/\*\.dng' matches no file"):
         load_manifest(rewrite(path, doc))
 
 
-def test_missing_reference_file_named(tmp_path):
+def test_missing_reference_file_named(tmp_path, make_capture):
     path, _ = make_capture(tmp_path)
     (tmp_path / "data" / "ref.png").unlink()
     with pytest.raises(ValueError, match="ref.png"):
         load_manifest(path)
 
 
-def test_file_not_in_checksums_named(tmp_path):
+def test_file_not_in_checksums_named(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path)
     del doc["checksums"]["u/f2.png"]
     with pytest.raises(ValueError, match=r"not listed in checksums: u/f2\.png.*shadowcam checksum"):
         load_manifest(rewrite(path, doc))
 
 
-def test_bad_checksum_names_file_expected_actual(tmp_path):
+def test_bad_checksum_names_file_expected_actual(tmp_path, make_capture):
     path, doc = make_capture(tmp_path)
     manifest = load_manifest(path)
     target = tmp_path / "data" / "u" / "f10.png"
@@ -144,7 +108,7 @@ def test_bad_checksum_names_file_expected_actual(tmp_path):
     assert list(verify_checksums(manifest, ["reference"])) == ["ref.png"]
 
 
-def test_file_removed_after_load_named(tmp_path):
+def test_file_removed_after_load_named(tmp_path, make_capture):
     path, _ = make_capture(tmp_path)
     manifest = load_manifest(path)
     (tmp_path / "data" / "u" / "f1.png").unlink()
@@ -152,7 +116,7 @@ def test_file_removed_after_load_named(tmp_path):
         verify_checksums(manifest)
 
 
-def test_timing_from_filename(tmp_path):
+def test_timing_from_filename(tmp_path, make_capture, rewrite):
     path, _ = make_capture(
         tmp_path, names=("img_0.000s.png", "img_0.250s.png", "img_1.500s.png"),
         timing={"source": "filename", "regex": r"_(?P<time_s>\d+\.\d+)s"},
@@ -165,7 +129,7 @@ def test_timing_from_filename(tmp_path):
         load_manifest(rewrite(path, doc))
 
 
-def test_timing_from_exif_metadata_with_subseconds(tmp_path):
+def test_timing_from_exif_metadata_with_subseconds(tmp_path, write_image, rewrite):
     data = tmp_path / "data" / "u"
     data.mkdir(parents=True)
     stamps = [("2024:05:01 18:59:59", "500"), ("2024:05:01 19:00:00", "750"), ("2024:05:01 19:00:02", "")]
@@ -180,7 +144,7 @@ def test_timing_from_exif_metadata_with_subseconds(tmp_path):
     np.testing.assert_allclose(times, [0.0, 1.25, 2.5], atol=1e-6)
 
 
-def test_timing_from_sidecar(tmp_path):
+def test_timing_from_sidecar(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path, with_checksums=False)
     side = tmp_path / "data" / "stamps.json"
     side.write_text(json.dumps({"times_s": {"u": [0.0, 0.9, 2.1]}}))
@@ -198,7 +162,7 @@ def test_timing_from_sidecar(tmp_path):
         load_manifest(rewrite(path, doc))
 
 
-def test_checksum_cli_block_pastes_into_manifest(tmp_path, capsys):
+def test_checksum_cli_block_pastes_into_manifest(tmp_path, capsys, make_capture):
     path, doc = make_capture(tmp_path, with_checksums=False)
     with pytest.raises(ValueError, match="not listed in checksums"):
         load_manifest(path)
@@ -211,7 +175,7 @@ def test_checksum_cli_block_pastes_into_manifest(tmp_path, capsys):
     assert yaml.safe_load(format_checksums(manifest["checksums"])) == {"checksums": manifest["checksums"]}
 
 
-@pytest.mark.skipif(not SHARED.is_dir(), reason="shared dev data not present")
+@pytest.mark.usefixtures("shared_data")  # the repository manifest reads the shared dev data
 @pytest.mark.parametrize("name, suffix", [("dev_spheres", ".png"), ("dev_spheres_raw", ".dng")])
 def test_shared_dev_manifests(name, suffix):
     manifest = load_manifest(REPO / "data_manifest" / f"{name}.yaml")

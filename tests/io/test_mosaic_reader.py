@@ -1,6 +1,5 @@
 """The direct DNG read gives rawpy's mosaic exactly, and rawpy decides whenever a file differs."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -9,7 +8,6 @@ from shadowcam.io.raw_mosaic import read_mosaic
 from shadowcam.io.mosaic_reader import MosaicReader
 from shadowcam.io.raw_writer import write_dng
 
-SHARED_RAW = Path("/work/shared/data/lab-dev/dev_spheres_raw/frames_u")
 
 
 def _mosaic(seed, shape=(24, 40), top=16383):
@@ -47,9 +45,8 @@ def test_a_frame_compressed_otherwise_is_read_with_rawpy(tmp_path):
     np.testing.assert_array_equal(reader.read(other)[0], read_mosaic(other)[0])
 
 
-@pytest.mark.skipif(not SHARED_RAW.is_dir(), reason="shared dev data not present")
-def test_the_independent_renderers_dngs_are_read_as_rawpy_reads_them():
-    paths = sorted(SHARED_RAW.glob("*.dng"))[:2]
+def test_the_independent_renderers_dngs_are_read_as_rawpy_reads_them(shared_data):
+    paths = sorted((shared_data / "lab-dev" / "dev_spheres_raw" / "frames_u").glob("*.dng"))[:2]
     reader = MosaicReader(paths[0])
     for path in paths:
         np.testing.assert_array_equal(reader.read(path)[0], read_mosaic(path)[0])

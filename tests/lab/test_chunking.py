@@ -17,9 +17,6 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
-from conftest import snakemake, workflow_copy, write_manifest
-from test_decode import write_image
-from test_frame_store import make_frames
 
 from shadowcam.cli import main
 from shadowcam.io.frame_store import iter_frame_chunks, merge_frame_stores, open_frames, write_frames
@@ -43,7 +40,7 @@ def decode_in_parts(paths, out, *, chunk_frames, frames_per_part, times):
 
 
 @pytest.mark.parametrize("chunk_frames, frames_per_part", [(4, 4), (4, 12), (5, 10), (3, 24)])
-def test_merged_parts_equal_single_job_bit_for_bit(tmp_path, chunk_frames, frames_per_part):
+def test_merged_parts_equal_single_job_bit_for_bit(tmp_path, chunk_frames, frames_per_part, make_frames):
     paths, expected = make_frames(tmp_path / "frames", FRAMES, seed=3)
     times = np.linspace(0.0, 2.2, FRAMES)
     single = write_frames(paths, tmp_path / "single" / "u.zarr", times_s=times, attrs={"sweep": "u"},
@@ -60,14 +57,14 @@ def test_merged_parts_equal_single_job_bit_for_bit(tmp_path, chunk_frames, frame
     assert starts == list(range(0, FRAMES, chunk_frames))
 
 
-def test_merge_links_instead_of_copying(tmp_path):
+def test_merge_links_instead_of_copying(tmp_path, make_frames):
     paths, _ = make_frames(tmp_path / "frames", 8)
     merged = decode_in_parts(paths, tmp_path / "u.zarr", chunk_frames=2, frames_per_part=4, times=np.arange(8.0))
     part_chunk = tmp_path / "part0004.zarr" / "image" / "c" / "0" / "0" / "0" / "0"
     assert part_chunk.stat().st_ino == (merged / "image" / "c" / "2" / "0" / "0" / "0").stat().st_ino
 
 
-def test_merge_rejects_gaps_order_and_mixed_chunks(tmp_path):
+def test_merge_rejects_gaps_order_and_mixed_chunks(tmp_path, make_frames):
     paths, _ = make_frames(tmp_path / "frames", 8)
     times = np.arange(8.0)
     a = write_frames(paths[:4], tmp_path / "a.zarr", times_s=times[:4], chunk_frames=2)
@@ -86,14 +83,7 @@ def test_merge_rejects_gaps_order_and_mixed_chunks(tmp_path):
         write_frames(paths[3:], tmp_path / "d.zarr", times_s=times[3:], chunk_frames=2, first_frame=3)
 
 
-def sweep_manifest(folder, *, rate_hz):
-    """Write `folder`/cap.yaml describing sweep u = `folder`/data/u/*.tif, with checksums."""
-    return write_manifest(folder / "cap.yaml", {
-        "name": "cap", "kind": "lab", "light": "point", "root": "data",
-        "sweeps": {"u": {"files": "u/*.tif", "axis": "u"}}, "timing": {"source": "rate", "rate_hz": rate_hz}})
-
-
-def test_decode_cli_parts_equal_whole_sweep_with_provenance(tmp_path):
+def test_decode_cli_parts_equal_whole_sweep_with_provenance(tmp_path, make_frames, sweep_manifest):
     paths, expected = make_frames(tmp_path / "data" / "u", 7, seed=5)
     manifest = sweep_manifest(tmp_path, rate_hz=4.0)
     common = ["--manifest", str(manifest), "--sweep", "u", "--chunk-frames", "2"]
@@ -118,7 +108,7 @@ def test_decode_cli_parts_equal_whole_sweep_with_provenance(tmp_path):
         assert main(["decode", *common, "--frames", bad, "--out", str(tmp_path / "bad.zarr")]) == 2
 
 
-def test_workflow_splits_sweeps_into_decode_jobs(tmp_path):
+def test_workflow_splits_sweeps_into_decode_jobs(tmp_path, workflow_copy, snakemake):
     """Dry run: ceil(frames / (chunk_frames x chunks_per_job)) decode_part and shadow_time_chunk
     jobs per sweep."""
     workdir = workflow_copy(tmp_path)
@@ -137,23 +127,24 @@ def test_workflow_splits_sweeps_into_decode_jobs(tmp_path):
         assert counts["decode"] == sweeps and counts["shadow_time"] == 1
 
 
-def sweep_store(folder, *, frames=23, shape=(6, 20), chunk_frames=4, seed=0):
-    """A sweep whose shadow (2 frames wide) darkens column c in frames c and c + 1 (centre c + 0.5)."""
-    rng = np.random.default_rng(seed)
-    cols = np.arange(shape[1])
-    paths = []
-    folder.mkdir(parents=True)
-    for t in range(frames):
-        # frame t: columns t - 1 and t are dark
-        lit = np.where((cols >= t - 1) & (cols <= t), 0.05, 0.6)
-        image = np.broadcast_to(lit[None, :, None], shape + (3,)) + rng.normal(0, 0.002, shape + (3,))
-        paths.append(write_image(folder / f"{t:04d}.tif", np.round(image * 65535).astype(np.uint16)))
-    return write_frames(paths, folder.parent / f"{folder.name}.zarr", times_s=np.arange(float(frames)),
-                        chunk_frames=chunk_frames)
+@pytest.fixture
+def sweep_store(wire_sweep, write_image):
+    """``sweep_store(folder, ...)``: a TIFF sweep and its frame store, whose shadow (2 frames wide)
+    darkens column c in frames c and c + 1 (centre c + 0.5), lit 0.6, shadowed 0.05."""
+    def make(folder, *, frames=23, shape=(6, 20), chunk_frames=4, seed=0):
+        images, _ = wire_sweep(n_frames=frames, shape=shape, t0=0.0, px_per_frame=1.0, tilt=0.0, width=2.0,
+                               supersample=1, albedo=np.full(shape + (3,), 0.6), depth=1 - 0.05 / 0.6,
+                               noise=0.002, seed=seed, dtype=np.float64)
+        folder.mkdir(parents=True)
+        paths = [write_image(folder / f"{t:04d}.tif", np.round(image * 65535).astype(np.uint16))
+                 for t, image in enumerate(images)]
+        return write_frames(paths, folder.parent / f"{folder.name}.zarr", times_s=np.arange(float(frames)),
+                            chunk_frames=chunk_frames)
+    return make
 
 
 @pytest.mark.parametrize("owned", [[(0, 23)], [(0, 8), (8, 16), (16, 24)], [(0, 5), (5, 23)]])
-def test_shadow_time_from_chunk_partials_equals_single_pass(tmp_path, owned):
+def test_shadow_time_from_chunk_partials_equals_single_pass(tmp_path, owned, sweep_store):
     stores = [sweep_store(tmp_path / sweep, seed=k) for k, sweep in enumerate(("u", "v"))]
     common = ["--frames", *map(str, stores), "--sweeps", "u", "v", "--method", "dip_centroid"]
     assert main(["shadow-time", *common, "--out", str(tmp_path / "single.nc")]) == 0
@@ -175,7 +166,7 @@ def test_shadow_time_from_chunk_partials_equals_single_pass(tmp_path, owned):
     np.testing.assert_allclose(times, np.broadcast_to(inside + 0.5, times.shape), atol=0.1)
 
 
-def test_shadow_time_partials_must_cover_every_sweep(tmp_path):
+def test_shadow_time_partials_must_cover_every_sweep(tmp_path, sweep_store):
     store = sweep_store(tmp_path / "u")
     part = tmp_path / "u.npz"
     assert main(["shadow-time-chunk", "--frames", str(store), "--owned", "0:23", "--out", str(part)]) == 0

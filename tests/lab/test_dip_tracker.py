@@ -8,16 +8,18 @@ import pytest
 from shadowcam.lab.dip_tracker import DipPartial, DipSummary, DipTracker, merge_partials
 
 
-def _sweep(n_frames, dip_frames, shape=(4, 5), level=1.0, depth=0.9, seed=0, noise=0.0):
-    rng = np.random.default_rng(seed)
-    frames = np.full((n_frames,) + shape, level, np.float32)
-    for frame in dip_frames:
-        frames[frame] = level - depth
-    return frames + rng.normal(0, noise, frames.shape).astype(np.float32)
+@pytest.fixture(scope="module")
+def dip_sweep(wire_sweep):
+    """Scalar (T, rows, cols) frames at `level`, dipping by `depth` in each of `dip_frames` (every pixel)."""
+    def make(n_frames, dip_frames, shape=(4, 5), level=1.0, depth=0.9, seed=0, noise=0.0):
+        frames, _ = wire_sweep(n_frames=n_frames, centres=list(dip_frames), width=1.0, shape=shape,
+                               level=level, depth=depth, seed=seed, noise=noise)
+        return frames
+    return make
 
 
-def test_finds_the_dip_and_the_lit_level_without_it():
-    frames = _sweep(50, [20, 21, 22])
+def test_finds_the_dip_and_the_lit_level_without_it(dip_sweep):
+    frames = dip_sweep(50, [20, 21, 22])
     tracker = DipTracker(frames.shape[1:], half_window=3)
     tracker.update(frames)
     summary = tracker.result()
@@ -29,8 +31,8 @@ def test_finds_the_dip_and_the_lit_level_without_it():
 
 
 @pytest.mark.parametrize("block", [1, 3, 7, 50])
-def test_result_does_not_depend_on_block_size(block):
-    frames = _sweep(50, [10, 11, 40], noise=0.05, seed=3)
+def test_result_does_not_depend_on_block_size(block, dip_sweep):
+    frames = dip_sweep(50, [10, 11, 40], noise=0.05, seed=3)
     whole = DipTracker(frames.shape[1:], half_window=4)
     whole.update(frames)
     split = DipTracker(frames.shape[1:], half_window=4)
@@ -43,8 +45,8 @@ def test_result_does_not_depend_on_block_size(block):
     np.testing.assert_array_equal(a.second_value, b.second_value)
 
 
-def test_second_dip_a_window_away_is_recorded_and_shoulders_are_not():
-    frames = _sweep(60, [9, 10, 11])
+def test_second_dip_a_window_away_is_recorded_and_shoulders_are_not(dip_sweep):
+    frames = dip_sweep(60, [9, 10, 11])
     frames[40] = 0.4  # a shallower second dip
     frames[13] = 0.8  # a shoulder of the first dip, inside its window
     tracker = DipTracker(frames.shape[1:], half_window=3)
@@ -54,8 +56,8 @@ def test_second_dip_a_window_away_is_recorded_and_shoulders_are_not():
     assert np.all(summary.second_frame == 40)
 
 
-def test_dip_at_the_sequence_edges_is_found_and_padded_with_nan():
-    frames = _sweep(30, [29])
+def test_dip_at_the_sequence_edges_is_found_and_padded_with_nan(dip_sweep):
+    frames = dip_sweep(30, [29])
     tracker = DipTracker(frames.shape[1:], half_window=2)
     tracker.update(frames)
     summary = tracker.result()
@@ -77,8 +79,8 @@ def test_long_sequences_keep_running_statistics_exact():
     np.testing.assert_allclose(summary.noise, expected, rtol=0.05)
 
 
-def test_non_finite_samples_are_counted_not_propagated():
-    frames = _sweep(40, [19, 20, 21])
+def test_non_finite_samples_are_counted_not_propagated(dip_sweep):
+    frames = dip_sweep(40, [19, 20, 21])
     frames[5, 0, 0] = np.nan
     frames[6, 0, 1] = np.inf
     tracker = DipTracker(frames.shape[1:], half_window=3)
@@ -124,9 +126,9 @@ def _chunked(frames, bounds, *, half_window, block=5):
     return partials
 
 
-def _hard_sweep(seed=5):
+def _hard_sweep(dip_sweep, seed=5):
     """Colour frames with dips at chunk boundaries, second dips, ties, a ramp and NaNs."""
-    frames = _sweep(64, [], shape=(6, 7), noise=0.02, seed=seed)
+    frames = dip_sweep(64, [], shape=(6, 7), noise=0.02, seed=seed)
     frames[:, 0, 0] = 1.0  # exact ties everywhere
     frames[19:22, 1] -= 0.8  # dip centred on a boundary at 20
     frames[30:33, 2] -= 0.7
@@ -149,8 +151,8 @@ def _hard_sweep(seed=5):
 @pytest.mark.parametrize("bounds", [
     [0, 64], [0, 20, 64], [0, 3, 7, 8, 20, 21, 33, 64], list(range(0, 65, 4)), [0, 31, 32, 64],
 ])
-def test_merged_chunks_equal_the_single_pass_bit_for_bit(bounds):
-    frames = _hard_sweep()
+def test_merged_chunks_equal_the_single_pass_bit_for_bit(bounds, dip_sweep):
+    frames = _hard_sweep(dip_sweep)
     whole = DipTracker(frames.shape[1:3], half_window=3)
     whole.update(frames)
     expected = whole.result()
@@ -159,8 +161,8 @@ def test_merged_chunks_equal_the_single_pass_bit_for_bit(bounds):
     _summaries_equal(merge_partials(partials, n_frames=64), expected)
 
 
-def test_flat_minima_are_centred_close_equal_dips_seen_and_minus_inf_ignored():
-    frames = _hard_sweep()
+def test_flat_minima_are_centred_close_equal_dips_seen_and_minus_inf_ignored(dip_sweep):
+    frames = _hard_sweep(dip_sweep)
     tracker = DipTracker(frames.shape[1:3], half_window=3)
     tracker.update(frames)
     summary = tracker.result()
@@ -174,8 +176,8 @@ def test_flat_minima_are_centred_close_equal_dips_seen_and_minus_inf_ignored():
     assert summary.minimum_frame[5, 4] == 63 and summary.invalid_count[5, 4] == 1
 
 
-def test_second_dip_is_a_local_minimum_a_window_away_and_a_ramp_has_none():
-    frames = _hard_sweep()
+def test_second_dip_is_a_local_minimum_a_window_away_and_a_ramp_has_none(dip_sweep):
+    frames = _hard_sweep(dip_sweep)
     tracker = DipTracker(frames.shape[1:3], half_window=3)
     tracker.update(frames)
     summary = tracker.result()
@@ -187,8 +189,8 @@ def test_second_dip_is_a_local_minimum_a_window_away_and_a_ramp_has_none():
     assert summary.invalid_count[5, 5] == 1 and summary.invalid_count[4, 6] == 1
 
 
-def test_partial_round_trips_through_an_atomic_file(tmp_path):
-    frames = _hard_sweep()
+def test_partial_round_trips_through_an_atomic_file(tmp_path, dip_sweep):
+    frames = _hard_sweep(dip_sweep)
     partials = _chunked(frames, [0, 25, 64], half_window=2)
     paths = []
     for i, part in enumerate(partials):
@@ -200,8 +202,8 @@ def test_partial_round_trips_through_an_atomic_file(tmp_path):
     _summaries_equal(merge_partials(loaded, n_frames=64), merge_partials(partials, n_frames=64))
 
 
-def test_merge_rejects_gaps_and_short_feeds():
-    frames = _hard_sweep()
+def test_merge_rejects_gaps_and_short_feeds(dip_sweep):
+    frames = _hard_sweep(dip_sweep)
     partials = _chunked(frames, [0, 20, 40, 64], half_window=2)
     with pytest.raises(ValueError, match="tile"):
         merge_partials([partials[0], partials[2]], n_frames=64)

@@ -22,19 +22,17 @@ METHODS = sorted(SHADOW_TIME_METHODS)
 LEVEL = 0.6  # lit level of the synthetic pixels (white = 1)
 
 
-def dips(n_frames, centres, *, width=2.0, depth=0.9, shape=(6, 6), level=LEVEL, ramp=0.0):
-    """(T, rows, cols) signal: a dip of `width` frames (plus linear ramps of `ramp` frames,
-    an area source's penumbra) at `centres` (a time, a (rows, cols) array of times, or a
-    list of them for several dips, with a list of `depth`); exact, noise-free."""
-    t = np.arange(n_frames, dtype=np.float64)[:, None, None] + np.zeros(shape)
-    removed = np.zeros_like(t)
-    centres = list(centres) if isinstance(centres, list) else [centres]
-    depths = list(depth) if isinstance(depth, list) else [depth] * len(centres)
-    for c, d in zip(centres, depths):
-        dist = np.abs(t - c) - width / 2
-        cover = (dist < 0).astype(float) if ramp == 0 else np.clip(0.5 - dist / ramp, 0, 1)
-        removed += d * cover
-    return level * (1 - np.clip(removed, 0, 1))
+@pytest.fixture(scope="module")
+def dips(wire_sweep):
+    """``dips(n_frames, centres, ...)``: (T, rows, cols) signal, a dip of `width` frames (plus
+    linear ramps of `ramp` frames, an area source's penumbra) at `centres` (a time, a (rows,
+    cols) array of times, or a list of them for several dips, with a list of `depth`);
+    exact, noise-free, float64."""
+    def make(n_frames, centres, *, width=2.0, depth=0.9, shape=(6, 6), level=LEVEL, ramp=0.0):
+        frames, _ = wire_sweep(n_frames=n_frames, centres=centres, width=width, depth=depth, shape=shape,
+                               level=level, ramp=ramp, dtype=np.float64)
+        return frames
+    return make
 
 
 def run(stack, **kwargs):
@@ -62,7 +60,7 @@ def check_invariants(result, n_frames):
 @settings(max_examples=12, deadline=None)
 @given(electrons=st.sampled_from([15, 40, 100, 400, 3000]), seed=st.integers(0, 1000),
        method=st.sampled_from(METHODS))
-def test_low_light_12bit_times_are_right_or_flagged(electrons, seed, method):
+def test_low_light_12bit_times_are_right_or_flagged(electrons, seed, method, dips):
     """Poisson + read noise (6 e-), 12-bit quantisation, 15 to 3000 electrons when lit:
     pixels given a time are within 3 frames of the truth except for the detector's designed
     false alarms (SNR ~ 2 at 15 e-); in good light every pixel is within a frame."""
@@ -91,7 +89,7 @@ def test_low_light_12bit_times_are_right_or_flagged(electrons, seed, method):
 
 @settings(max_examples=10, deadline=None)
 @given(level=st.floats(0.9995, 3.0), method=st.sampled_from(METHODS))
-def test_saturated_pixels_are_flagged_never_timed(level, method):
+def test_saturated_pixels_are_flagged_never_timed(level, method, dips):
     frames = dips(30, 14.3, shape=(4, 4))
     frames[:, :, :2] = np.minimum(frames[:, :, :2] * level / LEVEL, 1.0)  # clipped at white
     result = run(frames, method=method)
@@ -105,7 +103,7 @@ def test_saturated_pixels_are_flagged_never_timed(level, method):
 
 @pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("width", [7.0, 9.0, 12.0, 16.0])
-def test_dip_wider_than_the_window_is_flagged_not_biased(width, method):
+def test_dip_wider_than_the_window_is_flagged_not_biased(width, method, dips):
     """Thick wire: a flat minimum wider than the 9-frame window. Its time is either the
     centre of the dip (within a quarter frame) or the pixel is flagged."""
     result = run(dips(60, 30.3, width=width), method=method, half_window=4)
@@ -116,14 +114,14 @@ def test_dip_wider_than_the_window_is_flagged_not_biased(width, method):
 
 
 @pytest.mark.parametrize("method", ["dip_centroid", "edge_fit"])
-def test_area_source_penumbra_that_fits_the_window_is_timed_at_its_centre(method):
+def test_area_source_penumbra_that_fits_the_window_is_timed_at_its_centre(method, dips):
     """Area source: umbra 2 frames, linear penumbra ramps of 3 frames each side."""
     result = run(dips(60, 30.3, width=2.0, ramp=3.0), method=method, half_window=6)
     assert (result["reason"] == OK).all()
     np.testing.assert_allclose(result["shadow_time"], 30.3, atol=0.1)
 
 
-def test_flat_minimum_narrower_than_the_window_is_timed():
+def test_flat_minimum_narrower_than_the_window_is_timed(dips):
     result = run(dips(60, 30.0, width=7.0), method="dip_centroid", half_window=4)
     assert (result["reason"] == OK).all()
     np.testing.assert_allclose(result["shadow_time"], 30.0, atol=0.25)
@@ -133,21 +131,21 @@ def test_flat_minimum_narrower_than_the_window_is_timed():
 
 
 @pytest.mark.parametrize("ratio", [0.6, 1.0])
-def test_two_comparable_minima_far_apart_are_flagged(ratio):
+def test_two_comparable_minima_far_apart_are_flagged(ratio, dips):
     """Two sources: two dips 20 frames apart, the second `ratio` as deep."""
     result = run(dips(60, [20.0, 40.0], depth=[0.9, 0.9 * ratio]))
     check_invariants(result, 60)
     assert (result["reason"] == SEVERAL_MINIMA).all()
 
 
-def test_a_much_weaker_second_minimum_keeps_the_deeper_time():
+def test_a_much_weaker_second_minimum_keeps_the_deeper_time(dips):
     result = run(dips(60, [20.5, 40.0], depth=[0.9, 0.25]), method="dip_centroid")
     assert (result["reason"] == OK).all()
     np.testing.assert_allclose(result["shadow_time"], 20.5, atol=0.05)
 
 
 @pytest.mark.parametrize("gap", [6.0, 8.0])
-def test_two_equal_minima_closer_than_a_window_are_flagged(gap):
+def test_two_equal_minima_closer_than_a_window_are_flagged(gap, dips):
     result = run(dips(60, [25.0, 25.0 + gap]), half_window=4)
     assert (result["reason"] == SEVERAL_MINIMA).all()
 
@@ -167,7 +165,7 @@ def test_pixels_that_never_change_are_flagged_without_division_by_zero(level, me
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
-def test_a_corrupt_sample_far_from_the_dip_is_ignored(bad):
+def test_a_corrupt_sample_far_from_the_dip_is_ignored(bad, dips):
     frames = dips(40, 25.5)
     frames[3] = bad
     result = run(frames, method="dip_centroid")
@@ -176,7 +174,7 @@ def test_a_corrupt_sample_far_from_the_dip_is_ignored(bad):
     np.testing.assert_allclose(result["lit_level"], LEVEL, rtol=1e-6)
 
 
-def test_a_minus_inf_sample_far_from_the_dip_is_ignored():
+def test_a_minus_inf_sample_far_from_the_dip_is_ignored(dips):
     frames = dips(40, 25.5)
     frames[3] = -np.inf
     result = run(frames, method="dip_centroid")
@@ -184,7 +182,7 @@ def test_a_minus_inf_sample_far_from_the_dip_is_ignored():
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
-def test_a_corrupt_sample_inside_the_dip_is_flagged(bad):
+def test_a_corrupt_sample_inside_the_dip_is_flagged(bad, dips):
     frames = dips(40, 25.5)
     frames[25] = bad
     result = run(frames)
@@ -200,7 +198,7 @@ def test_a_corrupt_sample_inside_the_dip_is_flagged(bad):
                         max_size=4),
        half_window=st.integers(1, 6), method=st.sampled_from(METHODS), seed=st.integers(0, 99))
 def test_detectors_never_crash_never_leave_the_sweep_and_say_why(
-        n_frames, centre, width, depth, noise, corrupt, half_window, method, seed):
+        n_frames, centre, width, depth, noise, corrupt, half_window, method, seed, dips):
     frames = dips(n_frames, centre, width=width, depth=depth, shape=(5, 5))
     frames += np.random.default_rng(seed).normal(0, noise, frames.shape)
     for frame, value in corrupt:

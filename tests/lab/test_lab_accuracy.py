@@ -3,7 +3,6 @@
 import csv
 import io
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,7 +20,6 @@ from shadowcam.lab.accuracy import (
 from shadowcam.cameras.dual_coords import dual_coords_dataset, dual_coords_uniform
 from shadowcam.cameras.dual_view import dual_view_dataset, resample_dual_view
 
-DEV = Path("/work/shared/data/lab-dev/dev_spheres/gt.npz")
 
 
 def _truth(rows=40, cols=50, seed=0):
@@ -119,11 +117,10 @@ def test_report_end_to_end_and_serialisation(tmp_path):
     assert rows["targets.shadow_time_p95_frames.u.pass"] == "True"
 
 
-@pytest.mark.skipif(not DEV.exists(), reason="shared dev data not available")
-def test_exact_gt_coordinates_give_the_dual_image_floor():
+def test_exact_gt_coordinates_give_the_dual_image_floor(shared_data):
     # exact times -> exact dual coords; the remaining dual-image error is the floor of
     # resampling + the near-light photometry (README 1.7) that a gain cannot remove
-    gt = np.load(DEV)
+    gt = np.load(shared_data / "lab-dev" / "dev_spheres" / "gt.npz")
     img, cov = resample_dual_view(gt["reference_linear"], gt["t_u"], gt["t_v"], shape=(96, 96))
     out = dual_image_errors(img, cov, gt["reciprocal"], dual_cam_visible=gt["dual_cam_visible"])
     ratio = (gt["cos_C"] / gt["dist_C"] ** 2) / (gt["cos_L"] / gt["dist_L"] ** 2)

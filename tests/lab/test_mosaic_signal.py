@@ -1,18 +1,15 @@
 """The tracker's signal from the Bayer mosaic equals the channel sum of the demosaiced frame."""
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from dng_files import write_dng
 from shadowcam.io.cfa import site_constants
 from shadowcam.io.decode import read_frame
 from shadowcam.io.raw_mosaic import read_mosaic
 from shadowcam.lab.mosaic_signal import bilinear_channels, mosaic_signal
 from shadowcam.lab.sweep_files import track_files
 
-SHARED_RAW = Path("/work/shared/data/lab-dev/dev_spheres_raw/frames_u")
 PATTERNS = ("RGGB", "BGGR", "GRBG", "GBRG")
 
 
@@ -29,9 +26,9 @@ def _normalised(mosaic, levels):
 
 
 @pytest.mark.parametrize("pattern", PATTERNS)
-def test_signal_and_channels_equal_the_demosaiced_frame(tmp_path, pattern):
+def test_signal_and_channels_equal_the_demosaiced_frame(tmp_path, pattern, write_pidng):
     """Against OpenCV's bilinear demosaic in read_frame, every CFA phase, odd borders included."""
-    path = write_dng(tmp_path / "f.dng", _noisy_mosaic((30, 46), 1), pattern=pattern)
+    path = write_pidng(tmp_path / "f.dng", _noisy_mosaic((30, 46), 1), pattern=pattern)
     rgb = read_frame(path).astype(np.float64)
     mosaic, levels = read_mosaic(path)
     assert levels["cfa_pattern"] == pattern
@@ -44,9 +41,8 @@ def test_signal_and_channels_equal_the_demosaiced_frame(tmp_path, pattern):
                                rtol=0, atol=1e-7)
 
 
-@pytest.mark.skipif(not SHARED_RAW.is_dir(), reason="shared dev data not present")
-def test_signal_of_the_independent_renderers_dng():
-    path = SHARED_RAW / "000000.dng"
+def test_signal_of_the_independent_renderers_dng(shared_data):
+    path = shared_data / "lab-dev" / "dev_spheres_raw" / "frames_u" / "000000.dng"
     mosaic, levels = read_mosaic(path)
     signal, _ = mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
                               white=levels["white_sites"])
@@ -75,9 +71,9 @@ def test_bad_input_is_refused():
         mosaic_signal(np.zeros((4, 4), np.float32), pattern="RGGB", black=np.zeros((2, 2)), white=np.ones((2, 2)))
 
 
-def test_tracking_dng_files_from_the_mosaic_keeps_the_colour_sums(tmp_path):
+def test_tracking_dng_files_from_the_mosaic_keeps_the_colour_sums(tmp_path, write_pidng):
     """Per-channel sums of a RAW sweep equal the sums of its demosaiced frames."""
-    paths = [write_dng(tmp_path / f"f{k:02d}.dng", _noisy_mosaic((24, 32), k), pattern="BGGR") for k in range(12)]
+    paths = [write_pidng(tmp_path / f"f{k:02d}.dng", _noisy_mosaic((24, 32), k), pattern="BGGR") for k in range(12)]
     summary = track_files(paths, workers=2, block_frames=5)
     frames = np.stack([read_frame(p) for p in paths]).astype(np.float64)
     np.testing.assert_allclose(summary.channel_sum, frames.sum(axis=0), rtol=0, atol=1e-6)
@@ -97,9 +93,9 @@ def test_site_sums_accumulate_the_mosaic_exactly():
                       site_sum=np.zeros((10, 14), np.int32))
 
 
-def test_colour_sums_follow_each_frames_own_levels(tmp_path):
+def test_colour_sums_follow_each_frames_own_levels(tmp_path, write_pidng):
     """A camera may write another black level for some frames (rawpy reads those)."""
-    paths = [write_dng(tmp_path / f"f{k:02d}.dng", _noisy_mosaic((24, 32), k, black=black), black=black)
+    paths = [write_pidng(tmp_path / f"f{k:02d}.dng", _noisy_mosaic((24, 32), k, black=black), black=black)
              for k, black in enumerate([256, 256, 300, 256, 300, 256, 256, 256, 256, 300, 256, 256, 256, 256])]
     summary = track_files(paths, workers=2, block_frames=4)
     frames = np.stack([read_frame(p) for p in paths]).astype(np.float64)

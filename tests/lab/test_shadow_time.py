@@ -12,43 +12,6 @@ from shadowcam.lab.shadow_time import (
 )
 
 
-def wire_sweep(*, shape=(48, 64), n_frames=40, px_per_frame=2.0, width=2.0, t0=6.0,
-               tilt=0.3, supersample=8, seed=0, electrons=None, read_noise=0.0,
-               shadowed_box=None, albedo=None):
-    """Frames of a wire shadow sweeping a textured plane, with exact shadow times.
-
-    The shadow's centre line crosses image point (row y, col x) at time
-    ``t0 + (x + tilt * y) / px_per_frame`` (pixel centres at integer + 0.5);
-    the shadow is `width` frames wide (hard edged: point light, opaque wire).
-    Each pixel integrates ``supersample**2`` points. `shadowed_box` (r0, r1,
-    c0, c1) is a region in a scene object's cast shadow: never lit. `albedo`
-    (H, W, 3) replaces the default random texture (0.3 to 0.9).
-    Returns frames (T, H, W, 3) and the exact time at pixel centres (NaN unlit).
-    """
-    rng = np.random.default_rng(seed)
-    h, w = shape
-    offsets = (np.arange(supersample) + 0.5) / supersample
-    ys = np.arange(h)[:, None, None, None] + offsets[None, None, :, None]
-    xs = np.arange(w)[None, :, None, None] + offsets[None, None, None, :]
-    t_sub = t0 + (xs + tilt * ys) / px_per_frame  # (H, W, s, s)
-    if albedo is None:
-        albedo = 0.3 + 0.6 * rng.random((h, w, 3))
-    frames = np.empty((n_frames, h, w, 3), np.float32)
-    for k in range(n_frames):
-        lit_fraction = (np.abs(k - t_sub) >= width / 2).mean(axis=(2, 3))
-        frames[k] = albedo * lit_fraction[..., None]
-    gt = t0 + (np.arange(w)[None] + 0.5 + tilt * (np.arange(h)[:, None] + 0.5)) / px_per_frame
-    if shadowed_box is not None:
-        r0, r1, c0, c1 = shadowed_box
-        frames[:, r0:r1, c0:c1] = 0
-        gt[r0:r1, c0:c1] = np.nan
-    gt[(gt < 0) | (gt > n_frames - 1)] = np.nan
-    if electrons is not None:  # 12-bit sensor, 1 DN per electron, white = 4095 DN
-        dn = rng.poisson(frames * electrons) + rng.normal(0, read_noise, frames.shape)
-        frames = (np.clip(np.round(dn), -64, 4095) / 4095).astype(np.float32)
-    return frames, gt
-
-
 def run(frames, **kwargs):
     return sweep_shadow_times([frames[i:i + 7] for i in range(0, len(frames), 7)],
                               frames.shape[1:3], **kwargs)
@@ -60,14 +23,14 @@ def abs_error(result, gt):
     return err[np.isfinite(err)], np.isfinite(result["shadow_time"][valid]).mean()
 
 
-def test_edge_fit_is_sub_tenth_frame_on_clean_thin_wire():
+def test_edge_fit_is_sub_tenth_frame_on_clean_thin_wire(wire_sweep):
     frames, gt = wire_sweep()
     err, coverage = abs_error(run(frames, method="edge_fit"), gt)
     assert coverage > 0.98
     assert np.percentile(err, 95) <= 0.1
 
 
-def test_per_pixel_midpoint_crossing_is_limited_by_the_on_off_profile():
+def test_per_pixel_midpoint_crossing_is_limited_by_the_on_off_profile(wire_sweep):
     # two pixels per frame: each pixel's own profile is nearly on/off, so a purely
     # temporal estimate cannot reach a tenth of a frame (the reason for edge_fit)
     frames, gt = wire_sweep()
@@ -78,14 +41,14 @@ def test_per_pixel_midpoint_crossing_is_limited_by_the_on_off_profile():
 
 
 @pytest.mark.parametrize("method", sorted(SHADOW_TIME_METHODS))
-def test_every_method_is_within_half_a_frame_on_clean_data(method):
+def test_every_method_is_within_half_a_frame_on_clean_data(method, wire_sweep):
     frames, gt = wire_sweep(px_per_frame=0.7, seed=2)
     err, coverage = abs_error(run(frames, method=method), gt)
     assert coverage > 0.95
     assert np.percentile(err, 95) < 0.5
 
 
-def test_noisy_low_light_12bit_meets_target_and_rejects_unlit():
+def test_noisy_low_light_12bit_meets_target_and_rejects_unlit(wire_sweep):
     box = (10, 30, 20, 40)
     frames, gt = wire_sweep(electrons=80.0, read_noise=6.0, shadowed_box=box, seed=4)
     result = run(frames, method="edge_fit")
@@ -98,7 +61,7 @@ def test_noisy_low_light_12bit_meets_target_and_rejects_unlit():
     assert set(np.unique(result["reason"][r0 + 1:r1 - 1, c0 + 1:c1 - 1])) <= {LOW_CONTRAST, NEVER_SHADOWED}
 
 
-def test_high_contrast_texture_is_not_taken_for_a_cast_shadow_boundary():
+def test_high_contrast_texture_is_not_taken_for_a_cast_shadow_boundary(wire_sweep):
     # grey albedo log-uniform over 0.1..0.8 per pixel: neighbours differ up to 8x,
     # but every pixel is fully lit, so every one must get its time
     rng = np.random.default_rng(11)
@@ -119,7 +82,7 @@ def test_constant_pixels_are_flagged_without_warnings():
     assert (result["reason"][:, :4] == LOW_CONTRAST).all()
 
 
-def test_saturated_and_invalid_pixels_say_why():
+def test_saturated_and_invalid_pixels_say_why(wire_sweep):
     frames, gt = wire_sweep(shape=(16, 16), n_frames=30, px_per_frame=1.0)
     frames[:, 0:3, 0:3, 0] = 1.0  # clipped red channel
     frames[12, 10, 10, :] = np.nan  # corrupt sample inside the dip window
@@ -132,7 +95,7 @@ def test_saturated_and_invalid_pixels_say_why():
     assert np.isnan(result["shadow_time"][result["reason"] != OK]).all()
 
 
-def test_two_minima_are_flagged():
+def test_two_minima_are_flagged(wire_sweep):
     frames, gt = wire_sweep(shape=(16, 16), n_frames=60, px_per_frame=1.0, t0=5.0)
     frames[45:47] *= 0.2  # a second source's shadow crosses every pixel later
     result = run(frames)
@@ -172,7 +135,7 @@ def test_cfa_site_colours_follow_the_pattern():
         cfa_site_colours((4, 4), "RGXB")
 
 
-def test_dataset_has_units_and_flag_meanings():
+def test_dataset_has_units_and_flag_meanings(wire_sweep):
     frames, _ = wire_sweep(shape=(12, 12), n_frames=20, px_per_frame=1.0)
     ds = shadow_time_dataset({"u": run(frames), "v": run(frames)})
     assert ds["shadow_time"].dims == ("sweep", "row", "col")

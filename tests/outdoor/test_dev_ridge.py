@@ -23,12 +23,10 @@ from shadowcam.outdoor.normalise import normalise_frames
 from shadowcam.outdoor.tracking import track_frames
 
 REPO = Path(__file__).resolve().parents[2]
-DATA = Path("/work/shared/data/outdoor-dev/dev_ridge")
-pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason="shared dev data not present")
 
 
 @pytest.fixture(scope="module")
-def run():
+def run(shared_data):  # the repository manifest reads the shared dev data
     manifest = load_manifest(REPO / "data_manifest" / "dev_ridge.yaml")
     sweep = manifest["sweeps"]["timelapse"]
     time_s = np.asarray(sweep["times_s"])

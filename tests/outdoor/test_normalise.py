@@ -20,7 +20,6 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from outdoor_scene import make_timelapse
 from shadowcam.cli import main
 from shadowcam.io.images import write_netcdf
 from shadowcam.outdoor.datasets import photometry_part_dataset
@@ -74,7 +73,7 @@ def _parts(frames, size, overlap=2):
     return parts
 
 
-def test_time_parts_merge_to_the_single_job():
+def test_time_parts_merge_to_the_single_job(make_timelapse):
     scene = make_timelapse(seed=4, **NUISANCES)
     frames = scene["frames"]
     single = normalise_frames(iter(frames))
@@ -99,7 +98,7 @@ def test_time_parts_merge_to_the_single_job():
     np.testing.assert_allclose(merged["shift"], scene["shift"] - scene["shift"][0], atol=0.05)
 
 
-def test_parts_must_cover_the_frames_and_warm_up():
+def test_parts_must_cover_the_frames_and_warm_up(make_timelapse):
     scene = make_timelapse(seed=3, n_frames=12)
     parts = _parts(scene["frames"], 4)
     with pytest.raises(ValueError, match="consecutive"):
@@ -126,7 +125,7 @@ def test_large_shake_on_reduced_frames_is_recovered_coarse_to_fine():
     assert np.abs(single["shift"] - shake).max() > 5  # one level: out of range
 
 
-def test_merge_step_reads_the_part_datasets_and_equals_merge_parts(tmp_path):
+def test_merge_step_reads_the_part_datasets_and_equals_merge_parts(tmp_path, make_timelapse):
     scene = make_timelapse(seed=5, n_frames=14, **NUISANCES)
     frames, time_s = scene["frames"], scene["time_s"]
     parts = _parts(frames, 5)
@@ -149,7 +148,7 @@ def test_merge_step_reads_the_part_datasets_and_equals_merge_parts(tmp_path):
     assert not (tmp_path / "gap.nc").exists()
 
 
-def test_soft_shadow_edge_needs_a_margin_of_its_width():
+def test_soft_shadow_edge_needs_a_margin_of_its_width(make_timelapse):
     # a scene upsampled 8x: the moving shadow edge is an 8 px ramp, the camera does not move
     scene = make_timelapse(n_frames=8, seed=2, speed=1.0)
     factor = 8

@@ -8,7 +8,6 @@ arrival map, against the analytic arrival time of every pixel centre.
 import numpy as np
 import pytest
 
-from outdoor_scene import make_timelapse
 from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals
 from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
 from shadowcam.outdoor.accuracy import arrival_errors
@@ -32,7 +31,7 @@ def _run(scene):
     return photometry, tracked, stats
 
 
-def test_clean_scene_meets_the_clean_targets_with_margin():
+def test_clean_scene_meets_the_clean_targets_with_margin(make_timelapse):
     scene = make_timelapse(seed=3)
     photometry, tracked, stats = _run(scene)
     assert stats["coverage"] == 1.0
@@ -42,7 +41,7 @@ def test_clean_scene_meets_the_clean_targets_with_margin():
     assert np.median(np.abs(tracked["edge_row"] - scene["edge_row"])[found]) < 0.02  # pixels
 
 
-def test_nuisances_exposure_shake_noise_sunset_irregular_and_dropped_frames():
+def test_nuisances_exposure_shake_noise_sunset_irregular_and_dropped_frames(make_timelapse):
     scene = make_timelapse(seed=4, **NUISANCES)
     photometry, _, stats = _run(scene)
     np.testing.assert_allclose(photometry["shift"], scene["shift"], atol=0.05)  # pixels
@@ -51,7 +50,7 @@ def test_nuisances_exposure_shake_noise_sunset_irregular_and_dropped_frames():
     assert stats["median_abs"] <= 0.15 and stats["p95_abs"] <= 0.5 and stats["frac_over_5"] == 0
 
 
-def test_a_cloud_frame_is_interpolated_between_keyframes():
+def test_a_cloud_frame_is_interpolated_between_keyframes(make_timelapse):
     scene = make_timelapse(seed=5)
     frames = scene["frames"].copy()
     frames[20, 6:, :40] *= np.float32(0.3)  # a cloud shadows most of the terrain in frame 20

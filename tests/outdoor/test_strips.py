@@ -13,13 +13,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from outdoor_scene import make_timelapse
 from shadowcam.outdoor.normalise import normalise_frames
 from shadowcam.outdoor.strips import merge_strips, strip_bounds, strip_halo, strip_window, track_strip
 from shadowcam.outdoor.tracking import track_frames
 
 REPO = Path(__file__).resolve().parents[2]
-DATA = Path("/work/shared/data/outdoor-dev/dev_ridge")
 
 
 def _assert_identical(merged, single):
@@ -40,7 +38,7 @@ def _strips(frames, photometry, time_s, n_strips, **options):
 
 
 @pytest.fixture(scope="module")
-def shaken():
+def shaken(make_timelapse):
     scene = make_timelapse(width=70, n_frames=30, shake=2.5, noise=True, gain_steps=True, slope=0.3, seed=5)
     photometry = normalise_frames(iter(scene["frames"]))
     assert np.abs(photometry["shift"][:, 1]).max() > 1.5  # the halo matters
@@ -84,7 +82,7 @@ def test_strip_layout_is_validated(shaken):
         track_strip((f[:, :10] for f in scene["frames"]), photometry, scene["time_s"], cols=(30, 40))
 
 
-@pytest.mark.skipif(not DATA.is_dir(), reason="shared dev data not present")
+@pytest.mark.usefixtures("shared_data")  # the repository manifest reads the shared dev data
 def test_strips_of_dev_ridge_equal_the_single_job():
     from shadowcam.io.decode import iter_frames
     from shadowcam.io.manifest import load_manifest
@@ -99,16 +97,14 @@ def test_strips_of_dev_ridge_equal_the_single_job():
         _assert_identical(merge_strips(_strips(frames, photometry, time_s, n_strips, guard=0)), single)
 
 
-@pytest.mark.skipif(not DATA.is_dir(), reason="shared dev data not present")
-def test_workflow_strips_give_the_same_edges_nc_as_one_job(tmp_path):
+@pytest.mark.slow  # runs the workflow (Snakemake) on dev_ridge
+def test_workflow_strips_give_the_same_edges_nc_as_one_job(tmp_path, shared_data, snakemake, workflow_copy):
     import xarray as xr
     import yaml
 
-    from conftest import snakemake, workflow_copy
-
     workdir = workflow_copy(tmp_path / "wf")
     manifest = yaml.safe_load((REPO / "data_manifest" / "dev_ridge.yaml").read_text())
-    manifest["root"] = str(DATA)
+    manifest["root"] = str(shared_data / "outdoor-dev" / "dev_ridge")
     (workdir / "data_manifest" / "dev_ridge.yaml").write_text(yaml.safe_dump(manifest))
     edges = workdir / "results" / "dev_ridge" / "outdoor" / "edges.nc"
     loaded = {}

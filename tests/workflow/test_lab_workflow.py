@@ -9,23 +9,25 @@ truth written by the renderer.
 import json
 import re
 import subprocess
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 import yaml
 
-from conftest import BIN, snakemake, workflow_copy
-
 DS = "synthetic_tiny"
 DATASETS = f"datasets=[{DS}]"
 FRAMES = 24  # frames per sweep of synthetic_tiny = dual grid size
 DAG_SECONDS = 120
+BIN = Path(sys.executable).parent  # this environment's shadowcam and snakemake
+pytestmark = pytest.mark.slow  # runs the whole DAG
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
+def run(tmp_path_factory, workflow_copy, snakemake):
     """Scratch working directory after running the whole DAG; and its wall time (s)."""
     workdir = workflow_copy(tmp_path_factory.mktemp("workflow"))
     start = time.perf_counter()
@@ -55,7 +57,7 @@ def open_nc(run, name):
         return ds.load()
 
 
-def planned_jobs(workdir, *extra):
+def planned_jobs(snakemake, workdir, *extra):
     """Rule name -> job count of a dry run."""
     result = snakemake(["-n", "--cores", "1", "--config", DATASETS, *extra], workdir)
     assert result.returncode == 0, result.stdout[-3000:]
@@ -148,7 +150,7 @@ def test_accuracy_and_figures_written(run):
         assert (workdir / "logs" / DS / f"{rule}.log").is_file()
 
 
-def test_report_shows_every_figure(run):
+def test_report_shows_every_figure(run, snakemake):
     workdir, _ = run
     result = snakemake(["--cores", "1", "--config", DATASETS, "--report", "report.html"],
                        workdir)
@@ -159,9 +161,9 @@ def test_report_shows_every_figure(run):
         assert name in page
 
 
-def test_nothing_to_do_after_a_run(run):
+def test_nothing_to_do_after_a_run(run, snakemake):
     workdir, _ = run
-    assert planned_jobs(workdir) == {}
+    assert planned_jobs(snakemake, workdir) == {}
 
 
 @pytest.mark.parametrize(
@@ -177,18 +179,18 @@ def test_nothing_to_do_after_a_run(run):
           "accuracy", "report_figures"}),
     ],
 )
-def test_params_change_reruns_what_it_affects(run, section, change, rerun):
+def test_params_change_reruns_what_it_affects(run, section, change, rerun, snakemake):
     workdir, _ = run
     config = yaml.safe_load((workdir / "config" / "config.yaml").read_text())
     config[section].update(change)
     changed = workdir / "config" / f"changed_{section}.yaml"
     changed.write_text(yaml.safe_dump(config))
-    jobs = planned_jobs(workdir, "--configfile", str(changed))
+    jobs = planned_jobs(snakemake, workdir, "--configfile", str(changed))
     jobs.pop("all", None)
     assert set(jobs) == rerun
 
 
-def test_lint_is_clean(tmp_path):
+def test_lint_is_clean(tmp_path, workflow_copy, snakemake):
     result = snakemake(["--lint"], workflow_copy(tmp_path))
     assert result.returncode == 0, result.stdout[-3000:]
     assert "Congratulations" in result.stdout

@@ -12,6 +12,7 @@
 import os
 import signal
 import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -19,14 +20,13 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
-from conftest import BIN, snakemake, workflow_copy
-from test_chunking import sweep_manifest
-from test_frame_store import make_frames
 
 from shadowcam.io import frame_store
 from shadowcam.io.frame_store import merge_frame_stores, open_frames, write_frames
 
 DS = "synthetic_tiny"
+BIN = Path(sys.executable).parent  # this environment's shadowcam and snakemake
+pytestmark = pytest.mark.slow  # kills and restarts the CLI and the workflow
 SWEEPS = ("u", "v", "cal_u", "cal_v")
 PARTS = {"decode": {"chunk_frames": 6, "chunks_per_job": 2}}
 
@@ -57,7 +57,7 @@ def group_processes(pgid, *words):
     return pids
 
 
-def test_killed_decode_leaves_no_store_and_rerun_is_identical(tmp_path):
+def test_killed_decode_leaves_no_store_and_rerun_is_identical(tmp_path, make_frames, sweep_manifest):
     paths, expected = make_frames(tmp_path / "data" / "u", 60, shape=(256, 256, 3))
     manifest = sweep_manifest(tmp_path, rate_hz=1.0)
     out = tmp_path / "u.zarr"
@@ -79,7 +79,7 @@ def test_killed_decode_leaves_no_store_and_rerun_is_identical(tmp_path):
     np.testing.assert_array_equal(open_frames(out)["image"].values, expected)
 
 
-def test_failed_merge_leaves_nothing(tmp_path, monkeypatch):
+def test_failed_merge_leaves_nothing(tmp_path, monkeypatch, make_frames):
     paths, _ = make_frames(tmp_path / "frames", 8)
     times = np.arange(8.0)
     parts = [write_frames(paths[s:s + 4], tmp_path / f"p{s}.zarr", times_s=times[s:s + 4], chunk_frames=2,
@@ -109,8 +109,7 @@ def start_workflow(workdir):
     )
 
 
-@pytest.mark.slow
-def test_workflow_killed_and_restarted_equals_uninterrupted(tmp_path):
+def test_workflow_killed_and_restarted_equals_uninterrupted(tmp_path, workflow_copy, snakemake):
     workdir = workflow_copy(tmp_path / "wf")
     (workdir / "parts.yaml").write_text(yaml.safe_dump(PARTS))
     frames = workdir / "results" / DS / "frames"

@@ -24,16 +24,17 @@ import re
 import shutil
 import subprocess
 import time
+from pathlib import Path
 
 import pytest
 import xarray as xr
 import yaml
-from conftest import REPO, snakemake, workflow_copy
 
 from shadowcam.io.frame_store import open_frames
 
 pytestmark = [pytest.mark.slurm, pytest.mark.slow]
 
+REPO = Path(__file__).resolve().parents[2]
 SCRIPT = REPO / "scripts" / "slurm_cluster.sh"
 DS = "synthetic_tiny"
 SWEEPS = ("u", "v", "cal_u", "cal_v")
@@ -67,7 +68,7 @@ def cluster():
         subprocess.run([str(SCRIPT), "stop"], check=True, capture_output=True, timeout=120)
 
 
-def run_workflow(workdir, *args):
+def run_workflow(snakemake, workdir, *args):
     """Run the whole DAG of `DS` in `workdir`; return (stdout, wall seconds)."""
     start = time.perf_counter()
     result = snakemake([*args, "--config", f"datasets=[{DS}]"], workdir, timeout=900)
@@ -77,13 +78,13 @@ def run_workflow(workdir, *args):
 
 
 @pytest.fixture(scope="module")
-def runs(cluster, tmp_path_factory):
+def runs(cluster, tmp_path_factory, workflow_copy, snakemake):
     """(local workdir, SLURM workdir, SLURM stdout, wall times)."""
     local = workflow_copy(tmp_path_factory.mktemp("local"))
-    _, local_s = run_workflow(local, "--profile", "profiles/local")
+    _, local_s = run_workflow(snakemake, local, "--profile", "profiles/local")
     remote = workflow_copy(tmp_path_factory.mktemp("slurm"))
     (remote / "parts.yaml").write_text(yaml.safe_dump(PARTS))
-    stdout, slurm_s = run_workflow(
+    stdout, slurm_s = run_workflow(snakemake, 
         remote, "--profile", "profiles/slurm", "--configfile", "config/config.yaml", "parts.yaml",
         # the status poll interval grows while nothing finishes; poll fast for seconds-long jobs
         "--slurm-init-seconds-before-status-checks", "2",
