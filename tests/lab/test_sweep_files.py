@@ -10,6 +10,7 @@ from shadowcam.evaluate.speed_benchmark import WireScene, write_sweep_dngs
 from shadowcam.lab.dip_tracker import DipSummary
 from shadowcam.lab.sweep_files import chunk_bounds, sweep_shadow_times_from_files, track_files
 
+# the library's WireScene, not the wire_sweep fixture: write_sweep_dngs renders its DNG files from it
 SCENE = WireScene(height=48, width_px=64, n_frames=40, px_per_frame=2.5, t0=4.0, seed=3)
 
 
