@@ -2,10 +2,10 @@
 # unshadowed reference frame (when the capture has one) into its own store.
 # A sweep is decoded in time parts, one job each (decode_part: frames START:STOP into
 # a part store); `decode` joins the parts by hard-linking their chunk files, so the
-# sweep store equals a single-job decode bit for bit. Part sizes: common.smk.
+# sweep store equals a single-job decode bit for bit. Part sizes: parts.smk.
 
-# reference.zarr is a single image, not a sweep: decode_reference makes it.
-ruleorder: decode_reference > decode
+# reference.zarr is a single image, not a sweep (wildcard `sweep` never matches it):
+# decode_reference makes it.
 
 
 rule decode_part:

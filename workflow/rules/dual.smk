@@ -36,7 +36,7 @@ rule dual_view:
         exr="results/{ds}/dual_view.exr",
         png="results/{ds}/dual_view.png",
     params:
-        reference=get_reference_option,
+        reference=get_flag("--reference", "reference"),
         method=config["dual_view"]["method"],
         options=as_json(config["dual_view"]["params"]),
     resources:

@@ -29,7 +29,7 @@ rule methods_comparison:
     params:
         manifest=get_capture_manifest,
         sweeps=get_scene_sweeps,
-        reference=get_reference_option,
+        reference=get_flag("--reference", "reference"),
         options=get_methods_params,
     log:
         "logs/{ds}/methods_comparison.log",

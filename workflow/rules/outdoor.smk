@@ -1,5 +1,5 @@
 # Stages of an outdoor time-lapse (manifest kind: outdoor): registration and
-# photometric normalisation (one job per time part of config outdoor.part_frames
+# photometric normalisation (one job per time span of config outdoor.part_frames
 # frames, then an exact merge), shadow-edge tracking with keyframe interpolation
 # (one job per column strip of config outdoor.edge_strips, merged exactly),
 # the per-pixel arrival-time map, the ridge pushbroom, accuracy (datasets with
@@ -12,26 +12,24 @@ rule outdoor_normalise_part:
         capture=get_capture_input,
         frames=get_outdoor_frames,
     output:
-        temp("results/{ds}/outdoor/photometry.parts/{part}.nc"),
+        temp("results/{ds}/outdoor/photometry.parts/{span}.nc"),
     params:
         manifest=get_capture_manifest,
-        part=get_outdoor_part_range,
+        span=get_outdoor_span_range,
         options=as_json(config["outdoor"]["normalise"]),
-    wildcard_constraints:
-        part=r"\d+-(\d+|end)",  # START-STOP, not the 4-digit decode parts of common.smk
     resources:
-        mem_mb=outdoor_mem_mb("normalise"),
-        runtime=outdoor_runtime("normalise"),
+        mem_mb=get_normalise_mem_mb,
+        runtime=get_normalise_runtime,
     threads: 1
     log:
-        "logs/{ds}/outdoor_normalise_part{part}.log",
+        "logs/{ds}/outdoor_normalise_span{span}.log",
     benchmark:
-        "benchmarks/{ds}/outdoor_normalise_part{part}.tsv"
+        "benchmarks/{ds}/outdoor_normalise_span{span}.tsv"
     conda:
         "../envs/shadowcam.yaml"
     shell:
         "shadowcam outdoor-normalise --manifest {params.manifest} --frames {input.frames}"
-        " --part {params.part} --params {params.options:q} --out {output} > {log} 2>&1"
+        " --part {params.span} --params {params.options:q} --out {output} > {log} 2>&1"
 
 
 rule outdoor_normalise:
@@ -40,7 +38,7 @@ rule outdoor_normalise:
     output:
         "results/{ds}/outdoor/photometry.nc",
     resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
+        mem_mb=get_per_pixel_mem_mb,
         runtime=10,
     threads: 1
     log:
@@ -62,11 +60,9 @@ rule track_edges_strip:
     params:
         strip=get_edge_strip_arg,
         options=as_json(config["outdoor"]["track_edges"]),
-    wildcard_constraints:
-        strip=r"\d+",
     resources:
-        mem_mb=outdoor_mem_mb("track_strip"),
-        runtime=outdoor_runtime("track_strip"),
+        mem_mb=get_track_strip_mem_mb,
+        runtime=get_track_strip_runtime,
     threads: 1
     log:
         "logs/{ds}/track_edges_strip{strip}.log",
@@ -88,10 +84,10 @@ rule track_edges:
         "results/{ds}/outdoor/edges.nc",
     params:
         options=as_json(config["outdoor"]["track_edges"]),
-        strips=get_edge_strips_option,
+        strips=get_flag("--strips", "strips"),
     resources:
-        mem_mb=outdoor_mem_mb("track"),
-        runtime=outdoor_runtime("track"),
+        mem_mb=get_track_edges_mem_mb,
+        runtime=get_track_edges_runtime,
     threads: 1
     log:
         "logs/{ds}/track_edges.log",
@@ -113,8 +109,8 @@ rule arrival:
     params:
         options=as_json(config["outdoor"]["arrival"]),
     resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
     threads: 1
     log:
         "logs/{ds}/arrival.log",
@@ -135,8 +131,8 @@ rule pushbroom:
         nc="results/{ds}/outdoor/pushbroom.nc",
         png="results/{ds}/outdoor/pushbroom.png",
     resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
     threads: 1
     log:
         "logs/{ds}/pushbroom.log",
@@ -170,8 +166,8 @@ rule outdoor_accuracy:
         manifest=get_capture_manifest,
         options=as_json(config["outdoor"]["accuracy"]),
     resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
     threads: 1
     log:
         "logs/{ds}/outdoor_accuracy.log",
@@ -204,10 +200,10 @@ rule outdoor_figures:
             labels={"dataset": "{ds}", "figure": "{figure}"},
         ),
     params:
-        accuracy=get_outdoor_accuracy_option,
+        accuracy=get_flag("--accuracy", "accuracy"),
     resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
     threads: 1
     log:
         "logs/{ds}/outdoor_figures.log",

@@ -20,8 +20,8 @@ rule report_figures:
         ),
     params:
         manifest=get_capture_manifest,
-        reference=get_reference_option,
-        accuracy=get_accuracy_option,
+        reference=get_flag("--reference", "reference"),
+        accuracy=get_flag("--accuracy", "accuracy"),
     resources:
         mem_mb=get_image_mem_mb,
         runtime=15,
