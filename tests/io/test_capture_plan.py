@@ -116,9 +116,10 @@ def test_recursive_glob_counts_what_decode_decodes(tmp_path):
 
 
 def test_missing_timing_raises_the_schema_message(lab):
-    doc = lab_doc()
+    path = write_capture(lab, lab_doc())
+    doc = yaml.safe_load(path.read_text())
     del doc["timing"]
-    path = write_capture(lab, doc)
+    path.write_text(yaml.safe_dump(doc))
     with pytest.raises(ValueError, match=r"manifest .*cap\.yaml does not match the schema") as info:
         capture_plan(path)
     assert "'timing' is a dependency of 'sweeps'" in str(info.value)
