@@ -37,6 +37,6 @@ localrules:
 
 
 rule all:
+    default_target: True
     input:
         get_final_targets,
-    default_target: True

@@ -185,7 +185,9 @@ def get_scene_sweeps(wildcards):
 
 def get_scene_frames(wildcards):
     """Decoded frame stores of the scene sweeps (u, v), in `get_scene_sweeps` order."""
-    return [f"results/{wildcards.ds}/frames/{s}.zarr" for s in get_scene_sweeps(wildcards)]
+    return [
+        f"results/{wildcards.ds}/frames/{s}.zarr" for s in get_scene_sweeps(wildcards)
+    ]
 
 
 def get_methods_params(wildcards):

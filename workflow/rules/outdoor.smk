@@ -13,20 +13,20 @@ rule outdoor_normalise_part:
         frames=get_outdoor_frames,
     output:
         temp("results/{ds}/outdoor/photometry.parts/{span}.nc"),
-    params:
-        manifest=get_capture_manifest,
-        span=get_outdoor_span_range,
-        options=as_json(config["outdoor"]["normalise"]),
-    resources:
-        mem_mb=get_normalise_mem_mb,
-        runtime=get_normalise_runtime,
-    threads: 1
     log:
         "logs/{ds}/outdoor_normalise_span{span}.log",
     benchmark:
         "benchmarks/{ds}/outdoor_normalise_span{span}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_normalise_mem_mb,
+        runtime=get_normalise_runtime,
+    params:
+        manifest=get_capture_manifest,
+        span=get_outdoor_span_range,
+        options=as_json(config["outdoor"]["normalise"]),
     shell:
         "shadowcam outdoor-normalise --manifest {params.manifest} --frames {input.frames}"
         " --part {params.span} --params {params.options:q} --out {output} > {log} 2>&1"
@@ -37,16 +37,16 @@ rule outdoor_normalise:
         get_outdoor_photometry_parts,
     output:
         "results/{ds}/outdoor/photometry.nc",
-    resources:
-        mem_mb=get_per_pixel_mem_mb,
-        runtime=10,
-    threads: 1
     log:
         "logs/{ds}/outdoor_normalise.log",
     benchmark:
         "benchmarks/{ds}/outdoor_normalise.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=10,
     shell:
         "shadowcam outdoor-merge-photometry --parts {input} --out {output} > {log} 2>&1"
 
@@ -57,19 +57,19 @@ rule track_edges_strip:
         photometry="results/{ds}/outdoor/photometry.nc",
     output:
         temp("results/{ds}/outdoor/edges.strips/{strip}.npz"),
-    params:
-        strip=get_edge_strip_arg,
-        options=as_json(config["outdoor"]["track_edges"]),
-    resources:
-        mem_mb=get_track_strip_mem_mb,
-        runtime=get_track_strip_runtime,
-    threads: 1
     log:
         "logs/{ds}/track_edges_strip{strip}.log",
     benchmark:
         "benchmarks/{ds}/track_edges_strip{strip}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_track_strip_mem_mb,
+        runtime=get_track_strip_runtime,
+    params:
+        strip=get_edge_strip_arg,
+        options=as_json(config["outdoor"]["track_edges"]),
     shell:
         "shadowcam track-edges-strip --frames {input.frames} --photometry {input.photometry}"
         " --strip {params.strip} --params {params.options:q} --out {output} > {log} 2>&1"
@@ -82,19 +82,19 @@ rule track_edges:
         strips=get_edge_strips,
     output:
         "results/{ds}/outdoor/edges.nc",
-    params:
-        options=as_json(config["outdoor"]["track_edges"]),
-        strips=get_flag("--strips", "strips"),
-    resources:
-        mem_mb=get_track_edges_mem_mb,
-        runtime=get_track_edges_runtime,
-    threads: 1
     log:
         "logs/{ds}/track_edges.log",
     benchmark:
         "benchmarks/{ds}/track_edges.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_track_edges_mem_mb,
+        runtime=get_track_edges_runtime,
+    params:
+        options=as_json(config["outdoor"]["track_edges"]),
+        strips=get_flag("--strips", "strips"),
     shell:
         "shadowcam track-edges --frames {input.frames} --photometry {input.photometry}"
         " {params.strips} --params {params.options:q} --out {output} > {log} 2>&1"
@@ -106,18 +106,18 @@ rule arrival:
         edges="results/{ds}/outdoor/edges.nc",
     output:
         "results/{ds}/outdoor/arrival.nc",
-    params:
-        options=as_json(config["outdoor"]["arrival"]),
-    resources:
-        mem_mb=get_per_pixel_mem_mb,
-        runtime=get_per_pixel_runtime,
-    threads: 1
     log:
         "logs/{ds}/arrival.log",
     benchmark:
         "benchmarks/{ds}/arrival.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
+    params:
+        options=as_json(config["outdoor"]["arrival"]),
     shell:
         "shadowcam arrival --photometry {input.photometry} --edges {input.edges}"
         " --params {params.options:q} --out {output} > {log} 2>&1"
@@ -130,16 +130,16 @@ rule pushbroom:
     output:
         nc="results/{ds}/outdoor/pushbroom.nc",
         png="results/{ds}/outdoor/pushbroom.png",
-    resources:
-        mem_mb=get_per_pixel_mem_mb,
-        runtime=get_per_pixel_runtime,
-    threads: 1
     log:
         "logs/{ds}/pushbroom.log",
     benchmark:
         "benchmarks/{ds}/pushbroom.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
     shell:
         "shadowcam pushbroom --photometry {input.photometry} --edges {input.edges}"
         " --out {output.nc} --png {output.png} > {log} 2>&1"
@@ -162,19 +162,19 @@ rule outdoor_accuracy:
             subcategory="accuracy",
             labels={"dataset": "{ds}", "table": "outdoor accuracy (CSV)"},
         ),
-    params:
-        manifest=get_capture_manifest,
-        options=as_json(config["outdoor"]["accuracy"]),
-    resources:
-        mem_mb=get_per_pixel_mem_mb,
-        runtime=get_per_pixel_runtime,
-    threads: 1
     log:
         "logs/{ds}/outdoor_accuracy.log",
     benchmark:
         "benchmarks/{ds}/outdoor_accuracy.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
+    params:
+        manifest=get_capture_manifest,
+        options=as_json(config["outdoor"]["accuracy"]),
     shell:
         "shadowcam outdoor-accuracy --manifest {params.manifest} --frames {input.frames}"
         " --photometry {input.photometry} --edges {input.edges} --arrival {input.arrival}"
@@ -199,18 +199,18 @@ rule outdoor_figures:
             subcategory="figures",
             labels={"dataset": "{ds}", "figure": "{figure}"},
         ),
-    params:
-        accuracy=get_flag("--accuracy", "accuracy"),
-    resources:
-        mem_mb=get_per_pixel_mem_mb,
-        runtime=get_per_pixel_runtime,
-    threads: 1
     log:
         "logs/{ds}/outdoor_figures.log",
     benchmark:
         "benchmarks/{ds}/outdoor_figures.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
+    params:
+        accuracy=get_flag("--accuracy", "accuracy"),
     shell:
         "shadowcam outdoor-figures --frames {input.frames} --photometry {input.photometry}"
         " --edges {input.edges} --arrival {input.arrival} --pushbroom {input.pushbroom}"

@@ -65,7 +65,9 @@ def get_decode_runtime(wildcards, attempt):
 
 def get_shadow_time_mem_mb(wildcards, attempt):
     """shadow_time: the merged summaries and per-sweep maps of every sweep."""
-    maps = len(get_sweeps(wildcards)) * _pixels(wildcards.ds) * SHADOW_TIME_BYTES_PER_PIXEL
+    maps = (
+        len(get_sweeps(wildcards)) * _pixels(wildcards.ds) * SHADOW_TIME_BYTES_PER_PIXEL
+    )
     return attempt * math.ceil(BASE_MEM_MB + maps / 2**20)
 
 
@@ -114,7 +116,11 @@ def _outdoor_megapixels(wildcards, stage):
 def _outdoor_frames(wildcards, stage):
     """Frames an outdoor job of `stage` handles (a first-pass span: warm-up and reference too)."""
     n_frames = outdoor_frame_count(wildcards.ds)
-    if stage == "normalise" and n_frames is not None and not wildcards.span.endswith("end"):
+    if (
+        stage == "normalise"
+        and n_frames is not None
+        and not wildcards.span.endswith("end")
+    ):
         start, stop = (int(v) for v in wildcards.span.split("-"))
         return stop - start + 3
     return n_frames or OUTDOOR_UNKNOWN_FRAMES
@@ -128,7 +134,9 @@ def _outdoor_mem_mb(wildcards, attempt, stage):
 def _outdoor_runtime(wildcards, attempt, stage):
     """3x the measured rate, at least 10 minutes."""
     rate = OUTDOOR_S_PER_MP_FRAME[_outdoor_stage(stage)]
-    seconds = rate * _outdoor_megapixels(wildcards, stage) * _outdoor_frames(wildcards, stage)
+    seconds = (
+        rate * _outdoor_megapixels(wildcards, stage) * _outdoor_frames(wildcards, stage)
+    )
     return attempt * max(10, int(3 * seconds / 60) + 1)
 
 

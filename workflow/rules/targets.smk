@@ -1,4 +1,4 @@
-# Final outputs of each configured dataset (rule `all`): a lab capture ends in shadow
+# Final outputs of each configured dataset (inputs of `all`); a lab capture ends in shadow
 # times, dual coordinates, the dual view and figures; an outdoor time-lapse in the
 # arrival-time map, the ridge pushbroom and figures; both add accuracy when the dataset
 # has ground truth. Stages a dataset does not need are not asked for.
