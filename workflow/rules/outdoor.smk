@@ -14,9 +14,9 @@ rule outdoor_normalise_part:
     output:
         temp("results/{ds}/outdoor/photometry.parts/{span}.nc"),
     log:
-        "logs/{ds}/outdoor_normalise_span{span}.log",
+        "logs/{ds}/outdoor_normalise_part{span}.log",
     benchmark:
-        "benchmarks/{ds}/outdoor_normalise_span{span}.tsv"
+        "benchmarks/{ds}/outdoor_normalise_part{span}.tsv"
     conda:
         "../envs/shadowcam.yaml"
     threads: 1
