@@ -1,5 +1,5 @@
 # shadowcam: `make demo` runs the default synthetic dataset end to end and builds the
-# report; `make test` runs the test suite; `make lint` lints the workflow;
+# report; `make test` runs the test suite; `make lint` lints the workflow (snakemake --lint, snakefmt --check);
 # `make bench-outdoor` reruns the outdoor pipeline on dev_ridge and prints per-stage
 # wall time / peak memory and the arrival-time accuracy (ours and the naive baseline);
 # `make bench-outdoor-size` the same stages at a camera's size (24 MP by default), extrapolated.
@@ -92,6 +92,7 @@ bench-outdoor-size: $(STAMP)
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint
+	$(BIN)/snakefmt --check Snakefile workflow
 
 clean:
 	rm -rf results logs benchmarks .snakemake

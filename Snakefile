@@ -1,7 +1,8 @@
 # shadowcam workflow: shadow cameras from moving shadows.
 # Run:    snakemake --profile profiles/local [--config datasets=[NAME]]
 # Report: snakemake --report results/report.html
-# Stages live in workflow/rules/*.smk, helpers in workflow/rules/common.smk.
+# Stages live in workflow/rules/*.smk; helpers in common.smk (capture plans, inputs),
+# parts.smk (time parts, spans, strips), resources.smk (job sizes), targets.smk.
 from snakemake.utils import min_version, validate
 
 min_version("9.0")
@@ -17,6 +18,9 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
+include: "workflow/rules/parts.smk"
+include: "workflow/rules/resources.smk"
+include: "workflow/rules/targets.smk"
 include: "workflow/rules/render.smk"
 include: "workflow/rules/decode.smk"
 include: "workflow/rules/shadow_time.smk"
@@ -33,6 +37,6 @@ localrules:
 
 
 rule all:
+    default_target: True
     input:
         get_final_targets,
-    default_target: True

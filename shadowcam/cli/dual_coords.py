@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from shadowcam.cli.options import parse_params
+from shadowcam.io.capture_plan import choose_dual_model
 from shadowcam.cameras.dual_coords import (
     DUAL_COORD_METHODS,
     dual_coords_calibration,
@@ -75,12 +76,12 @@ def run(args):
             raise ValueError(f"--shadow-time {args.shadow_time} has no sweep {needed!r} (has {sweeps})")
     plane = manifest.get("calibration_plane") or {}
     has_cal = "cal_u" in sweeps and "cal_v" in sweeps and "homography" in plane
-    model = args.model
-    if model == "auto":
-        model = "calibration" if has_cal else "uniform"
-    if model == "calibration" and not has_cal:
-        raise ValueError(f"--model calibration needs sweeps cal_u, cal_v in {args.shadow_time} (has {sweeps}) "
-                         f"and calibration_plane.homography in {args.manifest}")
+    try:
+        model = choose_dual_model(args.model, calibration_available=has_cal,
+                                  missing=f"sweeps cal_u, cal_v in {args.shadow_time} (has {sweeps}) "
+                                  f"and calibration_plane.homography in {args.manifest}")
+    except ValueError as exc:
+        raise ValueError(f"--{exc}") from None
     n_frames = tuple(int(shadow_time.attrs.get(f"n_frames_{s}", 0)) for s in ("u", "v"))
     if min(n_frames) < 1:
         raise ValueError(f"--shadow-time {args.shadow_time}: attrs n_frames_u / n_frames_v missing")

@@ -3,6 +3,7 @@ datasets with provenance, ground-truth loaders and writers of rendered frames.
 
 Modules
 -------
+capture_plan : every fact the workflow plans jobs from (files, frame counts, shape, dual model), once.
 cfa : colour filter arrays (Bayer mosaics): patterns, per-site constants, bilinear demosaic.
 decode : frame decoding: camera RAW, TIFF, PNG and EXR to linear float32 RGB.
 frame_store : time-chunked frame stores (zarr v3): write decoded frames, open and stream them.

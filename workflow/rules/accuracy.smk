@@ -17,17 +17,17 @@ rule accuracy:
             subcategory="accuracy",
             labels={"dataset": "{ds}", "table": "accuracy (CSV)"},
         ),
-    params:
-        manifest=get_capture_manifest,
-    resources:
-        mem_mb=get_image_mem_mb,
-        runtime=15,
     log:
         "logs/{ds}/accuracy.log",
     benchmark:
         "benchmarks/{ds}/accuracy.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
+    params:
+        manifest=get_capture_manifest,
     shell:
         "shadowcam accuracy --manifest {params.manifest} --shadow-time {input.shadow_time}"
         " --dual-coords {input.dual_coords} --dual-view {input.dual_view}"

@@ -2,10 +2,10 @@
 # unshadowed reference frame (when the capture has one) into its own store.
 # A sweep is decoded in time parts, one job each (decode_part: frames START:STOP into
 # a part store); `decode` joins the parts by hard-linking their chunk files, so the
-# sweep store equals a single-job decode bit for bit. Part sizes: common.smk.
+# sweep store equals a single-job decode bit for bit. Part sizes: parts.smk.
 
-# reference.zarr is a single image, not a sweep: decode_reference makes it.
-ruleorder: decode_reference > decode
+# reference.zarr is a single image, not a sweep (wildcard `sweep` never matches it):
+# decode_reference makes it.
 
 
 rule decode_part:
@@ -13,19 +13,19 @@ rule decode_part:
         get_part_files,
     output:
         temp(directory("results/{ds}/frames/{sweep}.parts/{part}.zarr")),
-    params:
-        manifest=get_capture_manifest,
-        chunk_frames=get_chunk_frames,
-        frames=get_part_range,
-    resources:
-        mem_mb=get_decode_mem_mb,
-        runtime=get_decode_runtime,
     log:
         "logs/{ds}/decode_{sweep}_part{part}.log",
     benchmark:
         "benchmarks/{ds}/decode_{sweep}_part{part}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_decode_mem_mb,
+        runtime=get_decode_runtime,
+    params:
+        manifest=get_capture_manifest,
+        chunk_frames=get_chunk_frames,
+        frames=get_part_range,
     shell:
         "shadowcam decode --manifest {params.manifest} --sweep {wildcards.sweep}"
         " --chunk-frames {params.chunk_frames} --frames {params.frames} --out {output} > {log} 2>&1"
@@ -36,15 +36,15 @@ rule decode:
         get_decode_parts,
     output:
         directory("results/{ds}/frames/{sweep}.zarr"),
-    resources:
-        mem_mb=1024,
-        runtime=10,
     log:
         "logs/{ds}/decode_{sweep}.log",
     benchmark:
         "benchmarks/{ds}/decode_{sweep}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=1024,
+        runtime=10,
     shell:
         "shadowcam merge-frames --parts {input} --out {output} > {log} 2>&1"
 
@@ -54,16 +54,16 @@ rule decode_reference:
         get_reference_files,
     output:
         directory("results/{ds}/frames/reference.zarr"),
-    params:
-        manifest=get_capture_manifest,
-    resources:
-        mem_mb=get_image_mem_mb,
-        runtime=10,
     log:
         "logs/{ds}/decode_reference.log",
     benchmark:
         "benchmarks/{ds}/decode_reference.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=10,
+    params:
+        manifest=get_capture_manifest,
     shell:
         "shadowcam decode --manifest {params.manifest} --sweep reference --out {output} > {log} 2>&1"

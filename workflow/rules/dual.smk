@@ -8,19 +8,19 @@ rule dual_coords:
         capture=get_capture_input,
     output:
         "results/{ds}/dual_coords.nc",
-    params:
-        manifest=get_capture_manifest,
-        model=get_dual_model,
-        options=get_dual_coords_params,
-    resources:
-        mem_mb=get_image_mem_mb,
-        runtime=15,
     log:
         "logs/{ds}/dual_coords.log",
     benchmark:
         "benchmarks/{ds}/dual_coords.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
+    params:
+        manifest=get_capture_manifest,
+        model=get_dual_model,
+        options=get_dual_coords_params,
     shell:
         "shadowcam dual-coords --shadow-time {input.shadow_time} --manifest {params.manifest}"
         " --model {params.model} --params {params.options:q} --out {output} > {log} 2>&1"
@@ -35,19 +35,19 @@ rule dual_view:
         nc="results/{ds}/dual_view.nc",
         exr="results/{ds}/dual_view.exr",
         png="results/{ds}/dual_view.png",
-    params:
-        reference=get_reference_option,
-        method=config["dual_view"]["method"],
-        options=as_json(config["dual_view"]["params"]),
-    resources:
-        mem_mb=get_image_mem_mb,
-        runtime=15,
     log:
         "logs/{ds}/dual_view.log",
     benchmark:
         "benchmarks/{ds}/dual_view.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
+    params:
+        reference=get_flag("--reference", "reference"),
+        method=config["dual_view"]["method"],
+        options=as_json(config["dual_view"]["params"]),
     shell:
         "shadowcam dual-view --dual-coords {input.dual_coords} --shadow-time {input.shadow_time}"
         " {params.reference} --method {params.method} --params {params.options:q}"

@@ -14,17 +14,17 @@ rule evaluate:
             category="simulation study",
             labels={"factor": "{factor}"},
         ),
-    params:
-        study=get_evaluate_params,
-    resources:
-        mem_mb=4096,
-        runtime=60,
     log:
         "logs/evaluate/evaluate.log",
     benchmark:
         "benchmarks/evaluate/evaluate.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=4096,
+        runtime=60,
+    params:
+        study=get_evaluate_params,
     shell:
         "shadowcam evaluate --params '{params.study}' --out {output.study}"
         " --figures {output.figures} > {log} 2>&1"

@@ -26,17 +26,17 @@ rule methods_comparison:
             subcategory="methods",
             labels={"dataset": "{ds}", "figure": "speed against error"},
         ),
-    params:
-        manifest=get_capture_manifest,
-        sweeps=get_scene_sweeps,
-        reference=get_reference_option,
-        options=get_methods_params,
     log:
         "logs/{ds}/methods_comparison.log",
     benchmark:
         "benchmarks/{ds}/methods_comparison.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    params:
+        manifest=get_capture_manifest,
+        sweeps=get_scene_sweeps,
+        reference=get_flag("--reference", "reference"),
+        options=get_methods_params,
     shell:
         "shadowcam methods-comparison --manifest {params.manifest} --frames {input.frames}"
         " --sweeps {params.sweeps} --shadow-time {input.shadow_time} --dual-coords {input.dual_coords}"

@@ -1,5 +1,5 @@
 # Stages of an outdoor time-lapse (manifest kind: outdoor): registration and
-# photometric normalisation (one job per time part of config outdoor.part_frames
+# photometric normalisation (one job per time span of config outdoor.part_frames
 # frames, then an exact merge), shadow-edge tracking with keyframe interpolation
 # (one job per column strip of config outdoor.edge_strips, merged exactly),
 # the per-pixel arrival-time map, the ridge pushbroom, accuracy (datasets with
@@ -12,26 +12,24 @@ rule outdoor_normalise_part:
         capture=get_capture_input,
         frames=get_outdoor_frames,
     output:
-        temp("results/{ds}/outdoor/photometry.parts/{part}.nc"),
-    params:
-        manifest=get_capture_manifest,
-        part=get_outdoor_part_range,
-        options=as_json(config["outdoor"]["normalise"]),
-    wildcard_constraints:
-        part=r"\d+-(\d+|end)",  # START-STOP, not the 4-digit decode parts of common.smk
-    resources:
-        mem_mb=outdoor_mem_mb("normalise"),
-        runtime=outdoor_runtime("normalise"),
-    threads: 1
+        temp("results/{ds}/outdoor/photometry.parts/{span}.nc"),
     log:
-        "logs/{ds}/outdoor_normalise_part{part}.log",
+        "logs/{ds}/outdoor_normalise_part{span}.log",
     benchmark:
-        "benchmarks/{ds}/outdoor_normalise_part{part}.tsv"
+        "benchmarks/{ds}/outdoor_normalise_part{span}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_normalise_mem_mb,
+        runtime=get_normalise_runtime,
+    params:
+        manifest=get_capture_manifest,
+        span=get_outdoor_span_range,
+        options=as_json(config["outdoor"]["normalise"]),
     shell:
         "shadowcam outdoor-normalise --manifest {params.manifest} --frames {input.frames}"
-        " --part {params.part} --params {params.options:q} --out {output} > {log} 2>&1"
+        " --part {params.span} --params {params.options:q} --out {output} > {log} 2>&1"
 
 
 rule outdoor_normalise:
@@ -39,16 +37,16 @@ rule outdoor_normalise:
         get_outdoor_photometry_parts,
     output:
         "results/{ds}/outdoor/photometry.nc",
-    resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=10,
-    threads: 1
     log:
         "logs/{ds}/outdoor_normalise.log",
     benchmark:
         "benchmarks/{ds}/outdoor_normalise.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=10,
     shell:
         "shadowcam outdoor-merge-photometry --parts {input} --out {output} > {log} 2>&1"
 
@@ -59,21 +57,19 @@ rule track_edges_strip:
         photometry="results/{ds}/outdoor/photometry.nc",
     output:
         temp("results/{ds}/outdoor/edges.strips/{strip}.npz"),
-    params:
-        strip=get_edge_strip_arg,
-        options=as_json(config["outdoor"]["track_edges"]),
-    wildcard_constraints:
-        strip=r"\d+",
-    resources:
-        mem_mb=outdoor_mem_mb("track_strip"),
-        runtime=outdoor_runtime("track_strip"),
-    threads: 1
     log:
         "logs/{ds}/track_edges_strip{strip}.log",
     benchmark:
         "benchmarks/{ds}/track_edges_strip{strip}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_track_strip_mem_mb,
+        runtime=get_track_strip_runtime,
+    params:
+        strip=get_edge_strip_arg,
+        options=as_json(config["outdoor"]["track_edges"]),
     shell:
         "shadowcam track-edges-strip --frames {input.frames} --photometry {input.photometry}"
         " --strip {params.strip} --params {params.options:q} --out {output} > {log} 2>&1"
@@ -86,19 +82,19 @@ rule track_edges:
         strips=get_edge_strips,
     output:
         "results/{ds}/outdoor/edges.nc",
-    params:
-        options=as_json(config["outdoor"]["track_edges"]),
-        strips=get_edge_strips_option,
-    resources:
-        mem_mb=outdoor_mem_mb("track"),
-        runtime=outdoor_runtime("track"),
-    threads: 1
     log:
         "logs/{ds}/track_edges.log",
     benchmark:
         "benchmarks/{ds}/track_edges.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_track_edges_mem_mb,
+        runtime=get_track_edges_runtime,
+    params:
+        options=as_json(config["outdoor"]["track_edges"]),
+        strips=get_flag("--strips", "strips"),
     shell:
         "shadowcam track-edges --frames {input.frames} --photometry {input.photometry}"
         " {params.strips} --params {params.options:q} --out {output} > {log} 2>&1"
@@ -110,18 +106,18 @@ rule arrival:
         edges="results/{ds}/outdoor/edges.nc",
     output:
         "results/{ds}/outdoor/arrival.nc",
-    params:
-        options=as_json(config["outdoor"]["arrival"]),
-    resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
-    threads: 1
     log:
         "logs/{ds}/arrival.log",
     benchmark:
         "benchmarks/{ds}/arrival.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
+    params:
+        options=as_json(config["outdoor"]["arrival"]),
     shell:
         "shadowcam arrival --photometry {input.photometry} --edges {input.edges}"
         " --params {params.options:q} --out {output} > {log} 2>&1"
@@ -134,16 +130,16 @@ rule pushbroom:
     output:
         nc="results/{ds}/outdoor/pushbroom.nc",
         png="results/{ds}/outdoor/pushbroom.png",
-    resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
-    threads: 1
     log:
         "logs/{ds}/pushbroom.log",
     benchmark:
         "benchmarks/{ds}/pushbroom.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
     shell:
         "shadowcam pushbroom --photometry {input.photometry} --edges {input.edges}"
         " --out {output.nc} --png {output.png} > {log} 2>&1"
@@ -166,19 +162,19 @@ rule outdoor_accuracy:
             subcategory="accuracy",
             labels={"dataset": "{ds}", "table": "outdoor accuracy (CSV)"},
         ),
-    params:
-        manifest=get_capture_manifest,
-        options=as_json(config["outdoor"]["accuracy"]),
-    resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
-    threads: 1
     log:
         "logs/{ds}/outdoor_accuracy.log",
     benchmark:
         "benchmarks/{ds}/outdoor_accuracy.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
+    params:
+        manifest=get_capture_manifest,
+        options=as_json(config["outdoor"]["accuracy"]),
     shell:
         "shadowcam outdoor-accuracy --manifest {params.manifest} --frames {input.frames}"
         " --photometry {input.photometry} --edges {input.edges} --arrival {input.arrival}"
@@ -203,18 +199,18 @@ rule outdoor_figures:
             subcategory="figures",
             labels={"dataset": "{ds}", "figure": "{figure}"},
         ),
-    params:
-        accuracy=get_outdoor_accuracy_option,
-    resources:
-        mem_mb=outdoor_mem_mb("per_pixel"),
-        runtime=outdoor_runtime("per_pixel"),
-    threads: 1
     log:
         "logs/{ds}/outdoor_figures.log",
     benchmark:
         "benchmarks/{ds}/outdoor_figures.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_per_pixel_mem_mb,
+        runtime=get_per_pixel_runtime,
+    params:
+        accuracy=get_flag("--accuracy", "accuracy"),
     shell:
         "shadowcam outdoor-figures --frames {input.frames} --photometry {input.photometry}"
         " --edges {input.edges} --arrival {input.arrival} --pushbroom {input.pushbroom}"

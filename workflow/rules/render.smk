@@ -7,14 +7,14 @@ rule render:
         "data_manifest/{ds}.yaml",
     output:
         directory("results/{ds}/capture"),
-    resources:
-        mem_mb=get_render_mem_mb,
-        runtime=30,
     log:
         "logs/{ds}/render.log",
     benchmark:
         "benchmarks/{ds}/render.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_render_mem_mb,
+        runtime=30,
     shell:
         "shadowcam render --manifest {input} --out {output} > {log} 2>&1"

@@ -18,19 +18,19 @@ rule report_figures:
             subcategory="figures",
             labels={"dataset": "{ds}", "figure": "{figure}"},
         ),
-    params:
-        manifest=get_capture_manifest,
-        reference=get_reference_option,
-        accuracy=get_accuracy_option,
-    resources:
-        mem_mb=get_image_mem_mb,
-        runtime=15,
     log:
         "logs/{ds}/report_figures.log",
     benchmark:
         "benchmarks/{ds}/report_figures.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_image_mem_mb,
+        runtime=15,
+    params:
+        manifest=get_capture_manifest,
+        reference=get_flag("--reference", "reference"),
+        accuracy=get_flag("--accuracy", "accuracy"),
     shell:
         "shadowcam report-figures --manifest {params.manifest} --shadow-time {input.shadow_time}"
         " --dual-view {input.dual_view} {params.reference} {params.accuracy} --outdir {output} > {log} 2>&1"

@@ -10,18 +10,18 @@ rule shadow_time_chunk:
         frames="results/{ds}/frames/{sweep}.zarr",
     output:
         temp("results/{ds}/shadow_time/{sweep}.parts/{part}.npz"),
-    params:
-        owned=get_part_range,
-        options=as_json(config["shadow_time"]["params"]),
-    resources:
-        mem_mb=get_shadow_time_chunk_mem_mb,
-        runtime=get_shadow_time_chunk_runtime,
     log:
         "logs/{ds}/shadow_time_{sweep}_part{part}.log",
     benchmark:
         "benchmarks/{ds}/shadow_time_{sweep}_part{part}.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_shadow_time_chunk_mem_mb,
+        runtime=get_shadow_time_chunk_runtime,
+    params:
+        owned=get_part_range,
+        options=as_json(config["shadow_time"]["params"]),
     shell:
         "shadowcam shadow-time-chunk --frames {input.frames} --owned {params.owned}"
         " --params {params.options:q} --out {output} > {log} 2>&1"
@@ -33,20 +33,20 @@ rule shadow_time:
         partials=get_partials,
     output:
         "results/{ds}/shadow_time.nc",
-    params:
-        sweeps=get_sweeps,
-        partials=get_partials_option,
-        method=config["shadow_time"]["method"],
-        options=as_json(config["shadow_time"]["params"]),
-    resources:
-        mem_mb=get_shadow_time_mem_mb,
-        runtime=15,
     log:
         "logs/{ds}/shadow_time.log",
     benchmark:
         "benchmarks/{ds}/shadow_time.tsv"
     conda:
         "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_shadow_time_mem_mb,
+        runtime=15,
+    params:
+        sweeps=get_sweeps,
+        partials=get_partials_option,
+        method=config["shadow_time"]["method"],
+        options=as_json(config["shadow_time"]["params"]),
     shell:
         "shadowcam shadow-time --frames {input.frames} --sweeps {params.sweeps} {params.partials}"
         " --method {params.method} --params {params.options:q} --out {output} > {log} 2>&1"

@@ -1,0 +1,151 @@
+# Jobs of one step over parts of a dataset, merged exactly afterwards.
+#
+# Wildcards
+# ---------
+# part    decode part of a sweep, 0000, 0001, ...: frames [i F, (i + 1) F) with
+#         F = chunk_frames x decode.chunks_per_job; `decode` joins the part stores
+#         (hard links, no copy) into results/{ds}/frames/{sweep}.zarr, and the
+#         shadow_time_chunk jobs track the dips of the same frame ranges
+# span    time span of the first outdoor pass, START-STOP (frames; `0-end` when the
+#         frame count is known only once the capture is rendered): config
+#         outdoor.part_frames frames per job, merged into photometry.nc
+# strip   column strip of the outdoor edge tracking, 0 .. edge_strips - 1, merged by
+#         track_edges (config outdoor.edge_strips; 1 = one job, no strips)
+#
+# Memory of a job is bounded by one time chunk of chunk_frames frames, whatever the
+# frames per job.
+from shadowcam.io.frame_store import default_chunk_frames
+
+
+wildcard_constraints:
+    part=r"\d{4}",
+    span=r"\d+-(\d+|end)",
+    strip=r"\d+",
+
+
+def decode_chunk_frames(ds):
+    """Frames per store chunk: config decode.chunk_frames, or ~64 MiB of float32 RGB if null."""
+    configured = config["decode"]["chunk_frames"]
+    if configured:
+        return int(configured)
+    return default_chunk_frames(capture(ds).frame_shape + (3,))
+
+
+def decode_part_ranges(ds, sweep):
+    """Frame ranges [(start, stop), ...] of the decode_part jobs of a sweep."""
+    total = capture(ds).n_frames(sweep)
+    step = decode_chunk_frames(ds) * int(config["decode"]["chunks_per_job"])
+    return [(start, min(start + step, total)) for start in range(0, total, step)]
+
+
+def part_range(wildcards):
+    """``(start, stop)`` frames of decode part `wildcards.part` of `wildcards.sweep`."""
+    ranges = decode_part_ranges(wildcards.ds, wildcards.sweep)
+    index = int(wildcards.part)
+    if index >= len(ranges):
+        raise ValueError(
+            f"{wildcards.ds} sweep {wildcards.sweep} has {len(ranges)} parts, no part {index}"
+        )
+    return ranges[index]
+
+
+def sweep_parts(ds, sweep, template):
+    """`template` (with {ds}, {sweep}, {part}) of every decode part of a sweep, in time order."""
+    count = len(decode_part_ranges(ds, sweep))
+    return [template.format(ds=ds, sweep=sweep, part=f"{i:04d}") for i in range(count)]
+
+
+def get_decode_parts(wildcards):
+    """Part stores of a sweep, in time order (inputs of `decode`)."""
+    template = "results/{ds}/frames/{sweep}.parts/{part}.zarr"
+    return sweep_parts(wildcards.ds, wildcards.sweep, template)
+
+
+def get_part_files(wildcards):
+    """Files one decode_part job reads: the rendered capture, or the manifest and its frames."""
+    plan = capture(wildcards.ds)
+    if plan.rendered:
+        return [f"results/{wildcards.ds}/capture"]
+    start, stop = part_range(wildcards)
+    files = plan.sweep(wildcards.sweep).files[start:stop]
+    return [manifest_path(wildcards.ds)] + relative(files)
+
+
+def get_part_range(wildcards):
+    """``START:STOP`` of ``shadowcam decode --frames`` (and ``--owned``) for one part."""
+    start, stop = part_range(wildcards)
+    return f"{start}:{stop}"
+
+
+def get_chunk_frames(wildcards):
+    """``--chunk-frames`` of a sweep (the same for all its parts)."""
+    return decode_chunk_frames(wildcards.ds)
+
+
+def get_partials(wildcards):
+    """Dip-tracking partials of every sweep of `get_sweeps` (inputs of `shadow_time`)."""
+    template = "results/{ds}/shadow_time/{sweep}.parts/{part}.npz"
+    return [
+        p for s in get_sweeps(wildcards) for p in sweep_parts(wildcards.ds, s, template)
+    ]
+
+
+def get_partials_option(wildcards, input):
+    """``--partials SWEEP FILE... --partials ...`` of ``shadowcam shadow-time``."""
+    template = "results/{ds}/shadow_time/{sweep}.parts/{part}.npz"
+    return " ".join(
+        f"--partials {s} " + " ".join(sweep_parts(wildcards.ds, s, template))
+        for s in get_sweeps(wildcards)
+    )
+
+
+def outdoor_frame_count(ds):
+    """Frames of the time-lapse of `ds`, or None if known only once rendered (dropped frames)."""
+    plan = capture(ds)
+    return None if plan.rendered else plan.n_frames(plan.outdoor_sweep)
+
+
+def outdoor_spans(ds):
+    """Time spans of the first outdoor pass of `ds`: ``START-STOP`` names (one ``0-end`` if unknown)."""
+    n_frames = outdoor_frame_count(ds)
+    size = int(config["outdoor"]["part_frames"])
+    if n_frames is None or size <= 0:
+        return ["0-end"]
+    return [
+        f"{start}-{min(start + size, n_frames)}" for start in range(0, n_frames, size)
+    ]
+
+
+def get_outdoor_photometry_parts(wildcards):
+    """Span datasets of the first outdoor pass, merged into photometry.nc."""
+    return [
+        f"results/{wildcards.ds}/outdoor/photometry.parts/{span}.nc"
+        for span in outdoor_spans(wildcards.ds)
+    ]
+
+
+def get_outdoor_span_range(wildcards):
+    """``--part START:STOP`` value of a span ``START-STOP`` (``end`` = to the last frame)."""
+    start, stop = wildcards.span.split("-")
+    return f"{start}:{'' if stop == 'end' else stop}"
+
+
+def edge_strip_count():
+    """Column strips of the edge-tracking pass (config outdoor.edge_strips; 1 = one job)."""
+    return int(config["outdoor"]["edge_strips"])
+
+
+def get_edge_strips(wildcards):
+    """Strip files of the edge-tracking pass merged by track_edges (none for one job)."""
+    count = edge_strip_count()
+    if count <= 1:
+        return []
+    return [
+        f"results/{wildcards.ds}/outdoor/edges.strips/{index}.npz"
+        for index in range(count)
+    ]
+
+
+def get_edge_strip_arg(wildcards):
+    """``--strip I/N`` value of strip job `wildcards.strip`."""
+    return f"{wildcards.strip}/{edge_strip_count()}"
