@@ -1,14 +1,12 @@
 """Tests of shadowcam.io.capture_plan: the facts the workflow plans jobs from."""
 
 import glob
-import os
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 import yaml
-from test_decode import write_image  # noqa: E402  (tests dir is on sys.path)
 
 from shadowcam.cli import main
 from shadowcam.io.capture_plan import (
@@ -24,13 +22,18 @@ ROWS, COLS = 6, 10
 IDENTITY = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
 
 
-def write_frames(folder, names, seed):
-    """Seeded 16-bit RGB frames of ROWS x COLS under `folder` (subfolders allowed in names)."""
-    rng = np.random.default_rng(seed)
-    for name in names:
-        path = Path(folder) / name
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_image(path, rng.integers(0, 65536, (ROWS, COLS, 3)).astype(np.uint16))
+@pytest.fixture
+def write_frames(write_image):
+    """Write seeded 16-bit RGB frames of ROWS x COLS under `folder` (subfolders allowed in names)."""
+
+    def write(folder, names, seed):
+        rng = np.random.default_rng(seed)
+        for name in names:
+            path = Path(folder) / name
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_image(path, rng.integers(0, 65536, (ROWS, COLS, 3)).astype(np.uint16))
+
+    return write
 
 
 def write_capture(tmp_path, doc, *, checksums=True):
@@ -58,7 +61,7 @@ def lab_doc(**overrides):
 
 
 @pytest.fixture
-def lab(tmp_path):
+def lab(tmp_path, write_frames):
     data = tmp_path / "data"
     write_frames(data / "u", [f"f{i}.png" for i in (1, 2, 10)], seed=1)
     write_frames(data / "v", [f"f{i}.png" for i in range(1, 5)], seed=2)
@@ -96,7 +99,7 @@ def test_plan_is_frozen(lab):
         plan.sweeps["w"] = plan.sweeps["u"]
 
 
-def test_recursive_glob_counts_what_decode_decodes(tmp_path):
+def test_recursive_glob_counts_what_decode_decodes(tmp_path, write_frames):
     """A `**` pattern over nested folders, with a folder whose name matches the pattern:
     the plan counts the files decode writes, not what a plain glob returns."""
     data = tmp_path / "data"
@@ -137,7 +140,7 @@ def test_lab_needs_both_scene_sweeps(lab):
         capture_plan(path)
 
 
-def test_calibration_sweeps_choose_the_calibration_model(lab):
+def test_calibration_sweeps_choose_the_calibration_model(lab, write_frames):
     data = lab / "data"
     write_frames(data / "cal_u", ["f1.png", "f2.png"], seed=7)
     write_frames(data / "cal_v", ["f1.png", "f2.png"], seed=8)
@@ -176,7 +179,7 @@ def outdoor_doc(sweeps):
     }
 
 
-def test_outdoor_capture_facts(tmp_path):
+def test_outdoor_capture_facts(tmp_path, write_frames):
     write_frames(tmp_path / "data" / "seq", [f"f{i}.png" for i in range(5)], seed=9)
     path = write_capture(tmp_path, outdoor_doc({"seq": {"files": "seq/*.png"}}))
     plan = capture_plan(path, edge_margin=3)
@@ -188,7 +191,7 @@ def test_outdoor_capture_facts(tmp_path):
     assert capture_plan(path).strip_halo == strip_halo(shift)  # the tracker's own margin
 
 
-def test_outdoor_needs_one_timelapse_sweep(tmp_path):
+def test_outdoor_needs_one_timelapse_sweep(tmp_path, write_frames):
     for name in ("a", "b"):
         write_frames(tmp_path / "data" / name, ["f1.png"], seed=10)
     path = write_capture(tmp_path, outdoor_doc({"a": {"files": "a/*.png"}, "b": {"files": "b/*.png"}}))
@@ -214,14 +217,9 @@ def test_rendered_capture_plans_from_the_synthetic_block(tmp_path):
         plan.sweep("w")
 
 
-def test_repository_manifests_plan(tmp_path):
-    """Every manifest shipped in data_manifest/ whose files are present gives a plan."""
-    repo = Path(__file__).resolve().parents[2]
+def test_repository_manifests_plan(repo, shared_data):
+    """Every manifest shipped in data_manifest/ gives a plan (the dev ones read the shared data)."""
     for path in sorted((repo / "data_manifest").glob("*.yaml")):
-        doc = yaml.safe_load(path.read_text())
-        root = path.parent / doc.get("root", ".")
-        if "sweeps" in doc and not os.path.isdir(root):
-            continue
         plan = capture_plan(path)
         assert plan.name == path.stem
         assert all(sweep.n_frames >= 2 for sweep in plan.sweeps.values())
