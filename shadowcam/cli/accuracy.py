@@ -46,7 +46,7 @@ def run(args):
     """Evaluate the products against the manifest's ground truth and write the report."""
     from shadowcam.lab.accuracy import accuracy_report, report_to_csv, report_to_json
     from shadowcam.io.ground_truth import load_ground_truth
-    from shadowcam.io.images import atomic_path
+    from shadowcam._shared.atomic import atomic_path
     from shadowcam.io.manifest import load_manifest
     from shadowcam.io.provenance import file_sha256
 

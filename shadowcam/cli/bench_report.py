@@ -24,7 +24,7 @@ import json
 import re
 from pathlib import Path
 
-from shadowcam.cli.outdoor_io import open_dataset
+from shadowcam.io.datasets import open_dataset
 from shadowcam.io.frame_store import open_frames
 from shadowcam.outdoor.accuracy import registration_errors
 

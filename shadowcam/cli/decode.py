@@ -8,12 +8,12 @@ With ``--frames START:STOP`` it decodes only that range into a *part* store
 Offers
 ------
 add_parser : register the step and its options.
-parse_frame_range : the ``--frames START:STOP`` option, checked against the sweep length.
 run : verify checksums and decode.
 """
 
 import xarray as xr
 
+from shadowcam.cli.options import parse_frame_range
 from shadowcam.io.frame_store import write_frames, write_reference
 from shadowcam.io.manifest import load_manifest, manifest_files, verify_checksums
 from shadowcam.io.provenance import attach_provenance
@@ -34,24 +34,6 @@ def add_parser(subparsers, name):
                         help="decode only frames START..STOP-1 of the sweep into a part store "
                              "(START a multiple of --chunk-frames; STOP may exceed the sweep)")
     return parser
-
-
-def parse_frame_range(text, n_frames, *, chunk_frames=None):
-    """Return ``(start, stop)`` of a ``START:STOP`` range inside a sweep of `n_frames`.
-
-    `stop` is clipped to `n_frames` (the workflow sizes the last part by the
-    nominal job length); `start` must lie inside the sweep and, with
-    `chunk_frames`, on a chunk boundary.
-    """
-    try:
-        start, stop = (int(v) for v in text.split(":"))
-    except ValueError:
-        raise ValueError(f"--frames must be START:STOP with integers, got {text!r}") from None
-    if not 0 <= start < n_frames or stop <= start:
-        raise ValueError(f"--frames {text}: need 0 <= START < {n_frames} (frames in the sweep) and STOP > START")
-    if chunk_frames is None or start % chunk_frames:
-        raise ValueError(f"--frames {text}: START must be a multiple of --chunk-frames (given: {chunk_frames})")
-    return start, min(stop, n_frames)
 
 
 def run(args):

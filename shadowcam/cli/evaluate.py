@@ -102,7 +102,7 @@ def run(args):
     """Run the study, write the dataset (and figures), print the tables."""
     from dataclasses import replace
 
-    from shadowcam.io.images import atomic_path
+    from shadowcam._shared.atomic import atomic_path
     from shadowcam.io.provenance import attach_provenance
     from shadowcam.evaluate.simulation_study import BASELINE, FACTORS, run_study
 

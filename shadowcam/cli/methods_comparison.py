@@ -47,7 +47,8 @@ def run(args):
     from shadowcam.cameras.dual_view import camera_colours
     from shadowcam.io.frame_store import iter_frame_chunks, open_frames
     from shadowcam.io.ground_truth import load_ground_truth
-    from shadowcam.io.images import atomic_path, write_netcdf
+    from shadowcam._shared.atomic import atomic_path
+    from shadowcam.io.datasets import write_netcdf
     from shadowcam.io.manifest import load_manifest
     from shadowcam.evaluate.methods_comparison import (
         compare_dual_view_methods, compare_shadow_time_methods, methods_dataset, speed_error_figure,

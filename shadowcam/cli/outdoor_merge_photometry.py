@@ -15,7 +15,7 @@ run : merge and write the photometry dataset.
 
 import numpy as np
 
-from shadowcam.cli.outdoor_io import input_checksums, open_dataset, read_attrs, write_dataset
+from shadowcam.io.datasets import merge_input_checksums, open_dataset, read_attrs, write_dataset
 from shadowcam.outdoor.datasets import photometry_dataset, photometry_part_arrays
 from shadowcam.outdoor.normalise import PartMerger
 
@@ -41,7 +41,7 @@ def run(args):
         exposure.append(part["exposure_gain"].values)
         first = int(part.attrs["first_frame"])
         ranges.append([first, first + part.sizes["time"]])
-        checksums.update(input_checksums(part))
+        checksums.update(merge_input_checksums(part))
         sky_source = sky_source or part.attrs["sky_source"]
         del part
     time_s, exposure = np.concatenate(time_s), np.concatenate(exposure)

@@ -18,9 +18,9 @@ run : run the pass (or a part) and write the dataset.
 import numpy as np
 
 from shadowcam.cli.options import parse_params
-from shadowcam.cli.outdoor_io import input_checksums, iter_frames, write_dataset
+from shadowcam.io.datasets import write_dataset
 from shadowcam.io.decode import read_frame
-from shadowcam.io.frame_store import open_frames
+from shadowcam.io.frame_store import iter_store_frames, open_frames
 from shadowcam.io.manifest import load_manifest, verify_checksums
 from shadowcam.outdoor.datasets import photometry_dataset, photometry_part_dataset
 from shadowcam.outdoor.normalise import normalise_frames, normalise_part, part_frames
@@ -87,16 +87,16 @@ def run(args):
     config = {"manifest": manifest["name"], "sky_source": sky_source, **params}
     time_s = frames["time_s"].values
     if args.part is None:
-        result = normalise_frames(iter_frames(frames), **options)
+        result = normalise_frames(iter_store_frames(frames), **options)
         dataset = photometry_dataset(result, time_s, exposure_gain=exposure, sky_source=sky_source)
     else:
         start, stop = parse_part(args.part, frames.sizes["time"])
         overlap = int(params.get("overlap", 2))
         first, _ = part_frames(start, stop, overlap=overlap)
         reference = frames["image"].isel(time=0).values
-        part = normalise_part(iter_frames(frames.isel(time=slice(first, stop))), start=start, stop=stop,
+        part = normalise_part(iter_store_frames(frames.isel(time=slice(first, stop))), start=start, stop=stop,
                               reference=reference, overlap=overlap, **options)
         dataset = photometry_part_dataset(part, time_s[start:stop], sky_source=sky_source,
                                           exposure_gain=None if exposure is None else exposure[start:stop])
         config["part"] = [start, stop]
-    write_dataset(dataset, args.out, config=config, checksums=input_checksums(frames), step="outdoor-normalise")
+    write_dataset(dataset, args.out, config=config, inputs=(frames,), step="outdoor-normalise")

@@ -22,7 +22,7 @@ import xarray as xr
 
 from outdoor_scene import make_timelapse
 from shadowcam.cli import main
-from shadowcam.io.images import write_netcdf
+from shadowcam.io.datasets import write_netcdf
 from shadowcam.outdoor.datasets import photometry_part_dataset
 from shadowcam.outdoor.normalise import merge_parts, normalise_frames, normalise_part, part_frames
 from shadowcam.outdoor.registration import (apply_shift, block_all, block_mean, registration_factor,
