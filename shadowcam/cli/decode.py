@@ -1,7 +1,7 @@
 """``shadowcam decode``: decode one sweep (or the reference) of a capture into a frame store.
 
 Verifies the sha256 of the files it decodes first, then streams the frames
-into ``results/<ds>/frames/<sweep>.zarr`` (see ``shadowcam.io.frame_store``).
+into ``results/<ds>/frames/<sweep>.zarr`` (:func:`shadowcam.io.sweep_store.decode_sweep`).
 With ``--frames START:STOP`` it decodes only that range into a *part* store
 (one job of a long sweep; ``shadowcam merge-frames`` joins the parts).
 
@@ -11,12 +11,9 @@ add_parser : register the step and its options.
 run : verify checksums and decode.
 """
 
-import xarray as xr
-
 from shadowcam.cli.options import parse_frame_range
-from shadowcam.io.frame_store import write_frames, write_reference
-from shadowcam.io.manifest import load_manifest, manifest_files, verify_checksums
-from shadowcam.io.provenance import attach_provenance
+from shadowcam.io.manifest import load_manifest
+from shadowcam.io.sweep_store import decode_sweep
 
 
 def add_parser(subparsers, name):
@@ -39,38 +36,10 @@ def add_parser(subparsers, name):
 def run(args):
     """Decode ``args.sweep`` of ``args.manifest`` into ``args.out``."""
     manifest = load_manifest(args.manifest)
-    sweep = args.sweep
-    if sweep != "reference" and sweep not in manifest["sweeps"]:
-        raise ValueError(
-            f"--sweep {sweep!r} is not a sweep of {args.manifest}; "
-            f"available: {sorted(manifest['sweeps']) + (['reference'] if manifest['reference_paths'] else [])}"
-        )
-    if sweep == "reference" and not manifest["reference_paths"]:
-        raise ValueError(f"manifest {args.manifest} has no reference frame (key reference)")
-    if sweep == "reference" and args.frames:
+    frames = None
+    if args.frames and args.sweep in manifest["sweeps"]:
+        n_frames = len(manifest["sweeps"][args.sweep]["paths"])
+        frames = parse_frame_range(args.frames, n_frames, chunk_frames=args.chunk_frames)
+    elif args.frames and args.sweep == "reference":
         raise ValueError("--frames applies to sweeps, not to the reference")
-    if sweep == "reference":
-        checksums = verify_checksums(manifest, [sweep])
-    else:
-        entry = manifest["sweeps"][sweep]
-        start, stop = (0, len(entry["paths"]))
-        if args.frames:
-            start, stop = parse_frame_range(args.frames, stop, chunk_frames=args.chunk_frames)
-        checksums = verify_checksums(_only_files(manifest, sweep, entry["paths"][start:stop]), [sweep])
-    config = {"manifest": manifest["name"], "sweep": sweep, "chunk_frames": args.chunk_frames}
-    attrs = dict(attach_provenance(xr.Dataset(), config=config, input_checksums=checksums, step="decode").attrs)
-    attrs.update(dataset=manifest["name"], sweep=sweep)
-    if sweep == "reference":
-        write_reference(manifest["reference_paths"], args.out, attrs=attrs)
-        return
-    if "axis" in entry:
-        attrs["axis"] = entry["axis"]
-    write_frames(entry["paths"][start:stop], args.out, times_s=entry["times_s"][start:stop],
-                 attrs=attrs, chunk_frames=args.chunk_frames, first_frame=start)
-
-
-def _only_files(manifest, group, paths):
-    """`manifest` whose file group `group` lists only `paths` (what one part job reads)."""
-    wanted = {str(p) for p in paths}
-    files = [rel for rel, path in manifest_files(manifest, [group]).items() if path in wanted]
-    return {**manifest, "files": {**manifest["files"], group: files}}
+    decode_sweep(manifest, args.sweep, args.out, frames=frames, chunk_frames=args.chunk_frames)
