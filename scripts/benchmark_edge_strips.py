@@ -52,7 +52,7 @@ def run_step(args):
 def prepare(out, tiles):
     from shadowcam.io.decode import iter_frames
     from shadowcam.io.frame_store import write_frames
-    from shadowcam.io.images import write_netcdf
+    from shadowcam.io.datasets import write_netcdf
     from shadowcam.io.manifest import load_manifest
     from shadowcam.outdoor.datasets import photometry_dataset
     from shadowcam.outdoor.normalise import normalise_frames

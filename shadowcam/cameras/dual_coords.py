@@ -35,6 +35,10 @@ fit_time_to_plane : fit and select the ``(t_u, t_v) -> (x, y)`` model (cross-val
 apply_homography : apply a 3x3 homography to points.
 sweep_crossing_sine : per-point sine of the angle between the two sweep directions.
 dual_coords_dataset : assemble the ``dual_coords`` xarray Dataset.
+UNIFORM_OPTIONS, CALIBRATION_OPTIONS : options of the two methods accepted by the front function.
+choose_dual_model : the dual-coordinate method that runs for a requested one (``auto`` decided once).
+choose_dual_coords_method : the same, for what a shadow-time dataset holds.
+dual_coords_from_shadow_time : shadow-time dataset -> dual-coordinates dataset (either method).
 """
 
 import json
@@ -682,3 +686,120 @@ def dual_coords_dataset(u, v, valid, *, info, method, reason=None):
             attrs[key] = value
     ds.attrs.update(attrs)
     return ds
+
+
+UNIFORM_OPTIONS = ("scale", "offset", "min_spread")
+CALIBRATION_OPTIONS = ("models", "k_folds", "rel_tol", "abs_tol", "seed", "model_options", "min_spread",
+                       "plane_window", "extrapolation_margin", "min_sweep_angle_deg")
+
+
+def _sweeps_of(shadow_time):
+    return [str(s) for s in shadow_time["sweep"].values]
+
+
+def choose_dual_model(model, *, calibration_available, missing="the calibration sweeps and plane"):
+    """Return the dual-coordinate model that runs for a requested `model`.
+
+    Parameters
+    ----------
+    model : {"auto", "uniform", "calibration"}
+        Requested model; ``auto`` is the simplest model the data support: the
+        calibration plane when it is available, else uniform motion.
+    calibration_available : bool
+        The calibration sweeps ``cal_u``, ``cal_v`` and the plane's homography exist.
+    missing : str, optional
+        What the calibration model lacks, for the error message.
+
+    Returns
+    -------
+    str
+        ``"uniform"`` or ``"calibration"``.
+
+    Raises
+    ------
+    ValueError
+        If `model` is unknown, or ``calibration`` without calibration data.
+    """
+    if model not in ("auto", *DUAL_COORD_METHODS):
+        raise ValueError(f"model must be 'auto' or one of {', '.join(DUAL_COORD_METHODS)}; got {model!r}")
+    if model == "auto":
+        return "calibration" if calibration_available else "uniform"
+    if model == "calibration" and not calibration_available:
+        raise ValueError(f"model 'calibration' needs {missing}; use model 'auto' or 'uniform'")
+    return model
+
+
+def choose_dual_coords_method(shadow_time, method="auto", *, homography=None):
+    """The method that runs on `shadow_time` (:func:`choose_dual_model` on what it holds).
+
+    Calibration is available when `shadow_time` has sweeps ``cal_u`` and ``cal_v``
+    and the calibration plane's `homography` is known.
+    """
+    sweeps = _sweeps_of(shadow_time)
+    return choose_dual_model(
+        method, calibration_available="cal_u" in sweeps and "cal_v" in sweeps and homography is not None,
+        missing=f"sweeps cal_u, cal_v in the shadow times (has {sweeps}) and the calibration plane's "
+        "homography (manifest calibration_plane.homography)")
+
+
+def _sweep_times(shadow_time, sweep, min_confidence):
+    t = shadow_time["shadow_time"].sel(sweep=sweep).transpose("row", "col").values.astype(np.float32)
+    if min_confidence > 0 and "confidence" in shadow_time:
+        conf = shadow_time["confidence"].sel(sweep=sweep).transpose("row", "col").values
+        t = np.where(conf >= min_confidence, t, np.nan).astype(np.float32)
+    return t
+
+
+def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=None, dual_height=None,
+                                 min_confidence=0.0, homography=None, plane_mask=None, **options):
+    """Dual coordinates of every camera pixel from its shadow times.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``shadow_time (sweep, row, col)`` with sweeps ``u``, ``v`` (and ``cal_u``,
+        ``cal_v`` for the calibration method), optional ``confidence``; attrs
+        ``n_frames_u``, ``n_frames_v``.
+    method : {"uniform", "calibration"}
+    dual_width, dual_height : int, optional
+        Dual grid size; default the frames per sweep (``n_frames_u``, ``n_frames_v``).
+    min_confidence : float
+        Shadow times of lower confidence count as missing.
+    homography : (3, 3) array_like, optional
+        Camera -> calibration plane (calibration method).
+    plane_mask : (rows, cols) bool ndarray, optional
+        Camera pixels on the calibration plane (calibration method).
+    **options
+        :data:`UNIFORM_OPTIONS` or :data:`CALIBRATION_OPTIONS` of the method.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`dual_coords_dataset`.
+    """
+    if method not in DUAL_COORD_METHODS:
+        raise ValueError(f"method: must be one of {sorted(DUAL_COORD_METHODS)}; got {method!r}")
+    allowed = UNIFORM_OPTIONS if method == "uniform" else CALIBRATION_OPTIONS
+    sweeps = _sweeps_of(shadow_time)
+    for needed in ("u", "v") if method == "uniform" else ("u", "v", "cal_u", "cal_v"):
+        if needed not in sweeps:
+            raise ValueError(f"shadow_time: has no sweep {needed!r} (has {sweeps})")
+    n_frames = tuple(int(shadow_time.attrs.get(f"n_frames_{s}", 0)) for s in ("u", "v"))
+    if min(n_frames) < 1:
+        raise ValueError("shadow_time: attrs n_frames_u / n_frames_v missing")
+    shape = (int(n_frames[1] if dual_height is None else dual_height),
+             int(n_frames[0] if dual_width is None else dual_width))
+    min_confidence = float(min_confidence)
+    t_u, t_v = _sweep_times(shadow_time, "u", min_confidence), _sweep_times(shadow_time, "v", min_confidence)
+    opts = {k: options[k] for k in allowed if k in options}
+    if method == "uniform":
+        u, v, valid, info = dual_coords_uniform(t_u, t_v, n_frames=n_frames, dual_shape=shape, **opts)
+        reason = None
+    else:
+        if homography is None:
+            raise ValueError("homography: the calibration method needs the camera -> plane homography")
+        u, v, valid, reason, info = dual_coords_calibration(
+            t_u, t_v, cal_t_u=_sweep_times(shadow_time, "cal_u", min_confidence),
+            cal_t_v=_sweep_times(shadow_time, "cal_v", min_confidence), homography=homography,
+            dual_shape=shape, plane_mask=plane_mask, **opts)
+    return dual_coords_dataset(u, v, valid, info=info, method=method, reason=reason)

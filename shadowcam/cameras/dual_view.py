@@ -26,13 +26,18 @@ dual_view_idw : k-nearest inverse-distance weighting.
 resample_dual_view : dispatch through `DUAL_VIEW_METHODS` with input checks.
 camera_colours : the camera colours to resample (reference frame or mean lit image).
 dual_view_dataset : assemble the ``dual_view`` xarray Dataset.
+dual_view_from_coords : dual-coordinates + shadow-time datasets -> dual-view dataset.
 """
 
 import json
+import logging
+import time
 
 import numpy as np
 import xarray as xr
 from scipy.spatial import cKDTree
+
+log = logging.getLogger(__name__)
 
 #: candidate (triangle, dual pixel) pairs processed at once by the mesh warp
 _CHUNK_CANDIDATES = 1 << 21
@@ -295,3 +300,54 @@ def dual_view_dataset(image, coverage, *, method, params=None, channels=("R", "G
     )
     ds.attrs.update(resampling=method, resampling_params=json.dumps(dict(params or {})))
     return ds
+
+
+def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh", **params):
+    """Resample the camera colours into the dual grid of `coords`.
+
+    Parameters
+    ----------
+    coords : xarray.Dataset
+        Dual coordinates (``u``, ``v``, ``valid`` over ``(row, col)``; attrs ``dual_height``,
+        ``dual_width``, ``model``).
+    shadow_time : xarray.Dataset
+        Its ``lit_image`` gives the colours when `reference` is None.
+    reference : xarray.Dataset, optional
+        Reference frame store (``image``, averaged over ``time`` if it has one).
+    method : str
+        Key of :data:`DUAL_VIEW_METHODS`.
+    **params
+        Method options.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`dual_view_dataset` with attrs ``colour_source``, ``dual_coords_model``,
+        ``resampling_seconds``.
+    """
+    if reference is not None:
+        image = reference["image"]
+        if "time" in image.dims:
+            image = image.mean("time")
+        reference = image.transpose("row", "col", "channel").values
+    colours = camera_colours(shadow_time, reference=reference)
+    shape = (int(coords.attrs["dual_height"]), int(coords.attrs["dual_width"]))
+    u = coords["u"].transpose("row", "col").values
+    v = coords["v"].transpose("row", "col").values
+    if u.shape != colours.shape[:2]:
+        raise ValueError(f"coords: grid {u.shape} differs from the camera colours {colours.shape[:2]}")
+    start = time.perf_counter()
+    try:
+        image, coverage = resample_dual_view(colours, u, v, shape=shape, valid=coords["valid"].values,
+                                             method=method, **params)
+    except TypeError as exc:
+        raise ValueError(f"params: {exc}") from None
+    seconds = time.perf_counter() - start
+    log.info("%s resampling: %d camera pixels in %.3f s (%.2f M px/s), coverage %.1f%% of %dx%d",
+             method, u.size, seconds, u.size / seconds / 1e6, 100 * coverage.mean(), *shape)
+    channels = ([str(c) for c in shadow_time["channel"].values] if "channel" in shadow_time.coords
+                else ("R", "G", "B"))
+    dataset = dual_view_dataset(image, coverage, method=method, params=params, channels=channels)
+    dataset.attrs.update(colour_source="reference" if reference is not None else "mean lit_image of u, v",
+                         dual_coords_model=coords.attrs.get("model", ""), resampling_seconds=seconds)
+    return dataset

@@ -14,7 +14,9 @@ run : evaluate and write the report.
 
 import logging
 
+from shadowcam._shared.atomic import atomic_path
 from shadowcam.cli.options import parse_params
+from shadowcam.io.datasets import open_dataset
 
 log = logging.getLogger(__name__)
 
@@ -33,42 +35,23 @@ def add_parser(subparsers, name):
     return parser
 
 
-def _open(path):
-    import xarray as xr
-
-    if path is None:
-        return None
-    with xr.open_dataset(path, engine="h5netcdf") as ds:
-        return ds.load()
-
-
 def run(args):
     """Evaluate the products against the manifest's ground truth and write the report."""
-    from shadowcam.lab.accuracy import accuracy_report, report_to_csv, report_to_json
     from shadowcam.io.ground_truth import load_ground_truth
-    from shadowcam.io.images import atomic_path
     from shadowcam.io.manifest import load_manifest
     from shadowcam.io.provenance import file_sha256
+    from shadowcam.lab.accuracy import accuracy_report, noise_condition, report_to_csv, report_to_json
 
     params = parse_params(args.params, allowed={"noise"})
     manifest = load_manifest(args.manifest)
     gt = load_ground_truth(manifest)
-    synthetic = manifest.get("synthetic") or {}
-    declared = (manifest.get("ground_truth") or {}).get("noise")
-    if "noise" in params:
-        noise, source = params["noise"], "--params"
-    elif declared:
-        noise, source = declared, "manifest ground_truth.noise"
-    elif "noise" in synthetic:
-        noise, source = ("raw12" if synthetic["noise"] else "noise_free"), "manifest synthetic.noise"
-    else:
-        noise, source = "noise_free", "default"
-    report = accuracy_report(_open(args.shadow_time), gt, dual_coords=_open(args.dual_coords),
-                             dual_view=_open(args.dual_view), noise=noise)
-    report["noise_source"] = source
-    report["dataset"] = manifest["name"]
-    report["inputs"] = {str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view) if p}
-    report["ground_truth_sha256"] = gt.attrs.get("source_sha256", "")
+    noise, source = noise_condition(manifest, params.get("noise"))
+    report = accuracy_report(open_dataset(args.shadow_time), gt, noise=noise,
+                             dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None,
+                             dual_view=open_dataset(args.dual_view) if args.dual_view else None)
+    report.update(noise_source=source, dataset=manifest["name"],
+                  inputs={str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view) if p},
+                  ground_truth_sha256=gt.attrs.get("source_sha256", ""))
     for target in report["targets"]:
         log.info("%s [%s] = %.4g (%s %.4g): %s", target["target"], target["sweep"], target["value"],
                  target["comparison"], target["threshold"], "pass" if target["pass"] else "FAIL")

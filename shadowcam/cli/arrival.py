@@ -11,7 +11,7 @@ run : compute and write the arrival map.
 
 from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals, time_to_frame
 from shadowcam.cli.options import parse_params
-from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
+from shadowcam.io.datasets import open_dataset, write_dataset
 from shadowcam.io.frame_times import median_interval
 from shadowcam.outdoor.datasets import arrival_dataset
 
@@ -43,4 +43,4 @@ def run(args):
                                        tolerance_s=params.get("tolerance_intervals", 1.5) * interval)
     dataset = arrival_dataset(arrival, time_to_frame(arrival, time_s), reason, edge_arrival_s=edge_s,
                               coverage_arrival_s=coverage_s, interval_s=interval)
-    write_dataset(dataset, args.out, config=params, checksums=input_checksums(photometry, edges), step="arrival")
+    write_dataset(dataset, args.out, config=params, inputs=(photometry, edges), step="arrival")

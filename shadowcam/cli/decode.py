@@ -1,22 +1,19 @@
 """``shadowcam decode``: decode one sweep (or the reference) of a capture into a frame store.
 
 Verifies the sha256 of the files it decodes first, then streams the frames
-into ``results/<ds>/frames/<sweep>.zarr`` (see ``shadowcam.io.frame_store``).
+into ``results/<ds>/frames/<sweep>.zarr`` (:func:`shadowcam.io.sweep_store.decode_sweep`).
 With ``--frames START:STOP`` it decodes only that range into a *part* store
 (one job of a long sweep; ``shadowcam merge-frames`` joins the parts).
 
 Offers
 ------
 add_parser : register the step and its options.
-parse_frame_range : the ``--frames START:STOP`` option, checked against the sweep length.
 run : verify checksums and decode.
 """
 
-import xarray as xr
-
-from shadowcam.io.frame_store import write_frames, write_reference
-from shadowcam.io.manifest import load_manifest, manifest_files, verify_checksums
-from shadowcam.io.provenance import attach_provenance
+from shadowcam.cli.options import parse_frame_range
+from shadowcam.io.manifest import load_manifest
+from shadowcam.io.sweep_store import decode_sweep
 
 
 def add_parser(subparsers, name):
@@ -36,59 +33,13 @@ def add_parser(subparsers, name):
     return parser
 
 
-def parse_frame_range(text, n_frames, *, chunk_frames=None):
-    """Return ``(start, stop)`` of a ``START:STOP`` range inside a sweep of `n_frames`.
-
-    `stop` is clipped to `n_frames` (the workflow sizes the last part by the
-    nominal job length); `start` must lie inside the sweep and, with
-    `chunk_frames`, on a chunk boundary.
-    """
-    try:
-        start, stop = (int(v) for v in text.split(":"))
-    except ValueError:
-        raise ValueError(f"--frames must be START:STOP with integers, got {text!r}") from None
-    if not 0 <= start < n_frames or stop <= start:
-        raise ValueError(f"--frames {text}: need 0 <= START < {n_frames} (frames in the sweep) and STOP > START")
-    if chunk_frames is None or start % chunk_frames:
-        raise ValueError(f"--frames {text}: START must be a multiple of --chunk-frames (given: {chunk_frames})")
-    return start, min(stop, n_frames)
-
-
 def run(args):
     """Decode ``args.sweep`` of ``args.manifest`` into ``args.out``."""
     manifest = load_manifest(args.manifest)
-    sweep = args.sweep
-    if sweep != "reference" and sweep not in manifest["sweeps"]:
-        raise ValueError(
-            f"--sweep {sweep!r} is not a sweep of {args.manifest}; "
-            f"available: {sorted(manifest['sweeps']) + (['reference'] if manifest['reference_paths'] else [])}"
-        )
-    if sweep == "reference" and not manifest["reference_paths"]:
-        raise ValueError(f"manifest {args.manifest} has no reference frame (key reference)")
-    if sweep == "reference" and args.frames:
+    frames = None
+    if args.frames and args.sweep in manifest["sweeps"]:
+        n_frames = len(manifest["sweeps"][args.sweep]["paths"])
+        frames = parse_frame_range(args.frames, n_frames, chunk_frames=args.chunk_frames)
+    elif args.frames and args.sweep == "reference":
         raise ValueError("--frames applies to sweeps, not to the reference")
-    if sweep == "reference":
-        checksums = verify_checksums(manifest, [sweep])
-    else:
-        entry = manifest["sweeps"][sweep]
-        start, stop = (0, len(entry["paths"]))
-        if args.frames:
-            start, stop = parse_frame_range(args.frames, stop, chunk_frames=args.chunk_frames)
-        checksums = verify_checksums(_only_files(manifest, sweep, entry["paths"][start:stop]), [sweep])
-    config = {"manifest": manifest["name"], "sweep": sweep, "chunk_frames": args.chunk_frames}
-    attrs = dict(attach_provenance(xr.Dataset(), config=config, input_checksums=checksums, step="decode").attrs)
-    attrs.update(dataset=manifest["name"], sweep=sweep)
-    if sweep == "reference":
-        write_reference(manifest["reference_paths"], args.out, attrs=attrs)
-        return
-    if "axis" in entry:
-        attrs["axis"] = entry["axis"]
-    write_frames(entry["paths"][start:stop], args.out, times_s=entry["times_s"][start:stop],
-                 attrs=attrs, chunk_frames=args.chunk_frames, first_frame=start)
-
-
-def _only_files(manifest, group, paths):
-    """`manifest` whose file group `group` lists only `paths` (what one part job reads)."""
-    wanted = {str(p) for p in paths}
-    files = [rel for rel, path in manifest_files(manifest, [group]).items() if path in wanted]
-    return {**manifest, "files": {**manifest["files"], group: files}}
+    decode_sweep(manifest, args.sweep, args.out, frames=frames, chunk_frames=args.chunk_frames)

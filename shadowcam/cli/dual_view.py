@@ -2,7 +2,8 @@
 
 Reads ``dual_coords.nc`` and ``shadow_time.nc`` (for the mean lit image, or
 ``--reference`` a reference frame store) and writes ``dual_view.nc``, a
-linear float EXR and an 8-bit sRGB PNG preview (holes in grey).
+linear float EXR and an 8-bit sRGB PNG preview (holes in grey)
+(:func:`shadowcam.cameras.dual_view.dual_view_from_coords`).
 
 Offers
 ------
@@ -10,13 +11,14 @@ add_parser : register the step and its options.
 run : resample and write the outputs.
 """
 
-import json
 import logging
-import time
 
-
+from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS, dual_view_from_coords
 from shadowcam.cli.options import parse_params
-from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS
+from shadowcam.io.datasets import open_dataset, write_dataset
+from shadowcam.io.frame_store import open_frames
+from shadowcam.io.images import write_exr, write_png_preview
+from shadowcam.io.provenance import file_sha256
 
 log = logging.getLogger(__name__)
 
@@ -39,55 +41,15 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Resample the camera colours into the dual grid and write the outputs."""
-    import xarray as xr
-
-    from shadowcam.cameras.dual_view import camera_colours, dual_view_dataset, resample_dual_view
-    from shadowcam.io.images import write_exr, write_netcdf, write_png_preview
-    from shadowcam.io.provenance import attach_provenance, file_sha256
-
     params = parse_params(args.params)
-    with xr.open_dataset(args.dual_coords, engine="h5netcdf") as ds:
-        coords = ds.load()
-    with xr.open_dataset(args.shadow_time, engine="h5netcdf") as ds:
-        shadow_time = ds[["lit_image"]].load() if "lit_image" in ds else ds.load()
-    checksums = {}
-    for path, ds in ((args.dual_coords, coords), (args.shadow_time, shadow_time)):
-        checksums.update(json.loads(ds.attrs.get("input_checksums", "{}")))
-        checksums[str(path)] = file_sha256(path)
-    reference = None
-    if args.reference:
-        from shadowcam.io.frame_store import open_frames
-
-        frames = open_frames(args.reference)
-        image = frames["image"]
-        if "time" in image.dims:
-            image = image.mean("time")
-        reference = image.transpose("row", "col", "channel").values
-        checksums.update(json.loads(frames.attrs.get("input_checksums", "{}")))
-    colours = camera_colours(shadow_time, reference=reference)
-    shape = (int(coords.attrs["dual_height"]), int(coords.attrs["dual_width"]))
-    u = coords["u"].transpose("row", "col").values
-    v = coords["v"].transpose("row", "col").values
-    if u.shape != colours.shape[:2]:
-        raise ValueError(f"--dual-coords grid {u.shape} differs from the camera colours {colours.shape[:2]}")
-    start = time.perf_counter()
-    try:
-        image, coverage = resample_dual_view(colours, u, v, shape=shape, valid=coords["valid"].values,
-                                             method=args.method, **params)
-    except TypeError as exc:
-        raise ValueError(f"--params: {exc}") from None
-    seconds = time.perf_counter() - start
-    log.info("%s resampling: %d camera pixels in %.3f s (%.2f M px/s), coverage %.1f%% of %dx%d",
-             args.method, u.size, seconds, u.size / seconds / 1e6, 100 * coverage.mean(), *shape)
-    channels = [str(c) for c in shadow_time["channel"].values] if "channel" in shadow_time.coords else ("R", "G", "B")
-    dataset = dual_view_dataset(image, coverage, method=args.method, params=params, channels=channels)
-    dataset.attrs.update(colour_source="reference" if reference is not None else "mean lit_image of u, v",
-                         dual_coords_model=coords.attrs.get("model", ""),
-                         resampling_seconds=seconds)
-    dataset = attach_provenance(dataset, config={"method": args.method, **params,
-                                                 "reference": bool(args.reference)},
-                                input_checksums=checksums, step="dual-view")
-    write_netcdf(dataset, args.out)
+    coords, shadow_time = open_dataset(args.dual_coords), open_dataset(args.shadow_time)
+    reference = open_frames(args.reference) if args.reference else None
+    dataset = dual_view_from_coords(coords, shadow_time, reference=reference, method=args.method, **params)
+    inputs = (coords, shadow_time) + ((reference,) if reference is not None else ())
+    checksums = {str(path): file_sha256(path) for path in (args.dual_coords, args.shadow_time)}
+    write_dataset(dataset, args.out, config={"method": args.method, **params, "reference": bool(args.reference)},
+                  inputs=inputs, checksums=checksums, step="dual-view")
+    image = dataset["dual_view"].values
     if args.exr:
         write_exr(args.exr, image)
     if args.png:

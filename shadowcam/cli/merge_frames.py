@@ -15,6 +15,7 @@ import json
 
 import xarray as xr
 
+from shadowcam.io.datasets import merge_input_checksums
 from shadowcam.io.frame_store import merge_frame_stores, open_frames
 from shadowcam.io.provenance import attach_provenance
 
@@ -30,11 +31,8 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Merge ``args.parts`` into ``args.out`` with the provenance of the whole sweep."""
-    checksums, first_attrs = {}, None
-    for path in args.parts:
-        attrs = open_frames(path).attrs
-        first_attrs = first_attrs or attrs
-        checksums.update(json.loads(attrs.get("input_checksums", "{}")))
-    provenance = attach_provenance(xr.Dataset(), config=json.loads(first_attrs.get("config", "{}")),
-                                   input_checksums=checksums, step=first_attrs.get("step", "decode")).attrs
+    attrs = [open_frames(path).attrs for path in args.parts]
+    first = next((a for a in attrs if a), {})
+    provenance = attach_provenance(xr.Dataset(), config=json.loads(first.get("config", "{}")),
+                                   input_checksums=merge_input_checksums(*attrs), step=first.get("step", "decode")).attrs
     merge_frame_stores(args.parts, args.out, attrs=provenance)

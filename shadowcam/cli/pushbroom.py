@@ -10,9 +10,10 @@ add_parser : register the step and its options.
 run : assemble and write the pushbroom.
 """
 
-from shadowcam.cli.outdoor_io import input_checksums, open_dataset, write_dataset
+from shadowcam.io.datasets import open_dataset, write_dataset
 from shadowcam.io.frame_times import median_interval
-from shadowcam.io.images import atomic_path, write_png_preview
+from shadowcam._shared.atomic import atomic_path
+from shadowcam.io.images import write_png_preview
 from shadowcam.outdoor.datasets import pushbroom_dataset
 from shadowcam.cameras.pushbroom import assemble_pushbroom, resample_uniform_time
 
@@ -35,7 +36,7 @@ def run(args):
     time_s = edges["time_s"].values
     image = assemble_pushbroom(photometry["reference"].values, edges["edge_row"].values)
     write_dataset(pushbroom_dataset(image, edges["edge_row"].values, time_s), args.out,
-                  config={"colour": "registered first frame"}, checksums=input_checksums(photometry, edges),
+                  config={"colour": "registered first frame"}, inputs=(photometry, edges),
                   step="pushbroom")
     _, uniform = resample_uniform_time(image, time_s, step_s=median_interval(time_s))
     with atomic_path(args.png) as tmp:

@@ -14,8 +14,8 @@ run : track the chunk and save the partial.
 import logging
 from pathlib import Path
 
-from shadowcam.cli.decode import parse_frame_range
-from shadowcam.cli.options import parse_params
+
+from shadowcam.cli.options import parse_frame_range, parse_params
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.io.frame_store import iter_frame_chunks, open_frames
 
@@ -41,7 +41,7 @@ def run(args):
     half_window = params.get("half_window", 4)
     frames = open_frames(args.frames)
     n_frames = frames.sizes["time"]
-    start, stop = parse_frame_range(args.owned, n_frames, chunk_frames=1)
+    start, stop = parse_frame_range(args.owned, n_frames, chunk_frames=1, option="--owned")
     out = Path(args.out)
     if out.suffix != ".npz":
         raise ValueError(f"--out must end with .npz; got {out}")

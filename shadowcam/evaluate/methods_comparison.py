@@ -26,8 +26,10 @@ compare_dual_view_methods : rows of figures, one per resampling method.
 pareto_front : which rows no other row beats in both speed and error.
 methods_dataset : the rows as an xarray dataset over ``method``.
 speed_error_figure : the speed-versus-error chart with its Pareto front.
+compare_methods : every method on one dataset's frame stores and dual coordinates -> the methods dataset.
 """
 
+import logging
 import time
 import tracemalloc
 
@@ -36,6 +38,8 @@ import numpy as np
 from shadowcam.lab.accuracy import dual_image_errors, shadow_time_errors
 from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS, resample_dual_view
 from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, summary_shadow_times, track_sweep
+
+log = logging.getLogger(__name__)
 
 
 def _measured(call):
@@ -261,3 +265,61 @@ def speed_error_figure(dataset, *, title=""):
         fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def compare_methods(truth, sweeps, shadow_time, coords, *, reference=None, half_window=4):
+    """Time every shadow-time and dual-view method on one dataset and score it against `truth`.
+
+    Parameters
+    ----------
+    truth : xarray.Dataset
+        Lab ground truth (``lit``, ``t_<sweep>``, ``reciprocal``, ``dual_cam_visible``).
+    sweeps : mapping of str to xarray.Dataset
+        Scene sweep name -> its frame store (loaded into memory before timing, so
+        that the trackers are timed and not the store's codec).
+    shadow_time : xarray.Dataset
+        Its ``lit_image`` gives the colours when `reference` is None.
+    coords : xarray.Dataset
+        Dual coordinates.
+    reference : xarray.Dataset, optional
+        Reference frame store.
+    half_window : int
+        Dip half window of the trackers.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`methods_dataset` of every method.
+    """
+    from shadowcam.cameras.dual_view import camera_colours
+    from shadowcam.io.frame_store import iter_frame_chunks
+
+    lit = truth["lit"].transpose("row", "col").values.astype(bool)
+    inputs, cfa = {}, None
+    for sweep, frames in sweeps.items():
+        if f"t_{sweep}" not in truth:
+            raise ValueError(f"sweeps: the ground truth has no t_{sweep}; compare scene sweeps only")
+        cfa = frames.attrs.get("cfa_pattern") or None
+        loaded = [block for _, block in iter_frame_chunks(frames)]
+
+        def blocks(loaded=loaded):
+            return iter(loaded)
+
+        inputs[sweep] = (blocks, truth[f"t_{sweep}"].transpose("row", "col").values, lit)
+    rows = compare_shadow_time_methods(inputs, half_window=half_window, cfa_pattern=cfa)
+    if reference is not None:
+        image = reference["image"]
+        image = image.mean("time") if "time" in image.dims else image
+        reference = image.transpose("row", "col", "channel").values
+    colours = camera_colours(shadow_time, reference=reference)
+    rows += compare_dual_view_methods(
+        colours, coords["u"].transpose("row", "col").values, coords["v"].transpose("row", "col").values,
+        shape=(int(coords.attrs["dual_height"]), int(coords.attrs["dual_width"])),
+        valid=coords["valid"].values, reciprocal=truth["reciprocal"].transpose("v", "u", "channel").values,
+        dual_cam_visible=truth["dual_cam_visible"].transpose("v", "u").values,
+    )
+    dataset = methods_dataset(rows)
+    for row, on_front in zip(rows, dataset["pareto"].values):
+        log.info("%-12s %-38s %9.3g /s  p95 %.4f  coverage %.3f  %s", row["stage"], row["method"],
+                 row["throughput"], row["p95"], row["coverage"], "Pareto" if on_front else "")
+    return dataset

@@ -22,7 +22,6 @@ OUTDOOR_SWEEP : preferred name of the time-lapse sweep of an outdoor capture.
 PLANNED_SHIFT_COLUMNS : camera shake (columns) the planned strip halo allows for.
 SweepPlan : one sweep: name, files, frame count, frame times, axis.
 CapturePlan : the plan of one capture (frozen dataclass).
-choose_dual_model : the dual-coordinate model that runs for a requested one.
 capture_plan : read a manifest into a :class:`CapturePlan`.
 """
 
@@ -33,6 +32,7 @@ from types import MappingProxyType
 
 import numpy as np
 
+from shadowcam.cameras.dual_coords import choose_dual_model
 from shadowcam.io.manifest import load_manifest
 
 #: scene sweeps of a lab capture (perpendicular, measuring dual u and v)
@@ -45,7 +45,6 @@ OUTDOOR_SWEEP = "timelapse"
 #: halo from the registration shifts it reads (shadowcam.outdoor.strips.strip_halo)
 PLANNED_SHIFT_COLUMNS = 4
 #: dual-coordinate models that may be requested ("auto" picks one of the other two)
-DUAL_MODELS = ("auto", "uniform", "calibration")
 
 
 @dataclass(frozen=True)
@@ -157,36 +156,6 @@ class CapturePlan:
         return self.sweeps[name]
 
 
-def choose_dual_model(model, *, calibration_available, missing="the calibration sweeps and plane"):
-    """Return the dual-coordinate model that runs for a requested `model`.
-
-    Parameters
-    ----------
-    model : {"auto", "uniform", "calibration"}
-        Requested model; ``auto`` is the simplest model the data support: the
-        calibration plane when it is available, else uniform motion.
-    calibration_available : bool
-        The calibration sweeps ``cal_u``, ``cal_v`` and the plane's homography exist.
-    missing : str, optional
-        What the calibration model lacks, for the error message.
-
-    Returns
-    -------
-    str
-        ``"uniform"`` or ``"calibration"``.
-
-    Raises
-    ------
-    ValueError
-        If `model` is unknown, or ``calibration`` without calibration data.
-    """
-    if model not in DUAL_MODELS:
-        raise ValueError(f"model must be one of {', '.join(DUAL_MODELS)}; got {model!r}")
-    if model == "auto":
-        return "calibration" if calibration_available else "uniform"
-    if model == "calibration" and not calibration_available:
-        raise ValueError(f"model 'calibration' needs {missing}; use model 'auto' or 'uniform'")
-    return model
 
 
 def _tracker_margin():

@@ -24,6 +24,7 @@ merge_frame_stores : join part stores (consecutive frame ranges) into one sweep 
 write_reference : decode and average reference frame(s) into a reference store.
 open_frames : open a store lazily (xarray, no dask).
 iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order (optionally a frame range).
+iter_store_frames : yield the (H, W, C) float32 frames one at a time (logging progress).
 """
 
 import json
@@ -418,3 +419,20 @@ def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
     for first in range(int(start), stop, chunk_frames):
         block = image.isel(time=slice(first, min(first + chunk_frames, stop))).values
         yield first, np.asarray(block, dtype=np.float32)
+
+
+def iter_store_frames(dataset, *, progress_every=50):
+    """Yield the ``(H, W, C)`` float32 frames of `dataset` one at a time, in time order.
+
+    Reads one chunk at a time (:func:`iter_frame_chunks`) and logs progress every
+    `progress_every` frames.
+    """
+    if progress_every < 1:
+        raise ValueError(f"progress_every must be >= 1; got {progress_every}")
+    n_frames = dataset.sizes["time"]
+    for start, block in iter_frame_chunks(dataset):
+        for offset, frame in enumerate(block):
+            done = start + offset + 1
+            if done % progress_every == 0 or done == n_frames:
+                log.info("frame %d/%d", done, n_frames)
+            yield frame

@@ -1,11 +1,10 @@
-"""Image and dataset writers: linear EXR, 8-bit PNG previews, NetCDF, all atomic.
+"""Image writers: linear EXR and 8-bit PNG previews, all atomic.
 
 Every writer writes to a temporary file next to the target and renames it
 into place, so a failure never leaves a half-written output behind.
 
 Offers
 ------
-atomic_path : context manager yielding a temporary path that replaces the target on success.
 write_exr : linear float32 OpenEXR via OpenImageIO (NaN kept).
 read_image : any OpenImageIO-readable image as a float32 ``(rows, cols, channel)`` array.
 exposure_scale : robust exposure scale (percentile of the brightest channel).
@@ -15,38 +14,16 @@ colormap_rgb8 : scalar map -> 8-bit colour-mapped preview, NaN in grey.
 write_png : write an 8-bit image as PNG.
 write_png_preview : `preview_rgb8` + `write_png`.
 write_scalar_preview : `colormap_rgb8` + `write_png`.
-write_netcdf : xarray Dataset -> NetCDF (h5netcdf engine).
 """
 
-import contextlib
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from shadowcam._shared.atomic import atomic_path
+
 #: display colour of holes (NaN) in previews, sRGB-encoded [0, 1] (mid grey)
 HOLE_COLOUR = (0.5, 0.5, 0.5)
-
-
-@contextlib.contextmanager
-def atomic_path(path):
-    """Yield a temporary path beside `path`; rename it onto `path` if the block succeeds.
-
-    The temporary name keeps the suffix of `path` (writers choose the format
-    from it). On an exception the temporary file is removed.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        yield Path(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
 
 
 def _as_hwc(image, name="image"):
@@ -230,9 +207,3 @@ def write_png_preview(path, image, **options):
 def write_scalar_preview(path, values, **options):
     """Write the `colormap_rgb8` of a scalar map as PNG (options as there)."""
     write_png(path, colormap_rgb8(values, **options))
-
-
-def write_netcdf(dataset, path):
-    """Write an xarray Dataset as NetCDF-4 (engine h5netcdf), atomically."""
-    with atomic_path(path) as tmp:
-        dataset.to_netcdf(tmp, engine="h5netcdf")

@@ -26,6 +26,7 @@ dual_coord_errors : error statistics of dual coordinates.
 dual_image_errors : gain-fitted relative RMSE of a dual view, masked and whole image.
 check_targets : pass/fail of every target for a report.
 accuracy_report : the nested report for one dataset's products.
+noise_condition : the noise condition whose targets apply, and where it came from.
 flatten_report : the report as ``(key, value)`` rows.
 report_to_json, report_to_csv : serialise a report to text.
 """
@@ -423,3 +424,31 @@ def report_to_csv(report):
     writer.writerow(["metric", "value"])
     writer.writerows(flatten_report(report))
     return buf.getvalue()
+
+
+def noise_condition(manifest, noise=None):
+    """The noise condition that selects the shadow-time target, and its source.
+
+    Parameters
+    ----------
+    manifest : mapping
+        Loaded manifest: ``ground_truth.noise``, else ``synthetic.noise`` (True: ``raw12``).
+    noise : str, optional
+        Explicit condition (wins).
+
+    Returns
+    -------
+    noise : str
+        ``noise_free`` or ``raw12`` (or the declared name).
+    source : str
+        ``--params``, ``manifest ground_truth.noise``, ``manifest synthetic.noise`` or ``default``.
+    """
+    synthetic = manifest.get("synthetic") or {}
+    declared = (manifest.get("ground_truth") or {}).get("noise")
+    if noise is not None:
+        return noise, "--params"
+    if declared:
+        return declared, "manifest ground_truth.noise"
+    if "noise" in synthetic:
+        return ("raw12" if synthetic["noise"] else "noise_free"), "manifest synthetic.noise"
+    return "noise_free", "default"

@@ -151,7 +151,7 @@ class DipPartial:
 
     def save(self, path):
         """Write to `path` (ending ``.npz``) atomically: a temporary file, then a rename."""
-        from shadowcam.io.images import atomic_path
+        from shadowcam._shared.atomic import atomic_path
 
         with atomic_path(path) as tmp:
             np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})

@@ -19,7 +19,11 @@ track_sweep : stream frame blocks of one sweep into a summary and per-channel co
 lit_colour : unshadowed colour per pixel from a summary with channel sums.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
 summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
+shadow_time_dataset : assemble the per-sweep results into the ``shadow_time`` dataset.
+shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials) -> the ``shadow_time`` dataset.
 """
+
+import logging
 
 import numba as nb
 import numpy as np
@@ -27,6 +31,8 @@ from scipy.special import ndtri
 
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
+
+log = logging.getLogger(__name__)
 
 #: flag code -> meaning (0 = a reliable time)
 REASONS = {
@@ -683,3 +689,59 @@ def shadow_time_dataset(per_sweep, *, channels=("R", "G", "B")):
     for name in names:
         ds.attrs[f"n_frames_{name}"] = int(per_sweep[name]["n_frames"])
     return ds
+
+
+def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_window=4, method_params=None,
+                          classify_params=None):
+    """Shadow times of every sweep of a capture.
+
+    Parameters
+    ----------
+    stores : mapping of str to xarray.Dataset
+        Sweep name -> its frame store (``image (time, row, col, channel)``), streamed one
+        time chunk at a time.
+    method : str
+        Key of :data:`SHADOW_TIME_METHODS`.
+    partials : mapping of str to sequence of path, optional
+        Sweep name -> the :class:`shadowcam.lab.dip_tracker.DipPartial` files of all its
+        time chunks; those sweeps are merged from them instead of streamed (same result
+        bit for bit).
+    half_window : int
+        Dip half window of the streamed sweeps.
+    method_params, classify_params : mapping, optional
+        Options of the timing method and of :func:`classify_dips`.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`shadow_time_dataset` of the sweeps.
+    """
+    from shadowcam.io.frame_store import iter_frame_chunks
+    from shadowcam.lab.dip_tracker import DipPartial, merge_partials
+
+    if method not in SHADOW_TIME_METHODS:
+        raise ValueError(f"method: unknown {method!r}; choose from {sorted(SHADOW_TIME_METHODS)}")
+    partials = dict(partials or {})
+    unknown = set(partials) - set(stores)
+    if unknown:
+        raise ValueError(f"partials: sweeps {sorted(unknown)} are not among the stores {sorted(stores)}")
+    per_sweep = {}
+    for sweep, frames in stores.items():
+        n_frames = frames.sizes["time"]
+        shape = (frames.sizes["row"], frames.sizes["col"])
+        options = dict(method=method, cfa_pattern=frames.attrs.get("cfa_pattern") or None,
+                       method_params=method_params, classify_params=classify_params)
+        if sweep in partials:
+            log.info("sweep %s: merging %d time chunks of %d frames", sweep, len(partials[sweep]), n_frames)
+            summary = merge_partials([DipPartial.load(p) for p in partials[sweep]], n_frames=n_frames)
+            per_sweep[sweep] = summary_shadow_times(summary, **options)
+        else:
+            log.info("sweep %s: %d frames of %dx%d", sweep, n_frames, shape[0], shape[1])
+
+            def progress(done, sweep=sweep, n_frames=n_frames):
+                log.info("sweep %s: %d/%d frames", sweep, done, n_frames)
+
+            per_sweep[sweep] = sweep_shadow_times(
+                (block for _, block in iter_frame_chunks(frames)), shape,
+                half_window=half_window, progress=progress, **options)
+    return shadow_time_dataset(per_sweep)

@@ -20,9 +20,19 @@ edge_errors : tracked edge rows against the GT edge rows.
 map_to_truth_camera : a map in the first frame's coordinates resampled into the GT camera's.
 edges_to_truth_camera : per-column edge rows of the first frame's coordinates in the GT camera's.
 registration_errors : estimated shifts (relative to frame 0) against the recorded shake.
+pushbroom_errors : relative colour errors of a pushbroom image against the GT pushbroom.
+accuracy_condition : the condition whose targets apply (explicit, else the manifest's GT noise).
+outdoor_accuracy : the whole report of one capture: arrival maps, baseline, edges, pushbroom, registration.
 """
 
+import logging
+
 import numpy as np
+
+from shadowcam.io.frame_store import iter_store_frames
+from shadowcam.io.frame_times import median_interval
+
+log = logging.getLogger(__name__)
 
 #: condition -> {statistic: bound} (errors in median capture intervals)
 TARGETS = {
@@ -294,3 +304,101 @@ def registration_errors(shift_row, shift_col, *, shake_dy, shake_dx):
             "rms_px": float(np.sqrt(np.mean(d_row**2 + d_col**2))),
             "max_abs_px": float(np.max(np.abs(np.r_[d_row, d_col]))),
             "true_max_px": float(np.max(np.hypot(true_row, true_col)))}
+
+
+def pushbroom_errors(pushbroom, truth):
+    """Relative colour errors of a pushbroom image against the GT pushbroom.
+
+    The estimate is scaled to the GT by the median ratio of channel sums (the
+    pipeline's colours are in camera units); the error of a pixel is the L1
+    colour difference over the GT's channel sum.
+
+    Parameters
+    ----------
+    pushbroom, truth : (T, W, C) ndarray
+        Estimated and GT pushbroom images (NaN = none); same shape.
+
+    Returns
+    -------
+    dict
+        ``n`` (pixels compared), ``scale_to_gt``, ``median_rel_error``, ``p95_rel_error``.
+    """
+    pushbroom, truth = np.asarray(pushbroom), np.asarray(truth)
+    if pushbroom.shape != truth.shape or pushbroom.ndim != 3:
+        raise ValueError(f"pushbroom: shape {pushbroom.shape} must equal the truth's {truth.shape} (T, W, C)")
+    both = np.isfinite(pushbroom).all(-1) & np.isfinite(truth).all(-1) & (truth.sum(-1) > 0)
+    scale = float(np.median(pushbroom[both].sum(-1) / truth[both].sum(-1))) if both.any() else float("nan")
+    rel = np.abs(pushbroom[both] / scale - truth[both]).sum(-1) / truth[both].sum(-1)
+    return {"n": int(both.sum()), "scale_to_gt": scale,
+            "median_rel_error": float(np.median(rel)) if rel.size else float("nan"),
+            "p95_rel_error": float(np.percentile(rel, 95)) if rel.size else float("nan")}
+
+
+def accuracy_condition(manifest, condition=None):
+    """The condition whose targets apply: `condition`, else the manifest's ``ground_truth.noise``
+    if it names one of :data:`TARGETS`, else ``nuisances``."""
+    if condition is not None:
+        if condition not in TARGETS:
+            raise ValueError(f"condition: must be one of {sorted(TARGETS)}; got {condition!r}")
+        return condition
+    noise = manifest.get("ground_truth", {}).get("noise")
+    return noise if noise in TARGETS else "nuisances"
+
+
+def outdoor_accuracy(truth, frames, photometry, edges, arrival, pushbroom, *, condition):
+    """Evaluate one outdoor capture's products against its ground truth.
+
+    Parameters
+    ----------
+    truth : xarray.Dataset
+        Outdoor ground truth (:func:`shadowcam.io.ground_truth.load_ground_truth`).
+    frames : xarray.Dataset
+        Frame store of the time-lapse (streamed for the naive baseline).
+    photometry, edges, arrival, pushbroom : xarray.Dataset
+        The pipeline's outdoor datasets.
+    condition : {"clean", "nuisances"}
+        Targets that apply.
+
+    Returns
+    -------
+    dict
+        :func:`evaluate_arrivals` report plus ``false_arrivals``, ``first_frame_shake_px``
+        and, where the GT has them, ``edge_row``, ``pushbroom``, ``registration``.
+    """
+    if condition not in TARGETS:
+        raise ValueError(f"condition: must be one of {sorted(TARGETS)}; got {condition!r}")
+    time_s = frames["time_s"].values
+    if "times_s" in truth and truth["times_s"].size == time_s.size:
+        log.info("frame times vs GT: max |difference| %.3g s", float(np.max(np.abs(truth["times_s"].values - time_s))))
+    baseline = NaiveBaseline((frames.sizes["row"], frames.sizes["col"]))
+    for frame, t in zip(iter_store_frames(frames), time_s):
+        baseline.update(frame, t)
+    # the maps are in the first frame's pixel grid; synthetic GT is in the unshaken camera
+    shift = {"shift_row": 0.0, "shift_col": 0.0}
+    has_shake = "shake_dy_px" in truth and truth["shake_dy_px"].size == time_s.size
+    if has_shake:
+        shift = {"shift_row": float(truth["shake_dy_px"].values[0]),
+                 "shift_col": float(truth["shake_dx_px"].values[0])}
+        log.info("first frame's shake (GT): row %+.3f px, col %+.3f px; maps resampled into the GT camera",
+                 shift["shift_row"], shift["shift_col"])
+    estimates = {
+        name: map_to_truth_camera(arrival[variable].values, **shift)
+        for name, variable in (("combined", "arrival_time_s"), ("edge_crossing", "edge_arrival_s"),
+                               ("coverage_crossing", "coverage_arrival_s"))
+    }
+    # the baseline works on the frames as delivered (no registration)
+    estimates["naive_baseline"] = baseline.arrival_s
+    report = evaluate_arrivals(estimates, truth, interval_s=median_interval(time_s), condition=condition)
+    report["false_arrivals"] = {name: false_arrivals(est, truth) for name, est in estimates.items()}
+    report["first_frame_shake_px"] = shift
+    if "pb_edge_y" in truth and truth["pb_edge_y"].shape == edges["edge_row"].shape:
+        unambiguous = truth["pb_n_transitions"].values == 1 if "pb_n_transitions" in truth else None
+        report["edge_row"] = edge_errors(edges_to_truth_camera(edges["edge_row"].values, **shift),
+                                         truth["pb_edge_y"].values, unambiguous=unambiguous)
+    if "pb_front" in truth and truth["pb_front"].shape == pushbroom["pushbroom"].shape:
+        report["pushbroom"] = pushbroom_errors(pushbroom["pushbroom"].values, truth["pb_front"].values)
+    if has_shake:
+        report["registration"] = registration_errors(photometry["shift_row"].values, photometry["shift_col"].values,
+                                                     shake_dy=truth["shake_dy_px"].values,
+                                                     shake_dx=truth["shake_dx_px"].values)
+    return report

@@ -33,18 +33,24 @@ strip_halo : halo columns needed for a photometry's shifts and the tracking opti
 strip_window : the columns a strip reads (its own plus the halo, clipped to the frame).
 track_strip : run the tracking pass on one strip.
 merge_strips : join strips into the single job's result.
+save_strip : write a strip to ``.npz`` atomically.
+load_strip : read it back.
 """
 
 import math
 
 import numpy as np
 
+from shadowcam._shared.atomic import atomic_path
 from shadowcam.outdoor.tracking import EdgeTracker
 
 #: extra halo columns against the band errors creeping in from the window's cut
 GUARD_COLUMNS = 8
 #: per-frame (time, col) results of the pass
 COLUMN_KEYS = ("edge_row", "confidence", "n_transitions")
+#: arrays of a strip file (:func:`save_strip`)
+STRIP_KEYS = ("cols", "kept", "width", "edge_row", "confidence", "n_transitions", "coverage_arrival_s",
+              "band_count", "valid_count")
 
 
 def strip_bounds(width, n_strips):
@@ -197,3 +203,26 @@ def merge_strips(strips):
     merged["band_fraction"] = (band / valid if valid else np.zeros_like(band)).astype(np.float32)
     return {key: merged[key] for key in ("edge_row", "confidence", "n_transitions", "band_fraction",
                                          "coverage_arrival_s")}
+
+
+def save_strip(strip, path):
+    """Write `strip` (:func:`track_strip`) to `path` (``.npz``) atomically."""
+    if not str(path).endswith(".npz"):
+        raise ValueError(f"path must end with .npz; got {path}")
+    with atomic_path(path) as tmp:
+        np.savez(tmp, **{key: np.asarray(strip[key]) for key in STRIP_KEYS})
+
+
+def load_strip(path):
+    """Read a strip written by :func:`save_strip` (dict as :func:`track_strip` returns)."""
+    with np.load(path) as data:
+        missing = set(STRIP_KEYS) - set(data.files)
+        if missing:
+            raise ValueError(f"{path} is not an edge-tracking strip: missing {sorted(missing)}; "
+                             "rerun track-edges-strip")
+        strip = {key: data[key] for key in STRIP_KEYS}
+    for key in ("cols", "kept"):
+        strip[key] = tuple(int(v) for v in strip[key])
+    for key in ("width", "valid_count"):
+        strip[key] = int(strip[key])
+    return strip

@@ -155,3 +155,41 @@ def test_tables():
     assert [m.n_params for m in DUAL_COORD_MODELS.values()] == sorted(
         m.n_params for m in DUAL_COORD_MODELS.values())
     assert set(DUAL_COORD_METHODS) == {"uniform", "calibration"}
+
+
+def _shadow_time_dataset(t_u, t_v, n_frames=(20, 10), cal=False):
+    import xarray as xr
+
+    sweeps = ["u", "v"] + (["cal_u", "cal_v"] if cal else [])
+    stack = np.stack([t_u, t_v] + ([t_u, t_v] if cal else []))
+    return xr.Dataset({"shadow_time": (("sweep", "row", "col"), stack)}, coords={"sweep": sweeps},
+                      attrs={"n_frames_u": n_frames[0], "n_frames_v": n_frames[1]})
+
+
+def test_front_function_uniform_motion_maps_frames_to_dual_pixels():
+    from shadowcam.cameras.dual_coords import choose_dual_coords_method, dual_coords_from_shadow_time
+
+    rows, cols = np.mgrid[0:6, 0:8].astype(np.float32)
+    shadow_time = _shadow_time_dataset(cols * 2.0, rows, n_frames=(20, 10))
+    assert choose_dual_coords_method(shadow_time, "auto", homography=np.eye(3)) == "uniform"
+    dataset = dual_coords_from_shadow_time(shadow_time, method="uniform")
+    assert (dataset.attrs["dual_width"], dataset.attrs["dual_height"]) == (20, 10)
+    np.testing.assert_allclose(dataset["u"].values, cols * 2.0)
+    np.testing.assert_allclose(dataset["v"].values, rows)
+    narrow = dual_coords_from_shadow_time(shadow_time, method="uniform", dual_width=10)
+    # half the grid: frame edges -0.5 .. 19.5 map onto dual edges -0.5 .. 9.5
+    np.testing.assert_allclose(narrow["u"].values, (cols * 2.0 + 0.5) / 2 - 0.5, atol=1e-5)
+
+
+def test_front_function_refuses_what_it_cannot_do():
+    from shadowcam.cameras.dual_coords import choose_dual_coords_method, dual_coords_from_shadow_time
+
+    shadow_time = _shadow_time_dataset(np.zeros((3, 3)), np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="cal_u"):
+        choose_dual_coords_method(shadow_time, "calibration", homography=np.eye(3))
+    assert choose_dual_coords_method(_shadow_time_dataset(np.zeros((3, 3)), np.zeros((3, 3)), cal=True),
+                                     homography=np.eye(3)) == "calibration"
+    with pytest.raises(ValueError, match="n_frames"):
+        dual_coords_from_shadow_time(shadow_time.assign_attrs(n_frames_u=0))
+    with pytest.raises(ValueError, match="cal_u"):
+        dual_coords_from_shadow_time(shadow_time, method="calibration", homography=np.eye(3))

@@ -173,3 +173,24 @@ def test_mesh_warp_of_exact_gt_reproduces_reciprocal_render(shared_data):
     assert np.median(np.abs(per_pixel - 1)) < 0.01
     rel_rmse = np.sqrt(np.mean((gain * est - ref) ** 2) / np.mean(ref**2))
     assert rel_rmse < 0.10
+
+
+def test_front_function_resamples_the_reference_colours_into_the_dual_grid():
+    from shadowcam.cameras.dual_view import dual_view_from_coords
+
+    rows, cols = np.mgrid[0:12, 0:16].astype(np.float64)
+    colours = np.stack([cols / 16, rows / 12, np.full_like(rows, 0.5)], axis=-1).astype(np.float32)
+    coords = xr.Dataset({"u": (("row", "col"), cols), "v": (("row", "col"), rows),
+                         "valid": (("row", "col"), np.ones(rows.shape, bool))},
+                        attrs={"dual_height": 12, "dual_width": 16, "model": "uniform"})
+    reference = xr.Dataset({"image": (("time", "row", "col", "channel"), np.stack([colours, colours]))})
+    shadow_time = xr.Dataset(coords={"sweep": ["u", "v"], "channel": ["R", "G", "B"]})
+    dataset = dual_view_from_coords(coords, shadow_time, reference=reference)
+    # identity coordinates: the dual view is the camera image
+    np.testing.assert_allclose(dataset["dual_view"].values, colours, atol=1e-6)
+    assert dataset["coverage"].values.all()
+    assert dataset.attrs["colour_source"] == "reference" and dataset.attrs["dual_coords_model"] == "uniform"
+    with pytest.raises(ValueError, match="params"):
+        dual_view_from_coords(coords, shadow_time, reference=reference, no_such_option=1)
+    with pytest.raises(ValueError, match="coords"):
+        dual_view_from_coords(coords.isel(row=slice(0, 6)), shadow_time, reference=reference)

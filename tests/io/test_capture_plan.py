@@ -8,12 +8,12 @@ import pytest
 import xarray as xr
 import yaml
 
+from shadowcam.cameras.dual_coords import choose_dual_model
 from shadowcam.cli import main
 from shadowcam.io.capture_plan import (
     PLANNED_SHIFT_COLUMNS,
     CapturePlan,
     capture_plan,
-    choose_dual_model,
 )
 from shadowcam.io.manifest import checksums_for
 from shadowcam.outdoor.strips import strip_halo
@@ -164,7 +164,7 @@ def test_choose_dual_model():
     assert choose_dual_model("uniform", calibration_available=True) == "uniform"
     with pytest.raises(ValueError, match="needs the plane"):
         choose_dual_model("calibration", calibration_available=False, missing="the plane")
-    with pytest.raises(ValueError, match="model must be one of"):
+    with pytest.raises(ValueError, match="model must be .auto. or one of"):
         choose_dual_model("affine", calibration_available=True)
 
 

@@ -2,18 +2,15 @@
 
 import numpy as np
 import pytest
-import xarray as xr
 
 from shadowcam.io.images import (
     HOLE_COLOUR,
-    atomic_path,
     colormap_rgb8,
     exposure_scale,
     preview_rgb8,
     read_image,
     srgb_encode,
     write_exr,
-    write_netcdf,
     write_png_preview,
     write_scalar_preview,
 )
@@ -61,16 +58,3 @@ def test_colormap_preview_nan_grey(tmp_path):
     assert (tmp_path / "t.png").stat().st_size > 0
     with pytest.raises(ValueError, match="values"):
         colormap_rgb8(np.zeros((2, 2, 2)))
-
-
-def test_atomic_path_removes_temporary_on_failure(tmp_path):
-    target = tmp_path / "x.nc"
-    with pytest.raises(RuntimeError):
-        with atomic_path(target) as tmp:
-            tmp.write_text("half")
-            raise RuntimeError("boom")
-    assert list(tmp_path.iterdir()) == []
-    ds = xr.Dataset({"a": (("row",), np.arange(3, dtype=np.float32))})
-    write_netcdf(ds, target)
-    with xr.open_dataset(target, engine="h5netcdf") as back:
-        np.testing.assert_array_equal(back["a"].values, ds["a"].values)

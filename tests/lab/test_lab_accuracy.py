@@ -182,3 +182,14 @@ def test_calibration_dual_grid_is_compared_like_for_like():
     assert report["dual_coords"]["max"] < 1e-3  # float32 coordinates of ~40 px
     assert report["dual_image"]["n_mask"] > 0.9 * 30 * 40
     assert report["dual_image"]["rel_rmse_masked"] < 5e-3  # bilinear resampling only
+
+
+def test_noise_condition_explicit_then_declared_then_synthetic_then_default():
+    from shadowcam.lab.accuracy import noise_condition
+
+    assert noise_condition({"ground_truth": {"noise": "raw12"}}, "noise_free") == ("noise_free", "--params")
+    assert noise_condition({"ground_truth": {"noise": "raw12"}, "synthetic": {"noise": False}}) == (
+        "raw12", "manifest ground_truth.noise")
+    assert noise_condition({"synthetic": {"noise": True}}) == ("raw12", "manifest synthetic.noise")
+    assert noise_condition({"synthetic": {"noise": False}}) == ("noise_free", "manifest synthetic.noise")
+    assert noise_condition({}) == ("noise_free", "default")

@@ -142,3 +142,26 @@ def test_dataset_has_units_and_flag_meanings(wire_sweep):
     assert ds["shadow_time"].attrs["units"] == "frame"
     assert ds["reason"].attrs["flag_meanings"].split()[0] == "ok"
     assert ds.attrs["n_frames_u"] == 20
+
+
+def test_stores_of_two_sweeps_give_one_dataset_equal_to_each_sweep_alone():
+    import xarray as xr
+
+    from shadowcam.lab.shadow_time import shadow_time_of_stores
+
+    frames_u, gt_u = wire_sweep(seed=1)
+    frames_v, gt_v = wire_sweep(seed=2, tilt=-0.2, t0=8.0)
+
+    def store(frames):
+        return xr.Dataset({"image": (("time", "row", "col", "channel"), frames)})
+
+    dataset = shadow_time_of_stores({"u": store(frames_u), "v": store(frames_v)}, half_window=4)
+    assert list(dataset["sweep"].values) == ["u", "v"]
+    alone = run(frames_v, half_window=4)
+    np.testing.assert_array_equal(dataset["shadow_time"].sel(sweep="v").values, alone["shadow_time"])
+    err, found = abs_error({"shadow_time": dataset["shadow_time"].sel(sweep="u").values}, gt_u)
+    assert found > 0.95 and np.median(err) < 0.1
+    with pytest.raises(ValueError, match="partials"):
+        shadow_time_of_stores({"u": store(frames_u)}, partials={"w": ["x.npz"]})
+    with pytest.raises(ValueError, match="method"):
+        shadow_time_of_stores({"u": store(frames_u)}, method="guess")

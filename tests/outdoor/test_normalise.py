@@ -21,7 +21,7 @@ import pytest
 import xarray as xr
 
 from shadowcam.cli import main
-from shadowcam.io.images import write_netcdf
+from shadowcam.io.datasets import write_netcdf
 from shadowcam.outdoor.datasets import photometry_part_dataset
 from shadowcam.outdoor.normalise import merge_parts, normalise_frames, normalise_part, part_frames
 from shadowcam.outdoor.registration import (apply_shift, block_all, block_mean, registration_factor,

@@ -53,3 +53,30 @@ def test_maps_of_a_shaken_first_frame_are_resampled_into_the_truth_camera():
     ok = np.isfinite(got)
     assert ok[:, 1:].all() and not ok[:, 0].any()  # column 0 maps to -0.4: outside
     np.testing.assert_allclose(got[ok], np.broadcast_to(edge_truth, got.shape)[ok], atol=1e-9)
+
+
+def test_pushbroom_errors_ignore_the_exposure_scale_and_find_colour_errors():
+    from shadowcam.outdoor.accuracy import pushbroom_errors
+
+    rng = np.random.default_rng(0)
+    truth = rng.uniform(0.1, 1.0, (6, 5, 3))
+    truth[0, 0] = np.nan  # no GT there
+    exact = pushbroom_errors(3.0 * truth, truth)
+    assert exact["n"] == 29 and exact["scale_to_gt"] == pytest.approx(3.0)
+    assert exact["median_rel_error"] == pytest.approx(0.0, abs=1e-12)
+    off = 3.0 * truth.copy()
+    off[..., 0] *= 1.3  # red 30 % too strong
+    worse = pushbroom_errors(off, truth)
+    assert worse["median_rel_error"] > 0.01
+    with pytest.raises(ValueError, match="pushbroom"):
+        pushbroom_errors(truth[:3], truth)
+
+
+def test_accuracy_condition_prefers_the_explicit_one():
+    from shadowcam.outdoor.accuracy import accuracy_condition
+
+    assert accuracy_condition({"ground_truth": {"noise": "clean"}}) == "clean"
+    assert accuracy_condition({"ground_truth": {"noise": "raw12"}}) == "nuisances"
+    assert accuracy_condition({}, "clean") == "clean"
+    with pytest.raises(ValueError, match="condition"):
+        accuracy_condition({}, "cloudy")

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from shadowcam.report import figures
-from shadowcam.cli.report_figures import csv_to_html
+from shadowcam.report.dataset_report import csv_to_html
 
 GREY_TOL = 1.5 / 255  # one 8-bit quantisation step (plus rounding)
 

@@ -222,7 +222,7 @@ def test_outdoor_manifests_validate():
 
 
 def test_accuracy_condition_is_clean_only_without_any_nuisance():
-    from shadowcam.cli.render_outdoor import OUTDOOR_OPTIONS, accuracy_condition
+    from shadowcam.synthetic.capture_options import OUTDOOR_OPTIONS, accuracy_condition
 
     clean = dict(OUTDOOR_OPTIONS, auto_exposure=False, shake_px=0, cloud=False,
                  irregular_timing=False, dropped_frames=0)

@@ -56,3 +56,32 @@ def test_mosaic_content_moves_by_the_recorded_shake():
     estimate, _ = shift_lucas_kanade_LucasKanade1981(greys[1], greys[0])
     true = np.array([shakes[1][1] - shakes[0][1], shakes[1][0] - shakes[0][0]])  # (row, col)
     np.testing.assert_allclose(estimate, true, atol=0.02)  # pixels of the sample
+
+
+def test_write_sample_writes_checksummed_frames_with_the_recorded_shake(tmp_path):
+    import json
+    from pathlib import Path
+
+    import yaml
+
+    from shadowcam.io.manifest import load_manifest
+    from shadowcam.io.provenance import file_sha256
+    from shadowcam.synthetic.outdoor.sample import write_sample
+
+    source_path = Path(__file__).resolve().parents[2] / "data_manifest" / "dev_ridge.yaml"
+    try:
+        source = load_manifest(source_path)
+    except (FileNotFoundError, ValueError) as exc:
+        pytest.skip(f"dev_ridge not available: {exc}")
+    manifest = write_sample(source, tmp_path / "sample", tmp_path / "m.yaml", name="tiny", size="96x64",
+                            frames=3, first=10, seed=2, shake_px=1.5)
+    assert yaml.safe_load((tmp_path / "m.yaml").read_text()) == manifest
+    assert sorted(p.name for p in (tmp_path / "sample" / "frames").iterdir()) == [
+        "000000.dng", "000001.dng", "000002.dng"]
+    sidecar = json.loads((tmp_path / "sample" / "timestamps.json").read_text())
+    assert sidecar["times_s"][0] == 0 and np.all(np.diff(sidecar["times_s"]) > 0)
+    assert max(np.abs(sidecar["shake_dx_px"]).max(), np.abs(sidecar["shake_dy_px"]).max()) <= 1.5 + 1e-9
+    for rel, digest in manifest["checksums"].items():
+        assert file_sha256(tmp_path / "sample" / rel) == digest, rel
+    with pytest.raises(ValueError, match="at least 3"):
+        write_sample(source, tmp_path / "x", tmp_path / "x.yaml", name="x", size="96x64", frames=2)

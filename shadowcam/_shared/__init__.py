@@ -1,0 +1,1 @@
+"""Small helpers shared by every wing of the package (no science here)."""

@@ -1,0 +1,136 @@
+"""The shadow edge of every outdoor frame: tracking, keyframes and the edges dataset.
+
+The second outdoor pass streams the registered frames through the edge tracker
+(:mod:`shadowcam.outdoor.tracking`), in one job or in column strips merged
+exactly (:mod:`shadowcam.outdoor.strips`); then keyframes are chosen and the
+edges of unreliable frames interpolated in seconds (:mod:`shadowcam.outdoor.keyframes`).
+
+Offers
+------
+TRACK_OPTIONS : options of the tracking pass.
+KEYFRAME_OPTIONS : options of the keyframe selection and interpolation.
+track_edges : frame store + photometry dataset -> edges dataset (one job).
+edges_from_strips : column strips of :func:`track_column_strip` + photometry -> the same edges dataset.
+track_column_strip : the tracking pass on one column strip of a frame store.
+"""
+
+import json
+import logging
+
+from shadowcam.io.frame_store import iter_store_frames
+from shadowcam.io.frame_times import find_gaps, median_interval
+from shadowcam.outdoor.datasets import edges_dataset, photometry_arrays
+from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
+from shadowcam.outdoor.strips import merge_strips, strip_bounds, strip_halo, strip_window, track_strip
+from shadowcam.outdoor.tracking import track_frames
+
+log = logging.getLogger(__name__)
+
+TRACK_OPTIONS = frozenset({"half_window", "min_drop", "margin", "max_step", "lit_update",
+                           "update_distance"})
+KEYFRAME_OPTIONS = frozenset({"min_confidence", "min_found_fraction"})
+
+
+def _check_options(options, allowed, name):
+    unknown = set(options) - set(allowed)
+    if unknown:
+        raise ValueError(f"{name}: unknown option(s) {sorted(unknown)}; allowed {sorted(allowed)}")
+
+
+def _edges(tracked, arrays, time_s, options):
+    key_options = {k: v for k, v in options.items() if k in KEYFRAME_OPTIONS}
+    is_keyframe = select_keyframes(tracked["confidence"], tracked["edge_row"], **key_options)
+    edge_row, interpolated = interpolate_edges(
+        tracked["edge_row"], tracked["confidence"], time_s, is_keyframe=is_keyframe,
+        min_confidence=key_options.get("min_confidence", 0.6))
+    dataset = edges_dataset(tracked, arrays, time_s, edge_row=edge_row, is_keyframe=is_keyframe,
+                            interpolated=interpolated)
+    dataset.attrs.update(median_interval_s=median_interval(time_s), gaps=json.dumps(find_gaps(time_s)))
+    return dataset
+
+
+def track_edges(frames, photometry, **options):
+    """Track the shadow edge of every frame and interpolate unreliable frames.
+
+    Parameters
+    ----------
+    frames : xarray.Dataset
+        Frame store of the time-lapse (``image (time, row, col, channel)``, coord ``time_s``).
+    photometry : xarray.Dataset
+        Result of the first pass (``photometry.nc``).
+    **options
+        :data:`TRACK_OPTIONS` and :data:`KEYFRAME_OPTIONS`.
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`shadowcam.outdoor.datasets.edges_dataset` with attrs ``median_interval_s``, ``gaps``.
+    """
+    _check_options(options, TRACK_OPTIONS | KEYFRAME_OPTIONS, "options")
+    arrays = photometry_arrays(photometry)
+    time_s = frames["time_s"].values
+    tracked = track_frames(iter_store_frames(frames), arrays, time_s,
+                           **{k: v for k, v in options.items() if k in TRACK_OPTIONS})
+    return _edges(tracked, arrays, time_s, options)
+
+
+def edges_from_strips(strips, photometry, time_s, *, width, **options):
+    """The :func:`track_edges` dataset from the column strips of the same frames.
+
+    Parameters
+    ----------
+    strips : sequence of dict
+        :func:`track_column_strip` results covering every column once.
+    photometry : xarray.Dataset
+    time_s : (T,) ndarray
+        Frame times of the frame store.
+    width : int
+        Columns of the frames.
+    **options
+        :data:`KEYFRAME_OPTIONS` (tracking options were used by the strips).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    _check_options(options, TRACK_OPTIONS | KEYFRAME_OPTIONS, "options")
+    tracked = merge_strips(strips)
+    if tracked["edge_row"].shape != (len(time_s), width):
+        raise ValueError(f"strips: merged shape {tracked['edge_row'].shape} does not match the frames "
+                         f"({len(time_s)} times x {width} columns); rerun track-edges-strip")
+    return _edges(tracked, photometry_arrays(photometry), time_s, options)
+
+
+def track_column_strip(frames, photometry, *, index, count, **options):
+    """Run the tracking pass on strip `index` of `count` equal column strips.
+
+    Reads only the strip's window (its columns plus a halo for the registration
+    shift and the frame-differencing widening) of every frame.
+
+    Parameters
+    ----------
+    frames : xarray.Dataset
+        Frame store of the time-lapse.
+    photometry : xarray.Dataset
+    index, count : int
+        Strip `index` (from 0) of `count`.
+    **options
+        :data:`TRACK_OPTIONS` (:data:`KEYFRAME_OPTIONS` are accepted and ignored).
+
+    Returns
+    -------
+    dict
+        :func:`shadowcam.outdoor.strips.track_strip` result.
+    """
+    _check_options(options, TRACK_OPTIONS | KEYFRAME_OPTIONS, "options")
+    if not 0 <= index < count:
+        raise ValueError(f"index: must be in [0, count={count}); got {index}")
+    options = {k: v for k, v in options.items() if k in TRACK_OPTIONS}
+    arrays = photometry_arrays(photometry)
+    width = frames.sizes["col"]
+    cols = strip_bounds(width, count)[index]
+    halo = strip_halo(arrays["shift"], margin=options.get("margin", 2))
+    a, b = strip_window(cols, halo, width)
+    log.info("strip %d/%d: columns %d:%d, reading %d:%d (halo %d)", index, count, *cols, a, b, halo)
+    return track_strip(iter_store_frames(frames.isel(col=slice(a, b))), arrays, frames["time_s"].values,
+                       cols=cols, halo=halo, **options)

@@ -1,0 +1,120 @@
+"""The report of one outdoor time-lapse: figures (paper Fig. 18), summary and accuracy table.
+
+Offers
+------
+accuracy_html : an HTML page of an outdoor accuracy report against its targets.
+outdoor_summary : counts of arrival reasons, keyframes and interpolated edges.
+write_outdoor_figures : write the figures, ``summary.json`` and ``accuracy.html`` into a directory.
+"""
+
+import html
+import json
+from pathlib import Path
+
+import numpy as np
+
+from shadowcam._shared.atomic import atomic_path
+from shadowcam.cameras.pushbroom import resample_uniform_time
+from shadowcam.io.frame_times import median_interval
+from shadowcam.outdoor.arrival import ARRIVAL_REASONS
+from shadowcam.outdoor.registration import apply_shift
+from shadowcam.report.figures import save_png
+from shadowcam.report.outdoor_figures import (
+    arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure, pushbroom_figure,
+)
+
+#: frames shown in the keyframes figure
+SHOWN_FRAMES = 6
+
+
+def accuracy_html(report):
+    """Return an HTML page of `report` (:func:`shadowcam.outdoor.accuracy.outdoor_accuracy`)."""
+    rows = []
+    for estimator, by_definition in report["errors"].items():
+        for definition, stats in by_definition.items():
+            rows.append(
+                f"<tr><td>{html.escape(estimator)}</td><td>{html.escape(definition)}</td>"
+                f"<td>{stats['median_abs']:.3f}</td><td>{stats['p95_abs']:.3f}</td>"
+                f"<td>{100 * stats['frac_over_5']:.2f}%</td><td>{100 * stats['frac_within_1']:.2f}%</td>"
+                f"<td>{100 * stats['coverage']:.2f}%</td></tr>")
+    targets = "".join(
+        f"<li>{html.escape(t['target'])} = {t['value']:.4f} (&lt;= {t['threshold']}): {'pass' if t['pass'] else 'FAIL'}</li>"
+        for t in report["targets"])
+    return (
+        "<html><body><h2>Outdoor arrival-time accuracy</h2>"
+        f"<p>Errors in median capture intervals ({report['interval_s']:.1f} s) over the {report['n_class3']} "
+        f"non-sky pixels the shadow reaches; targets ({html.escape(report['condition'])}) checked for "
+        f"{html.escape(report['primary_estimator'])} against {html.escape(report['primary_definition'])}.</p>"
+        f"<ul>{targets}</ul><table border='1'><tr><th>estimator</th><th>GT definition</th><th>median</th>"
+        "<th>p95</th><th>&gt; 5</th><th>within 1</th><th>coverage</th></tr>" + "".join(rows) + "</table></body></html>")
+
+
+def outdoor_summary(edges, arrival, report=None):
+    """Counts of the outdoor products: arrival reasons, keyframes, frames, interpolated edges.
+
+    Parameters
+    ----------
+    edges, arrival : xarray.Dataset
+    report : dict, optional
+        Accuracy report; adds ``all_targets_pass``.
+
+    Returns
+    -------
+    dict
+    """
+    reasons = arrival["reason"].values
+    summary = {"reasons": {name: int((reasons == code).sum()) for code, name in ARRIVAL_REASONS.items()},
+               "keyframes": int(edges["is_keyframe"].values.sum()),
+               "frames": int(edges["time_s"].size), "interpolated_edges": int(edges["interpolated"].values.sum())}
+    if report is not None:
+        summary["all_targets_pass"] = report["all_targets_pass"]
+    return summary
+
+
+def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbroom, report=None):
+    """Write the outdoor figures, ``summary.json`` and (with `report`) ``accuracy.html``.
+
+    Parameters
+    ----------
+    outdir : str or Path
+        Created if missing; files are written atomically one by one.
+    frames : xarray.Dataset
+        Frame store (only :data:`SHOWN_FRAMES` frames are read).
+    photometry, edges, arrival, pushbroom : xarray.Dataset
+        The pipeline's outdoor datasets.
+    report : dict, optional
+        Outdoor accuracy report.
+
+    Returns
+    -------
+    dict
+        The summary written.
+    """
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    sky = photometry["sky"].values.astype(bool)
+    time_s = edges["time_s"].values
+    picks = np.linspace(0, time_s.size - 1, SHOWN_FRAMES).round().astype(int)
+    step = display_step(sky.shape)
+    shown = []
+    for k in picks:  # registered, divided by their lit gain, decimated for display
+        frame = frames["image"].isel(time=int(k)).values
+        shift = (float(photometry["shift_row"][k]), float(photometry["shift_col"][k]))
+        shown.append(apply_shift(frame, shift)[::step, ::step] / np.float32(photometry["gain"].values[k]))
+        del frame
+    save_png(keyframes_figure(shown, [edges["edge_row"].values[k] for k in picks], time_s[picks], sky=sky,
+                              is_keyframe=edges["is_keyframe"].values[picks], step=step), outdir / "keyframes.png")
+    reference = photometry["reference"].values
+    save_png(edge_over_time_figure(edges["edge_row"].values, time_s, reference=reference, sky=sky),
+             outdir / "edge_over_time.png")
+    save_png(arrival_map_figure(arrival["arrival_time_s"].values, sky=sky), outdir / "arrival_map.png")
+    uniform_t, uniform = resample_uniform_time(pushbroom["pushbroom"].values, time_s,
+                                               step_s=median_interval(time_s))
+    save_png(pushbroom_figure(reference, uniform, uniform_t, sky=sky), outdir / "pushbroom.png")
+    if report is not None:
+        with atomic_path(outdir / "accuracy.html") as tmp:
+            tmp.write_text(accuracy_html(report))
+    summary = outdoor_summary(edges, arrival, report)
+    with atomic_path(outdir / "summary.json") as tmp:
+        tmp.write_text(json.dumps(summary, indent=2))
+    return summary
