@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from outdoor_scene import make_timelapse
 from shadowcam.outdoor.datasets import photometry_dataset
 from shadowcam.outdoor.edges import edges_from_strips, track_column_strip, track_edges
 from shadowcam.outdoor.normalise import normalise_frames
@@ -12,7 +11,7 @@ from shadowcam.outdoor.strips import load_strip, save_strip
 
 
 @pytest.fixture(scope="module")
-def capture():
+def capture(make_timelapse):
     scene = make_timelapse(width=60, n_frames=24, shake=1.5, noise=True, slope=0.3, seed=3)
     frames = xr.Dataset({"image": (("time", "row", "col", "channel"), np.asarray(scene["frames"]))},
                         coords={"time_s": ("time", scene["time_s"])})
