@@ -22,7 +22,6 @@ ARRIVAL_REASONS : reason code -> name (CF flag meanings).
 arrival_from_edges : arrival time of every pixel from the per-frame edge rows.
 CoverageCrossing : streaming first downward 0.5-crossing of per-pixel coverage.
 combine_arrivals : the final arrival map and its reasons.
-time_to_frame : fractional frame index of times, piecewise linear in the frame times.
 """
 
 import numpy as np
@@ -36,14 +35,6 @@ ARRIVAL_REASONS = {
     4: "sky",
 }
 REASON_CODE = {name: code for code, name in ARRIVAL_REASONS.items()}
-
-
-def time_to_frame(time_s, frame_times_s):
-    """Fractional frame index of `time_s`, piecewise linear in the frame times (NaN stays NaN)."""
-    frames = np.asarray(frame_times_s, dtype=np.float64)
-    time = np.asarray(time_s, dtype=np.float64)
-    out = np.interp(time, frames, np.arange(frames.size, dtype=np.float64))
-    return np.where(np.isfinite(time), out, np.nan)
 
 
 def arrival_from_edges(edge_row, time_s, *, eligible):
