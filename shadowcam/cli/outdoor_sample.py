@@ -30,7 +30,7 @@ from shadowcam.io.ground_truth import load_ground_truth
 from shadowcam.io.manifest import checksums_for, load_manifest
 from shadowcam.synthetic.outdoor.sample import parse_size, sample_mosaic, sample_shake, steady_frame, upsample_frame
 from shadowcam.io.raw_writer import write_dng
-from shadowcam.synthetic.sensor import SensorModel, exposure_scale
+from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
 log = logging.getLogger(__name__)
 
@@ -73,7 +73,7 @@ def run(args):
     def steady(k):
         return steady_frame(read_frame(sweep["paths"][args.first + k]), dx=source_dx[k], dy=source_dy[k])
 
-    scale = exposure_scale(upsample_frame(steady(0), rows=rows, cols=cols), sensor=sensor, target_fraction=0.7)
+    scale = electrons_per_unit_radiance(upsample_frame(steady(0), rows=rows, cols=cols), sensor=sensor, target_fraction=0.7)
     outdir = Path(args.outdir)
     (outdir / "frames").mkdir(parents=True, exist_ok=True)
     start_time = datetime.datetime(2026, 1, 15, 16, 0, 0)

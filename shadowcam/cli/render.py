@@ -188,7 +188,7 @@ def render_capture_dir(options, out_dir):
     """Render a capture described by `options` (see ``resolve_options``) into `out_dir`."""
     from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
     from shadowcam.synthetic.lab.scene import make_scene
-    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     started = time.perf_counter()
     scene = make_scene(options["scene"], seed=options["seed"], height=options["height"],
@@ -198,7 +198,7 @@ def render_capture_dir(options, out_dir):
                                calibration=options["calibration"])
     log.info("static rays cast in %.2f s", time.perf_counter() - started)
     sensor = SensorModel(bit_depth=options["bit_depth"])
-    scale = exposure_scale(renderer.reference, sensor=sensor,
+    scale = electrons_per_unit_radiance(renderer.reference, sensor=sensor,
                            target_fraction=options["exposure"])
     ext = options["format"]
     seed = int(options["seed"])

@@ -90,7 +90,7 @@ def render_outdoor_capture_dir(options, out_dir):
     from shadowcam.cli.render import DEFAULTS, _write_frame, staging_dir, write_ground_truth
     from shadowcam.synthetic.outdoor.capture import NUISANCES, edge_speed, render_outdoor_capture
     from shadowcam.synthetic.outdoor.render import make_outdoor_scene
-    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     started = time.perf_counter()
     outdoor = outdoor_options(options.get("outdoor"))
@@ -106,7 +106,7 @@ def render_outdoor_capture_dir(options, out_dir):
     gt = capture.ground_truth
     log.info("scene, frames and ground truth rendered in %.2f s", time.perf_counter() - started)
     sensor = SensorModel(bit_depth=options["bit_depth"])
-    scale = exposure_scale(gt["reference_radiance"].values, sensor=sensor,
+    scale = electrons_per_unit_radiance(gt["reference_radiance"].values, sensor=sensor,
                            target_fraction=options["exposure"])
     ext = options["format"]
     times = capture.times_s

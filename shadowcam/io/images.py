@@ -8,9 +8,11 @@ Offers
 atomic_path : context manager yielding a temporary path that replaces the target on success.
 write_exr : linear float32 OpenEXR via OpenImageIO (NaN kept).
 read_image : any OpenImageIO-readable image as a float32 ``(rows, cols, channel)`` array.
-exposure_scale : robust exposure scale (percentile of the brightest channel).
+white_point : the linear value shown as white (percentile of the brightest channel).
 srgb_encode : linear [0, 1] -> sRGB-encoded [0, 1].
-preview_rgb8 : linear colour image -> 8-bit sRGB preview, holes in a neutral colour.
+tone_map : linear colour image -> display RGB in [0, 1] (sRGB), holes in a neutral colour;
+    the one tone map of the PNG previews and the report figures.
+preview_rgb8 : `tone_map` quantised to 8 bits.
 colormap_rgb8 : scalar map -> 8-bit colour-mapped preview, NaN in grey.
 write_png : write an 8-bit image as PNG.
 write_png_preview : `preview_rgb8` + `write_png`.
@@ -114,8 +116,8 @@ def read_image(path):
     return np.asarray(pixels, dtype=np.float32).reshape(inp.spec().height, inp.spec().width, -1)
 
 
-def exposure_scale(image, *, percentile=99.0):
-    """Robust exposure scale: the `percentile` of each finite pixel's brightest channel.
+def white_point(image, *, percentile=99.0):
+    """The linear value shown as white: the `percentile` of each finite pixel's brightest channel.
 
     Parameters
     ----------
@@ -143,40 +145,53 @@ def srgb_encode(linear):
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
 
 
-def _to_uint8(display, holes, hole_colour):
+def _to_uint8(display, holes=None, hole_colour=HOLE_COLOUR):
     out = np.round(np.clip(display, 0, 1) * 255).astype(np.uint8)
-    out[holes] = np.round(np.asarray(hole_colour) * 255).astype(np.uint8)
+    if holes is not None:
+        out[holes] = np.round(np.asarray(hole_colour) * 255).astype(np.uint8)
     return out
 
 
-def preview_rgb8(image, *, percentile=99.0, scale=None, hole_colour=HOLE_COLOUR):
-    """8-bit sRGB preview of a linear image.
+def tone_map(image, *, percentile=99.0, scale=None, hole_colour=HOLE_COLOUR):
+    """Display RGB of a linear image: divided by its white point, sRGB-encoded.
 
     Parameters
     ----------
     image : (rows, cols[, channel]) ndarray
         Linear colour (1 channel -> grey, 3 -> RGB; extra channels dropped).
     percentile : float, keyword-only
-        Exposure: this percentile of the brightest channel maps to white.
+        Exposure: this percentile of the brightest channel maps to white (:func:`white_point`).
     scale : float, optional
-        Explicit exposure scale (overrides `percentile`).
+        Explicit white point (overrides `percentile`).
     hole_colour : (3,) sequence of float
         sRGB-encoded colour of pixels with a non-finite channel.
 
     Returns
     -------
-    (rows, cols, 3) uint8 ndarray
+    (rows, cols, 3) float64 ndarray
+        Values in [0, 1].
     """
     arr = _as_hwc(image).astype(np.float64)
     arr = np.repeat(arr, 3, axis=2) if arr.shape[2] == 1 else arr[..., :3]
     if arr.shape[2] != 3:
-        raise ValueError(f"image: expected 1 or >= 3 channels, got {arr.shape[2]}")
+        raise ValueError(f"image must have 1 or >= 3 channels; got {arr.shape[2]}")
     holes = ~np.all(np.isfinite(arr), axis=2)
-    scale = exposure_scale(arr, percentile=percentile) if scale is None else float(scale)
+    scale = white_point(arr, percentile=percentile) if scale is None else float(scale)
     if not scale > 0:
-        raise ValueError(f"scale: must be > 0, got {scale}")
+        raise ValueError(f"scale must be > 0; got {scale}")
     display = srgb_encode(np.nan_to_num(arr / scale, nan=0.0))
-    return _to_uint8(display, holes, hole_colour)
+    display[holes] = hole_colour
+    return display
+
+
+def preview_rgb8(image, **options):
+    """8-bit sRGB preview of a linear image: :func:`tone_map` (same options) quantised.
+
+    Returns
+    -------
+    (rows, cols, 3) uint8 ndarray
+    """
+    return _to_uint8(tone_map(image, **options))
 
 
 def colormap_rgb8(values, *, cmap="viridis", vmin=None, vmax=None, nan_colour=HOLE_COLOUR):

@@ -14,7 +14,7 @@ Offers
 ------
 SensorModel : bit depth, black level, gain, read noise (white level derived).
 mosaic_rggb : (rows, cols, 3) RGB -> (rows, cols) RGGB mosaic.
-exposure_scale : electrons per unit radiance placing a percentile of a reference at a target.
+electrons_per_unit_radiance : electrons per unit radiance placing a percentile of a reference at a target.
 simulate_raw : radiance -> integer DN (mosaic or per-channel RGB), noisy or noise-free.
 raw_to_linear : DN -> float32 normalised so that black = 0 and white level = 1.
 """
@@ -82,7 +82,7 @@ def mosaic_rggb(image):
     return out
 
 
-def exposure_scale(reference, *, sensor, target_fraction=0.8, percentile=99.5):
+def electrons_per_unit_radiance(reference, *, sensor, target_fraction=0.8, percentile=99.5):
     """Electrons per unit radiance so that a percentile of `reference` reaches a target.
 
     Parameters
@@ -117,7 +117,7 @@ def simulate_raw(radiance, *, sensor, scale, seed=None, noise=True, mosaic=True)
         Linear radiance (>= 0).
     sensor : SensorModel
     scale : float
-        Electrons per unit radiance (``exposure_scale``).
+        Electrons per unit radiance (``electrons_per_unit_radiance``).
     seed : int or sequence of int, optional
         Seed of ``numpy.random.default_rng``, e.g. ``[seed, sweep_index, frame]``;
         required when `noise` is True.
