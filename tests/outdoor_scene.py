@@ -14,7 +14,7 @@ make_timelapse : frames, times and the exact ground truth.
 
 import numpy as np
 
-from shadowcam.outdoor.registration import apply_shift
+from shadowcam.outdoor.translation import translate
 
 
 def make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.5, slope=0.15, y0=50.0,
@@ -55,7 +55,7 @@ def make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.5
         image = (radiance * gain * 0.5).astype(np.float32)
         shift = rng.uniform(-shake, shake, 2) if (shake and k) else np.zeros(2)
         if shake and k:
-            image = apply_shift(image, -shift)  # content moves by +shift
+            image = translate(image, -shift, method="opencv_cubic")  # content moves by +shift
         if noise:
             electrons = np.clip(image, 0, None) * 15000.0
             image = ((rng.poisson(electrons) + rng.normal(0, 4, image.shape)) / 15000.0).astype(np.float32)

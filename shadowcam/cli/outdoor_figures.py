@@ -25,7 +25,7 @@ from shadowcam.io.images import atomic_path
 from shadowcam.report.outdoor_figures import (arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure,
                                        pushbroom_figure)
 from shadowcam.cameras.pushbroom import resample_uniform_time
-from shadowcam.outdoor.registration import apply_shift
+from shadowcam.outdoor.translation import translate
 
 
 def add_parser(subparsers, name):
@@ -78,7 +78,7 @@ def run(args):
     for k in picks:  # six frames only: registered, divided by their lit gain, decimated for display
         frame = frames["image"].isel(time=int(k)).values
         shift = (float(photometry["shift_row"][k]), float(photometry["shift_col"][k]))
-        shown.append(apply_shift(frame, shift)[::step, ::step] / np.float32(photometry["gain"].values[k]))
+        shown.append(translate(frame, shift, method="opencv_cubic")[::step, ::step] / np.float32(photometry["gain"].values[k]))
         del frame
     save_png(keyframes_figure(shown, [edges["edge_row"].values[k] for k in picks], time_s[picks], sky=sky,
                               is_keyframe=edges["is_keyframe"].values[picks], step=step), outdir / "keyframes.png")

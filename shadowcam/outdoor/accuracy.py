@@ -24,6 +24,8 @@ registration_errors : estimated shifts (relative to frame 0) against the recorde
 
 import numpy as np
 
+from shadowcam.outdoor.translation import translate
+
 #: condition -> {statistic: bound} (errors in median capture intervals)
 TARGETS = {
     "clean": {"median_abs": 0.25, "p95_abs": 1.0},
@@ -229,19 +231,10 @@ def map_to_truth_camera(values, *, shift_row, shift_col):
     -------
     (H, W) float64 ndarray
     """
-    from scipy.ndimage import map_coordinates
-
     values = np.asarray(values, dtype=np.float64)
     if values.ndim != 2:
-        raise ValueError(f"values must be (H, W), got shape {values.shape}")
-    if shift_row == 0 and shift_col == 0:
-        return values.copy()
-    rows, cols = np.indices(values.shape, dtype=np.float64)
-    coords = np.stack([rows + shift_row, cols + shift_col])
-    missing = ~np.isfinite(values)
-    sampled = map_coordinates(np.where(missing, 0.0, values), coords, order=1, mode="constant", cval=np.nan)
-    touched = map_coordinates(missing.astype(np.float64), coords, order=1, mode="constant", cval=1.0)
-    return np.where(touched > 0, np.nan, sampled)
+        raise ValueError(f"values must be (H, W); got shape {values.shape}")
+    return translate(values, (shift_row, shift_col), method="linear_nan")
 
 
 def edges_to_truth_camera(edge_row, *, shift_row, shift_col):

@@ -10,8 +10,8 @@ the strongest feature of the image).
 
 Convention: a frame whose content moved by ``(shift_row, shift_col)``
 satisfies ``frame(r, c) = reference(r - shift_row, c - shift_col)``;
-:func:`apply_shift` samples the frame at ``(r + shift_row, c + shift_col)``
-to align it with the reference.
+:func:`shadowcam.outdoor.translation.translate` samples the frame at ``(r + shift_row,
+c + shift_col)`` to align it with the reference.
 
 Range: one Lucas-Kanade level converges from a start within a few pixels of
 the band-pass scale and rejects a solution more than ``max_shift`` (5) pixels
@@ -28,7 +28,6 @@ static_weight : weight mask of pixels whose illumination state did not change.
 shift_lucas_kanade_LucasKanade1981 : translation by iterative least squares.
 shift_coarse_to_fine : the same on a pyramid of block means, coarse levels first (large shifts).
 pyramid_levels : number of coarser levels an image of a given shape supports.
-apply_shift : resample an image so that it aligns with the reference.
 registration_factor : integer downsampling factor that brings a frame to a working size.
 block_mean : mean over factor x factor blocks (area downsampling; a shift scales by 1/factor).
 block_all : True where all pixels of a factor x factor block are (masks at the working size).
@@ -36,6 +35,8 @@ block_all : True where all pixels of a factor x factor block are (masks at the w
 
 import cv2
 import numpy as np
+
+from shadowcam.outdoor.translation import translate
 
 _EPS = 1e-3
 
@@ -172,32 +173,6 @@ def block_all(mask, factor):
     return block_mean(mask.astype(np.float32), factor) >= np.float32(1.0)
 
 
-def apply_shift(image, shift, *, interpolation=cv2.INTER_CUBIC):
-    """Resample `image` at ``(r + shift_row, c + shift_col)`` (edges replicated).
-
-    Parameters
-    ----------
-    image : (H, W) or (H, W, C) ndarray
-    shift : (2,) array_like
-        ``(shift_row, shift_col)`` in pixels.
-
-    Returns
-    -------
-    ndarray
-        Same shape and dtype (float32 stays float32).
-    """
-    image = np.asarray(image)
-    if image.ndim not in (2, 3):
-        raise ValueError(f"image must be (H, W) or (H, W, C); got shape {image.shape}")
-    d_row, d_col = (float(s) for s in shift)
-    if d_row == 0 and d_col == 0:
-        return image.copy()
-    matrix = np.float32([[1, 0, d_col], [0, 1, d_row]])
-    height, width = image.shape[:2]
-    return cv2.warpAffine(image, matrix, (width, height), flags=interpolation | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
-
-
 def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, initial=(0.0, 0.0),
                                        max_iter=10, tol=1e-3, min_weight=200.0, max_shift=5.0):
     """Estimate the translation of a frame relative to the reference.
@@ -249,7 +224,7 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
         return start, float("nan")
     error = None
     for _ in range(max_iter):
-        error = bandpass_log(apply_shift(luma, shift)).astype(np.float64) - target
+        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
         rhs = -np.array([np.sum(weight * grad_row * error), np.sum(weight * grad_col * error)])
         step = np.linalg.solve(normal, rhs)
         shift += step
@@ -257,7 +232,7 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = bandpass_log(apply_shift(luma, shift)).astype(np.float64) - target
+    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
     residual = float(np.sqrt(np.sum(weight * error**2) / max(np.sum(weight), 1.0)))
     return shift, residual
 

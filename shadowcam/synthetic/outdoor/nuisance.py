@@ -7,11 +7,13 @@ auto_exposure : auto-exposure gain per frame: 1/3-EV steps from centre-weighted 
     plus shutter flicker.
 metered_level : the centre-weighted mean that auto-exposure meters.
 shake_offsets : per-frame camera shake (dx, dy) in pixels, AR(1) jitter plus gust jolts.
-apply_shake : shift an image by a sub-pixel offset (cubic spline, edges replicated).
+apply_shake : move an image's content by a sub-pixel offset (cubic spline, edges replicated).
 cloud_transmittance : sun-term transmittance of a soft cloud shadow drifting over the ground.
 """
 
 import numpy as np
+
+from shadowcam.outdoor.translation import translate
 
 
 def capture_times(duration_s, frames, *, seed, irregular=True, dropped=0):
@@ -143,13 +145,9 @@ def shake_offsets(frames, *, seed, max_px=1.0):
 def apply_shake(image, dx, dy):
     """``out(u, v) = image(u - dx, v - dy)`` for a (rows, cols, C) image: cubic spline,
     edges replicated, clipped at 0 (radiance stays non-negative)."""
-    from scipy.ndimage import shift
-
     if dx == 0 and dy == 0:
         return image
-    out = np.empty_like(image)
-    for c in range(image.shape[2]):
-        shift(image[:, :, c], (dy, dx), output=out[:, :, c], order=3, mode="nearest")
+    out = translate(image, (-dy, -dx), method="spline")
     return np.clip(out, 0, None, out=out)
 
 

@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 
 from shadowcam.synthetic.outdoor.nuisance import apply_shake, shake_offsets
-from shadowcam.outdoor.registration import apply_shift
+from shadowcam.outdoor.translation import translate
 from shadowcam.synthetic.sensor import simulate_raw
 
 #: sub-pixel grid of OpenCV's warps (INTER_BITS = 5): a shake on it is applied exactly
@@ -127,7 +127,7 @@ def sample_mosaic(image, *, rows, cols, sensor, scale, seed, shake=(0.0, 0.0)):
     sensor : shadowcam.synthetic.sensor.SensorModel
         Bit depth, black level, gain, read noise.
     scale : float
-        Electrons per unit of `image` (:func:`shadowcam.synthetic.sensor.exposure_scale`); the same
+        Electrons per unit of `image` (:func:`shadowcam.synthetic.sensor.electrons_per_unit_radiance`); the same
         for every frame, so that the capture's own exposure changes are kept.
     seed : int or sequence of int
         Noise seed (``numpy.random.default_rng``).
@@ -147,5 +147,5 @@ def sample_mosaic(image, *, rows, cols, sensor, scale, seed, shake=(0.0, 0.0)):
         raise ValueError(f"image must have 3 channels (RGB); got {big.shape[2]}")
     dx, dy = (float(v) for v in shake)
     if dx or dy:
-        big = np.maximum(apply_shift(big, (-dy, -dx)), np.float32(0))
+        big = np.maximum(translate(big, (-dy, -dx), method="opencv_cubic"), np.float32(0))
     return simulate_raw(big, sensor=sensor, scale=scale, seed=seed, noise=True, mosaic=True)
