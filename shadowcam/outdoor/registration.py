@@ -17,8 +17,7 @@ Range: one Lucas-Kanade level converges from a start within a few pixels of
 the band-pass scale and rejects a solution more than ``max_shift`` (5) pixels
 from its start. :func:`shift_coarse_to_fine` first solves on ``2**levels``-times
 reduced images (block means) and refines level by level, so the range grows
-to about ``4 * 2**levels`` pixels (measured on a multi-scale texture: one level
-recovers 4 px, not 6; two coarser levels 16 px, not 24).
+to about ``4 * 2**levels`` pixels (``docs/benchmarks.md``).
 
 Offers
 ------
