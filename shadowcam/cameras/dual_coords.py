@@ -45,6 +45,8 @@ import xarray as xr
 from scipy.interpolate import RBFInterpolator
 from scipy.optimize import least_squares
 
+from shadowcam._shared.validation import check_array
+
 #: reason codes of the ``reason`` output variable
 REASON_FLAGS = {
     0: "ok",
@@ -77,8 +79,7 @@ def apply_homography(homography, points):
     if h.shape != (3, 3) or not np.all(np.isfinite(h)):
         raise ValueError(f"homography: expected a finite 3x3 matrix, got shape {h.shape}")
     p = np.asarray(points, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 2:
-        raise ValueError(f"points: expected shape (N, 2), got {p.shape}")
+    check_array(p, "points", shape=(None, 2))
     w = p @ h[2, :2] + h[2, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
         x = (p @ h[0, :2] + h[0, 2]) / w
@@ -328,8 +329,7 @@ def fit_time_to_plane(
     """
     times = np.asarray(times, dtype=np.float64)
     plane_xy = np.asarray(plane_xy, dtype=np.float64)
-    if times.ndim != 2 or times.shape[1] != 2:
-        raise ValueError(f"times: expected shape (N, 2), got {times.shape}")
+    check_array(times, "times", shape=(None, 2))
     if plane_xy.shape != times.shape:
         raise ValueError(f"plane_xy: shape {plane_xy.shape} differs from times {times.shape}")
     if not (np.all(np.isfinite(times)) and np.all(np.isfinite(plane_xy))):
@@ -416,8 +416,7 @@ def fit_time_to_plane(
 def _check_time_maps(t_u, t_v):
     t_u = np.asarray(t_u)
     t_v = np.asarray(t_v)
-    if t_u.ndim != 2:
-        raise ValueError(f"t_u: expected a (rows, cols) array, got shape {t_u.shape}")
+    check_array(t_u, "t_u", ndim=2)
     if t_v.shape != t_u.shape:
         raise ValueError(f"t_v: shape {t_v.shape} differs from t_u {t_u.shape}")
     return t_u, t_v

@@ -17,6 +17,8 @@ time_to_frame : times -> fractional frame indices, piecewise linear in the frame
 
 import numpy as np
 
+from shadowcam._shared.validation import check_in
+
 #: sources tried by ``timing: {source: auto}``, best first
 AUTO_ORDER = ("metadata", "filename", "sidecar")
 
@@ -103,8 +105,7 @@ def time_to_frame(time_s, frame_times_s, *, outside):
     -------
     float64 ndarray, shape of `time_s`
     """
-    if outside not in OUTSIDE_BEHAVIOURS:
-        raise ValueError(f"outside must be one of {OUTSIDE_BEHAVIOURS}; got {outside!r}")
+    check_in(outside, "outside", OUTSIDE_BEHAVIOURS)
     frames = np.asarray(frame_times_s, dtype=np.float64)
     time = np.asarray(time_s, dtype=np.float64)
     beyond = np.nan if outside == "nan" else None

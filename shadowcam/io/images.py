@@ -27,6 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_in_interval, check_positive
+
 #: display colour of holes (NaN) in previews, sRGB-encoded [0, 1] (mid grey)
 HOLE_COLOUR = (0.5, 0.5, 0.5)
 
@@ -130,8 +132,7 @@ def white_point(image, *, percentile=99.0):
     float
         Positive scale (1.0 if the image has no positive finite value).
     """
-    if not 0 < percentile <= 100:
-        raise ValueError(f"percentile: must be in (0, 100], got {percentile}")
+    check_in_interval(percentile, "percentile", 0, 100)
     arr = _as_hwc(image)
     finite = np.all(np.isfinite(arr), axis=2)
     peak = arr[finite].max(axis=1) if finite.any() else np.zeros(0)
@@ -177,8 +178,7 @@ def tone_map(image, *, percentile=99.0, scale=None, hole_colour=HOLE_COLOUR):
         raise ValueError(f"image must have 1 or >= 3 channels; got {arr.shape[2]}")
     holes = ~np.all(np.isfinite(arr), axis=2)
     scale = white_point(arr, percentile=percentile) if scale is None else float(scale)
-    if not scale > 0:
-        raise ValueError(f"scale must be > 0; got {scale}")
+    check_positive(scale, "scale")
     display = srgb_encode(np.nan_to_num(arr / scale, nan=0.0))
     display[holes] = hole_colour
     return display
@@ -214,8 +214,7 @@ def colormap_rgb8(values, *, cmap="viridis", vmin=None, vmax=None, nan_colour=HO
     from matplotlib import colormaps
 
     arr = np.asarray(values, dtype=np.float64)
-    if arr.ndim != 2:
-        raise ValueError(f"values: expected (rows, cols), got shape {arr.shape}")
+    check_array(arr, "values", ndim=2)
     if cmap not in colormaps:
         raise ValueError(f"cmap: unknown colormap {cmap!r}")
     finite = np.isfinite(arr)

@@ -22,6 +22,8 @@ from unittest import mock
 
 import numpy as np
 
+from shadowcam._shared.validation import check_in, check_positive
+
 #: sensor bit depth -> stored BitsPerSample (pidng's 14-bit packer is broken, so 14-bit
 #: data are stored in 16-bit samples; WhiteLevel still says 2**14 - 1)
 _STORAGE_BITS = {8: 8, 10: 10, 12: 12, 14: 16, 16: 16}
@@ -106,10 +108,8 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
     rows, cols = raw.shape
     if rows % 2 or cols % 2 or rows == 0:
         raise ValueError(f"raw: rows and cols must be even and positive, got {raw.shape}")
-    if compression not in ("none", "ljpeg"):
-        raise ValueError(f"compression: must be 'none' or 'ljpeg', got {compression!r}")
-    if bit_depth not in _PACKABLE_BITS:
-        raise ValueError(f"bit_depth: must be one of {_PACKABLE_BITS}, got {bit_depth}")
+    check_in(compression, "compression", ("none", "ljpeg"))
+    check_in(bit_depth, "bit_depth", _PACKABLE_BITS)
     max_value = 2**bit_depth - 1
     white_level = max_value if white_level is None else int(white_level)
     if not 0 < white_level <= max_value:
@@ -149,8 +149,7 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
         if capture_time.microsecond:
             tags.set(Tag.SubsecTimeOriginal, format_subseconds(capture_time))
     if exposure_time is not None:
-        if not exposure_time > 0:
-            raise ValueError(f"exposure_time: must be positive seconds, got {exposure_time}")
+        check_positive(exposure_time, "exposure_time")
         tags.set(Tag.ExposureTime, [[int(round(exposure_time * 1e6)), 1000000]])
 
     path = Path(path)

@@ -25,6 +25,7 @@ import numba as nb
 import numpy as np
 from scipy.special import ndtri
 
+from shadowcam._shared.validation import check_in_interval, check_positive
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
 
@@ -220,8 +221,7 @@ def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
     replaced by the nearest valid edge), then the parabola through the
     smoothed minimum and its neighbours gives the sub-frame offset.
     """
-    if not sigma > 0:
-        raise ValueError(f"sigma must be > 0, got {sigma!r}")
+    check_positive(sigma, "sigma")
     win = summary.window.astype(np.float64)
     k = win.shape[0]
     radius = max(1, int(np.ceil(3 * sigma)))
@@ -275,8 +275,7 @@ def detection_threshold(n_frames, *, false_alarm=1e-3):
     deviations with probability about ``n_frames * Q(z)``; ``z`` is chosen so
     that this is `false_alarm`.
     """
-    if not 0 < false_alarm < 1:
-        raise ValueError(f"false_alarm must be in (0, 1), got {false_alarm!r}")
+    check_in_interval(false_alarm, "false_alarm", 0, 1, closed="neither")
     return float(-ndtri(false_alarm / max(int(n_frames), 1)))
 
 

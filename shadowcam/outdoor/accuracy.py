@@ -24,6 +24,7 @@ registration_errors : estimated shifts (relative to frame 0) against the recorde
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_in, check_positive
 from shadowcam.outdoor.translation import translate
 
 #: condition -> {statistic: bound} (errors in median capture intervals)
@@ -58,8 +59,7 @@ def arrival_errors(estimate_s, truth_s, *, evaluate, interval_s):
     evaluate = np.asarray(evaluate, dtype=bool)
     if not (estimate.shape == truth.shape == evaluate.shape):
         raise ValueError(f"estimate_s {estimate.shape}, truth_s {truth.shape}, evaluate {evaluate.shape} must match")
-    if not interval_s > 0:
-        raise ValueError(f"interval_s must be positive; got {interval_s}")
+    check_positive(interval_s, "interval_s")
     pixels = evaluate & np.isfinite(truth)
     found = pixels & np.isfinite(estimate)
     error = (estimate[found] - truth[found]) / interval_s
@@ -133,8 +133,7 @@ def check_targets(stats, *, condition, estimator="combined"):
         ``{target, sweep, value, threshold, comparison, pass}`` (the layout of
         :func:`shadowcam.lab.accuracy.check_targets`; ``sweep`` names the estimator).
     """
-    if condition not in TARGETS:
-        raise ValueError(f"condition must be one of {sorted(TARGETS)}; got {condition!r}")
+    check_in(condition, "condition", TARGETS)
     return [
         {"target": name, "sweep": estimator, "value": stats[name], "threshold": bound, "comparison": "<=",
          "pass": bool(stats[name] <= bound)}
@@ -232,8 +231,7 @@ def map_to_truth_camera(values, *, shift_row, shift_col):
     (H, W) float64 ndarray
     """
     values = np.asarray(values, dtype=np.float64)
-    if values.ndim != 2:
-        raise ValueError(f"values must be (H, W); got shape {values.shape}")
+    check_array(values, "values", ndim=2)
     return translate(values, (shift_row, shift_col), method="linear_nan")
 
 
@@ -244,8 +242,7 @@ def edges_to_truth_camera(edge_row, *, shift_row, shift_col):
     (linear between columns, NaN past the image); its row moves by ``-shift_row``.
     """
     edge = np.asarray(edge_row, dtype=np.float64)
-    if edge.ndim != 2:
-        raise ValueError(f"edge_row must be (T, W), got shape {edge.shape}")
+    check_array(edge, "edge_row", ndim=2)
     width = edge.shape[1]
     if width < 2:
         raise ValueError(f"edge_row needs at least 2 columns, got {width}")

@@ -33,6 +33,7 @@ aligned_luminance : one frame's registered luminance from the pass's results.
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array
 from shadowcam.outdoor.photometric import estimate_gain, lit_at_start, luminance
 from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
                                     shift_coarse_to_fine, static_weight)
@@ -117,8 +118,7 @@ class SequenceNormaliser:
             self._last = (np.zeros(2), seed, seed)
 
     def _start(self, frame):
-        if frame.ndim != 3:
-            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
+        check_array(frame, "frame", ndim=3)
         height, width = frame.shape[:2]
         if self._sky is None:
             self._sky = auto_sky_mask(frame, **self._sky_params)
@@ -145,8 +145,7 @@ class SequenceNormaliser:
     def update(self, frame):
         """Process the next frame ``(H, W, C)`` (frame 0 sets the reference)."""
         frame = np.asarray(frame, dtype=np.float32)
-        if frame.ndim != 3:
-            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
+        check_array(frame, "frame", ndim=3)
         k = self._k
         if k == 0:
             self._start(frame)

@@ -35,6 +35,7 @@ block_all : True where all pixels of a factor x factor block are (masks at the w
 import cv2
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_positive
 from shadowcam.outdoor.translation import translate
 
 _EPS = 1e-3
@@ -54,8 +55,7 @@ def bandpass_log(luma, *, inner_sigma=0.7, outer_sigma=3.0):
     (H, W) float32 ndarray
     """
     luma = np.asarray(luma, dtype=np.float32)
-    if luma.ndim != 2:
-        raise ValueError(f"luma must be 2-D (H, W); got shape {luma.shape}")
+    check_array(luma, "luma", ndim=2)
     logl = np.log(np.maximum(luma, 0) + _EPS)
     smooth = cv2.GaussianBlur(logl, (0, 0), inner_sigma)
     return smooth - cv2.GaussianBlur(logl, (0, 0), outer_sigma)
@@ -97,8 +97,7 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_
     if not (luma.shape == ref.shape == lit.shape) or luma.ndim != 2:
         raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and lit_reference {lit.shape} "
                          "must be the same (H, W) shape")
-    if not gain > 0:
-        raise ValueError(f"gain must be positive; got {gain}")
+    check_positive(gain, "gain")
     changed = lit & (luma < max_ratio * gain * ref)
     # the reference's own shadow edge: a small move of it changes pixels less than max_ratio
     changed |= lit & (cv2.dilate((~lit).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
@@ -152,8 +151,7 @@ def block_mean(image, factor):
         translation ``d`` of `image` is a translation ``d / factor`` of the result.
     """
     image = np.asarray(image)
-    if image.ndim != 2:
-        raise ValueError(f"image must be 2-D (H, W); got shape {image.shape}")
+    check_array(image, "image", ndim=2)
     factor = int(factor)
     if factor < 1:
         raise ValueError(f"factor must be >= 1; got {factor}")

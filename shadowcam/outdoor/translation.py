@@ -34,6 +34,8 @@ import math
 import cv2
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_in
+
 #: Keys' free parameter, as OpenCV's INTER_CUBIC
 KEYS_A = -0.75
 
@@ -54,8 +56,7 @@ def cubic_weights(fraction, *, a=KEYS_A):
 def _translate_opencv_cubic(image, shift):
     """``"opencv_cubic"``: (H, W) or (H, W, C) image, same shape and dtype."""
     image = np.asarray(image)
-    if image.ndim not in (2, 3):
-        raise ValueError(f"image must be (H, W) or (H, W, C); got shape {image.shape}")
+    check_array(image, "image", ndim=(2, 3))
     d_row, d_col = (float(s) for s in shift)
     if d_row == 0 and d_col == 0:
         return image.copy()
@@ -83,8 +84,7 @@ def _translate_cubic_Keys1981(image, shift):
         ``ceil(|shift_col|) + 2`` or more from the window's cut edges.
     """
     out = np.asarray(image, dtype=np.float32)
-    if out.ndim != 2:
-        raise ValueError(f"image must be (H, W); got shape {out.shape}")
+    check_array(out, "image", ndim=2)
     shift = np.asarray(shift, dtype=np.float64)
     if shift.shape != (2,) or not np.all(np.isfinite(shift)):
         raise ValueError(f"shift must be two finite numbers (row, col); got {shift}")
@@ -117,8 +117,7 @@ def _translate_spline(image, shift):
     from scipy.ndimage import shift as ndimage_shift
 
     image = np.asarray(image)
-    if image.ndim not in (2, 3):
-        raise ValueError(f"image must be (H, W) or (H, W, C); got shape {image.shape}")
+    check_array(image, "image", ndim=(2, 3))
     d_row, d_col = (float(s) for s in shift)
     moved_by = (-d_row, -d_col)  # scipy: out(r) = in(r - moved_by)
     out = np.empty_like(image)
@@ -138,8 +137,7 @@ def _translate_linear_nan(image, shift):
     from scipy.ndimage import map_coordinates
 
     values = np.asarray(image, dtype=np.float64)
-    if values.ndim != 2:
-        raise ValueError(f"image must be (H, W); got shape {values.shape}")
+    check_array(values, "image", ndim=2)
     d_row, d_col = (float(s) for s in shift)
     if d_row == 0 and d_col == 0:
         return values.copy()
@@ -177,8 +175,7 @@ def translate(image, shift, *, method):
     ndarray
         Shape of `image`; dtype as the method says (module docstring).
     """
-    if method not in TRANSLATION_METHODS:
-        raise ValueError(f"method must be one of {sorted(TRANSLATION_METHODS)}; got {method!r}")
+    check_in(method, "method", TRANSLATION_METHODS)
     if np.shape(shift) != (2,):
         raise ValueError(f"shift must be two numbers (row, col); got {shift!r}")
     return TRANSLATION_METHODS[method](image, shift)

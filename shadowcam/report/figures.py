@@ -26,6 +26,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
+from shadowcam._shared.validation import check_positive
 from shadowcam.io.images import HOLE_COLOUR, tone_map
 
 FIGURE_DPI = 100
@@ -166,8 +167,7 @@ def error_histogram_figure(errors, *, limit=3.0, bins=60, unit="frame", size=(6.
     """
     if not hasattr(errors, "items") or not errors:
         raise ValueError("errors must be a non-empty mapping of name -> 1-D array")
-    if not limit > 0:
-        raise ValueError(f"limit must be positive, got {limit!r}")
+    check_positive(limit, "limit")
     if int(bins) < 1:
         raise ValueError(f"bins must be a positive integer, got {bins!r}")
     figure = _new_figure(size)

@@ -17,6 +17,7 @@ pushbroom_figure : the ridge pushbroom beside the real view.
 import numpy as np
 from matplotlib import colormaps
 
+from shadowcam._shared.validation import check_array
 from shadowcam.io.images import tone_map
 from shadowcam.report.figures import NAN_GREY, WHITE_PERCENTILE, _new_figure
 
@@ -144,8 +145,7 @@ def arrival_map_figure(arrival_s, *, sky, size=(6.5, 4.5)):
     matplotlib.figure.Figure
     """
     arrival = np.asarray(arrival_s, dtype=np.float64) / 60.0
-    if arrival.ndim != 2:
-        raise ValueError(f"arrival_s must be (H, W); got {arrival.shape}")
+    check_array(arrival, "arrival_s", ndim=2)
     arrival = np.where(np.asarray(sky, dtype=bool), np.nan, arrival)
     figure = _new_figure(size)
     axes = figure.add_subplot()

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array
 from shadowcam.synthetic.lab.scene import BackPlane, Box, GroundPlane, Sphere, texture_albedo
 
 #: default minimum hit distance (scene units) to avoid self-intersection
@@ -28,8 +29,7 @@ SURFACE_OFFSET = 1e-7
 def _check_rays(origins, directions):
     origins = np.asarray(origins, dtype=np.float64)
     directions = np.asarray(directions, dtype=np.float64)
-    if origins.ndim != 2 or origins.shape[1] != 3:
-        raise ValueError(f"origins: expected (N, 3), got {origins.shape}")
+    check_array(origins, "origins", shape=(None, 3))
     if directions.shape != origins.shape:
         raise ValueError(f"directions: expected {origins.shape}, got {directions.shape}")
     return origins, directions
@@ -290,8 +290,7 @@ def wire_occlusion_interval(points, light_points, sweep, mask, *, distant=False)
     """
     points = np.asarray(points, dtype=np.float64)
     light_points = np.asarray(light_points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    check_array(points, "points", shape=(None, 3))
     if light_points.shape != points.shape:
         raise ValueError(f"light_points: expected {points.shape}, got {light_points.shape}")
     seg = light_points if distant else light_points - points

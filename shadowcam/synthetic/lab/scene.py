@@ -26,6 +26,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_in, check_in_interval
+
 UP = (0.0, 1.0, 0.0)
 
 
@@ -89,8 +91,7 @@ class Texture:
     seed: int = 0
 
     def __post_init__(self):
-        if self.kind not in TEXTURE_KINDS:
-            raise ValueError(f"kind: must be one of {TEXTURE_KINDS}, got {self.kind!r}")
+        check_in(self.kind, "kind", TEXTURE_KINDS)
         colors = np.asarray(self.colors, dtype=np.float64)
         if colors.ndim != 2 or colors.shape[1] != 3 or colors.shape[0] < 2:
             raise ValueError(f"colors: expected (K>=2, 3) albedos, got shape {colors.shape}")
@@ -112,8 +113,7 @@ def texture_albedo(texture, coords):
         Linear albedo.
     """
     coords = np.asarray(coords, dtype=np.float64)
-    if coords.ndim != 2 or coords.shape[1] != 2:
-        raise ValueError(f"coords: expected (N, 2), got {coords.shape}")
+    check_array(coords, "coords", shape=(None, 2))
     colors = texture.colors
     s = coords / texture.scale
     if texture.kind == "checker":
@@ -314,8 +314,7 @@ class AreaLight:
     samples_per_side: int = 4
 
     def __post_init__(self):
-        if self.shape not in ("disc", "square"):
-            raise ValueError(f"shape: must be 'disc' or 'square', got {self.shape!r}")
+        check_in(self.shape, "shape", ("disc", "square"))
         if int(self.samples_per_side) < 1:
             raise ValueError(f"samples_per_side: must be >= 1, got {self.samples_per_side}")
         _set(self, position=_vec(self.position, "position"),
@@ -430,8 +429,7 @@ def look_at_camera(center, target, *, fov_x_deg, width, height, up=UP):
         raise ValueError("up: must not be parallel to the viewing direction")
     right /= np.linalg.norm(right)
     down = np.cross(forward, right)
-    if not 0 < fov_x_deg < 180:
-        raise ValueError(f"fov_x_deg: must be in (0, 180), got {fov_x_deg}")
+    check_in_interval(fov_x_deg, "fov_x_deg", 0, 180, closed="neither")
     focal = width / 2.0 / math.tan(math.radians(fov_x_deg) / 2.0)
     K = np.array([[focal, 0.0, width / 2.0], [0.0, focal, height / 2.0], [0.0, 0.0, 1.0]])
     return PinholeCamera(K=K, R=np.stack([right, down, forward]), center=center,
@@ -562,8 +560,7 @@ def make_mask_plane(light, *, target, frames, f=0.045, fov_deg=44.0, extent=None
         focal = None
     else:
         n = _unit(target - light.center, "target - light position")
-        if not 0 < fov_deg < 180:
-            raise ValueError(f"fov_deg: must be in (0, 180), got {fov_deg}")
+        check_in_interval(fov_deg, "fov_deg", 0, 180, closed="neither")
         delta = 2 * f * math.tan(math.radians(fov_deg) / 2) / frames
         origin = light.center + f * n
         focal = f
@@ -745,8 +742,7 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     -------
     Scene
     """
-    if name not in SCENES:
-        raise ValueError(f"name: unknown scene {name!r}; choose one of {sorted(SCENES)}")
+    check_in(name, "name", SCENES)
     for key, value in (("height", height), ("width", width)):
         if int(value) < 2 or int(value) % 2:
             raise ValueError(f"{key}: must be an even number >= 2, got {value}")

@@ -13,6 +13,7 @@ cloud_transmittance : sun-term transmittance of a soft cloud shadow drifting ove
 
 import numpy as np
 
+from shadowcam._shared.validation import check_positive
 from shadowcam.outdoor.translation import translate
 
 
@@ -45,8 +46,7 @@ def capture_times(duration_s, frames, *, seed, irregular=True, dropped=0):
         raise ValueError(f"frames: need at least 2, got {frames}")
     if not 0 <= dropped <= max(0, (frames - 2) // 4):
         raise ValueError(f"dropped: must be in [0, {(frames - 2) // 4}], got {dropped}")
-    if not duration_s > 0:
-        raise ValueError(f"duration_s: must be positive, got {duration_s}")
+    check_positive(duration_s, "duration_s")
     rng = np.random.default_rng([int(seed), 41])
     slots = frames + dropped
     intervals = np.ones(slots - 1)

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadowcam._shared.validation import check_in
 from shadowcam.synthetic.lab.scene import camera_rays, look_at_camera
 from shadowcam.synthetic.outdoor.sun import SunPath, sun_colour
 from shadowcam.synthetic.outdoor.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
@@ -99,8 +100,7 @@ def make_outdoor_scene(name="ridge", *, seed=0, height=128, width=192, latitude_
     -------
     OutdoorScene
     """
-    if name not in OUTDOOR_SCENES:
-        raise ValueError(f"name: unknown outdoor scene {name!r}; known: {sorted(OUTDOOR_SCENES)}")
+    check_in(name, "name", OUTDOOR_SCENES)
     if int(height) < 8 or int(width) < 8:
         raise ValueError(f"height, width: need at least 8 pixels, got {height}x{width}")
     if not 0.5 <= end_elevation_deg < start_elevation_deg <= 40.0:

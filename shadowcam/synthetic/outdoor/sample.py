@@ -27,6 +27,7 @@ sample_mosaic : one real-size noisy RGGB mosaic (uint16 DN) from a small frame, 
 import cv2
 import numpy as np
 
+from shadowcam._shared.validation import check_array
 from shadowcam.synthetic.outdoor.nuisance import apply_shake, shake_offsets
 from shadowcam.outdoor.translation import translate
 from shadowcam.synthetic.sensor import simulate_raw
@@ -63,8 +64,7 @@ def steady_frame(image, *, dx, dy):
         made with (:func:`shadowcam.synthetic.outdoor.nuisance.apply_shake`), edges replicated.
     """
     image = np.asarray(image, dtype=np.float32)
-    if image.ndim != 3:
-        raise ValueError(f"image must be (H, W, C); got shape {image.shape}")
+    check_array(image, "image", ndim=3)
     return apply_shake(image, -float(dx), -float(dy))
 
 
@@ -108,8 +108,7 @@ def upsample_frame(image, *, rows, cols):
         Pixel centres map to pixel centres (OpenCV ``INTER_LINEAR``).
     """
     image = np.asarray(image, dtype=np.float32)
-    if image.ndim != 3:
-        raise ValueError(f"image must be (H, W, C); got shape {image.shape}")
+    check_array(image, "image", ndim=3)
     if rows < 1 or cols < 1:
         raise ValueError(f"rows and cols must be positive; got {rows}, {cols}")
     return cv2.resize(image, (int(cols), int(rows)), interpolation=cv2.INTER_LINEAR).reshape(rows, cols, -1)

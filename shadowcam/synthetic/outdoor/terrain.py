@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_positive
+
 #: Shape parameters of the procedural ridge terrain (metres, degrees). ``saddle`` is
 #: (b centre, half width, depth), ``horn`` (a, b, height, radius), ``bay`` (b centre,
 #: half width, recess depth), ``summit`` (a, b, height, radius).
@@ -127,8 +129,7 @@ class Heightfield:
             raise ValueError(f"z: expected a finite (nb, na) grid with nb, na >= 2, got {z.shape}")
         if albedo.shape != z.shape + (3,):
             raise ValueError(f"albedo: expected shape {z.shape + (3,)}, got {albedo.shape}")
-        if not self.spacing > 0:
-            raise ValueError(f"spacing: must be positive, got {self.spacing}")
+        check_positive(self.spacing, "spacing")
         gb, ga = np.gradient(z, self.spacing)
         # world gradient from (a, b) gradient: d/dx = da/dx d/da + db/dx d/db
         s, c = np.sin(np.radians(self.axis_azimuth_deg)), np.cos(np.radians(self.axis_azimuth_deg))
@@ -302,8 +303,7 @@ def intersect_heightfield(terrain, origins, directions, *, min_step=0.5, bisect_
         highest terrain (sky).
     """
     origins, directions = _check_rays(origins, directions)
-    if not min_step > 0:
-        raise ValueError(f"min_step: must be positive, got {min_step}")
+    check_positive(min_step, "min_step")
     n = len(origins)
     dist = np.full(n, np.nan)
     s = np.zeros(n)
@@ -394,8 +394,7 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
     """
     points = np.asarray(points, dtype=np.float64)
     az = np.asarray(azimuths_rad, dtype=np.float64).ravel()
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    check_array(points, "points", shape=(None, 3))
     if pairwise and len(az) != len(points):
         raise ValueError(f"azimuths_rad: pairwise needs one azimuth per point ({len(points)}), "
                          f"got {len(az)}")
