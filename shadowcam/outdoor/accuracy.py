@@ -24,7 +24,7 @@ registration_errors : estimated shifts (relative to frame 0) against the recorde
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array, check_in, check_positive
+from shadowcam._shared.validation import check_array, check_in, check_positive, check_same_shape
 from shadowcam.outdoor.translation import translate
 
 #: condition -> {statistic: bound} (errors in median capture intervals)
@@ -57,8 +57,7 @@ def arrival_errors(estimate_s, truth_s, *, evaluate, interval_s):
     estimate = np.asarray(estimate_s, dtype=np.float64)
     truth = np.asarray(truth_s, dtype=np.float64)
     evaluate = np.asarray(evaluate, dtype=bool)
-    if not (estimate.shape == truth.shape == evaluate.shape):
-        raise ValueError(f"estimate_s {estimate.shape}, truth_s {truth.shape}, evaluate {evaluate.shape} must match")
+    check_same_shape({"estimate_s": estimate, "truth_s": truth, "evaluate": evaluate})
     check_positive(interval_s, "interval_s")
     pixels = evaluate & np.isfinite(truth)
     found = pixels & np.isfinite(estimate)
@@ -197,8 +196,7 @@ def edge_errors(edge_row, truth_edge_row, *, unambiguous=None):
     """Median and p95 absolute edge-row error (pixels) where both exist (and the GT column is unambiguous)."""
     edge = np.asarray(edge_row, dtype=np.float64)
     gt = np.asarray(truth_edge_row, dtype=np.float64)
-    if edge.shape != gt.shape:
-        raise ValueError(f"edge_row {edge.shape} and truth_edge_row {gt.shape} must match")
+    check_same_shape({"edge_row": edge, "truth_edge_row": gt})
     use = np.isfinite(edge) & np.isfinite(gt)
     if unambiguous is not None:
         use &= np.asarray(unambiguous, dtype=bool)

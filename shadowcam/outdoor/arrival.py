@@ -26,6 +26,8 @@ combine_arrivals : the final arrival map and its reasons.
 
 import numpy as np
 
+from shadowcam._shared.validation import check_same_shape
+
 #: reason code -> meaning (stored as CF flag_values / flag_meanings)
 ARRIVAL_REASONS = {
     0: "edge_crossing",
@@ -160,8 +162,7 @@ def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start):
     """
     edge_s = np.asarray(edge_s, dtype=np.float64)
     coverage_s = np.asarray(coverage_s, dtype=np.float64)
-    if edge_s.shape != coverage_s.shape:
-        raise ValueError(f"edge_s {edge_s.shape} and coverage_s {coverage_s.shape} must match")
+    check_same_shape({"edge_s": edge_s, "coverage_s": coverage_s})
     with np.errstate(invalid="ignore"):
         agree = np.abs(edge_s - coverage_s) <= tolerance_s
     use_edge = np.isfinite(edge_s) & (agree | np.isnan(coverage_s))

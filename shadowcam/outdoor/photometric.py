@@ -26,7 +26,7 @@ coverage : per-pixel lit fraction of a frame from its lit and shadow levels.
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array, check_positive
+from shadowcam._shared.validation import check_array, check_positive, check_same_shape
 
 
 def luminance(image):
@@ -145,8 +145,7 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
     luma = np.asarray(luma, dtype=np.float64)
     ref = np.asarray(reference_luma, dtype=np.float64)
     pixels = np.asarray(pixels, dtype=bool)
-    if not (luma.shape == ref.shape == pixels.shape):
-        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and pixels {pixels.shape} must match")
+    check_same_shape({"luma": luma, "reference_luma": ref, "pixels": pixels})
     check_positive(prior, "prior")
     use = pixels & (ref > 0)
     ratio = luma[use] / ref[use]
@@ -185,8 +184,7 @@ def coverage(luma, *, lit_level, shadow_level):
     luma = np.asarray(luma, dtype=np.float32)
     lit = np.asarray(lit_level, dtype=np.float32)
     shadow = np.asarray(shadow_level, dtype=np.float32)
-    if not (luma.shape == lit.shape == shadow.shape):
-        raise ValueError(f"luma {luma.shape}, lit_level {lit.shape}, shadow_level {shadow.shape} must match")
+    check_same_shape({"luma": luma, "lit_level": lit, "shadow_level": shadow})
     span = lit - shadow
     out = luma - shadow
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -35,7 +35,7 @@ block_all : True where all pixels of a factor x factor block are (masks at the w
 import cv2
 import numpy as np
 
-from shadowcam._shared.validation import check_array, check_positive
+from shadowcam._shared.validation import check_array, check_positive, check_same_shape
 from shadowcam.outdoor.translation import translate
 
 _EPS = 1e-3
@@ -209,8 +209,7 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
         weight = np.zeros(luma.shape)
         weight[4:-4, 4:-4] = 1.0
     weight = np.asarray(weight, dtype=np.float64)
-    if not (luma.shape == ref.shape == weight.shape):
-        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and weight {weight.shape} must match")
+    check_same_shape({"luma": luma, "reference_luma": ref, "weight": weight})
     target = bandpass_log(ref).astype(np.float64)
     grad_row, grad_col = np.gradient(target)
     normal = np.array([[np.sum(weight * grad_row**2), np.sum(weight * grad_row * grad_col)],
@@ -327,8 +326,7 @@ def shift_coarse_to_fine(luma, reference_luma, *, weight=None, initial=(0.0, 0.0
     if weight is None:
         weight = np.ones(luma.shape, dtype=np.float32)
     weight = np.asarray(weight, dtype=np.float32)
-    if weight.shape != luma.shape:
-        raise ValueError(f"weight {weight.shape} must match luma {luma.shape}")
+    check_same_shape({"weight": weight, "luma": luma})
     n_levels = pyramid_levels(luma.shape, levels=levels, min_size=min_size)
     start = np.asarray(initial, dtype=np.float64).copy()
     coarse = start
