@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array, check_in, check_in_interval
+from shadowcam._shared.validation import check_array, check_in, check_in_interval, check_positive
 
 UP = (0.0, 1.0, 0.0)
 
@@ -44,12 +44,6 @@ def _unit(value, name):
     if norm == 0:
         raise ValueError(f"{name}: must not be the zero vector")
     return arr / norm
-
-
-def _positive(value, name):
-    if not (np.isfinite(value) and value > 0):
-        raise ValueError(f"{name}: must be a positive number, got {value!r}")
-    return float(value)
 
 
 def _set(obj, **values):
@@ -95,7 +89,7 @@ class Texture:
         colors = np.asarray(self.colors, dtype=np.float64)
         if colors.ndim != 2 or colors.shape[1] != 3 or colors.shape[0] < 2:
             raise ValueError(f"colors: expected (K>=2, 3) albedos, got shape {colors.shape}")
-        _set(self, colors=colors, scale=_positive(self.scale, "scale"))
+        _set(self, colors=colors, scale=float(check_positive(self.scale, "scale", finite=True)))
 
 
 def texture_albedo(texture, coords):
@@ -174,7 +168,7 @@ class Material:
             raise ValueError(f"albedo: must lie in [0, 1], got {albedo}")
         if not 0 <= self.specular < 1:
             raise ValueError(f"specular: must be in [0, 1), got {self.specular}")
-        _set(self, albedo=albedo, shininess=_positive(self.shininess, "shininess"))
+        _set(self, albedo=albedo, shininess=float(check_positive(self.shininess, "shininess", finite=True)))
 
 
 # --------------------------------------------------------------------------- objects
@@ -189,7 +183,7 @@ class Sphere:
     material: Material = field(default_factory=Material)
 
     def __post_init__(self):
-        _set(self, center=_vec(self.center, "center"), radius=_positive(self.radius, "radius"))
+        _set(self, center=_vec(self.center, "center"), radius=float(check_positive(self.radius, "radius", finite=True)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -245,8 +239,8 @@ class BackPlane:
     material: Material = field(default_factory=Material)
 
     def __post_init__(self):
-        _set(self, center=_vec(self.center, "center"), width=_positive(self.width, "width"),
-             height=_positive(self.height, "height"), yaw_deg=float(self.yaw_deg))
+        _set(self, center=_vec(self.center, "center"), width=float(check_positive(self.width, "width", finite=True)),
+             height=float(check_positive(self.height, "height", finite=True)), yaw_deg=float(self.yaw_deg))
 
     @property
     def axis_x(self):
@@ -318,7 +312,7 @@ class AreaLight:
         if int(self.samples_per_side) < 1:
             raise ValueError(f"samples_per_side: must be >= 1, got {self.samples_per_side}")
         _set(self, position=_vec(self.position, "position"),
-             normal=_unit(self.normal, "normal"), size=_positive(self.size, "size"),
+             normal=_unit(self.normal, "normal"), size=float(check_positive(self.size, "size", finite=True)),
              intensity=_vec(self.intensity, "intensity"),
              samples_per_side=int(self.samples_per_side))
 
@@ -416,7 +410,7 @@ class OrthographicCamera:
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-9):
             raise ValueError("R: must be a (3, 3) rotation matrix")
         _set(self, R=R, center=_vec(self.center, "center"),
-             pixel_size=_positive(self.pixel_size, "pixel_size"),
+             pixel_size=float(check_positive(self.pixel_size, "pixel_size", finite=True)),
              width=int(self.width), height=int(self.height))
 
 
@@ -549,13 +543,13 @@ def make_mask_plane(light, *, target, frames, f=0.045, fov_deg=44.0, extent=None
     frames = int(frames)
     if frames < 2:
         raise ValueError(f"frames: must be >= 2, got {frames}")
-    f = _positive(f, "f")
+    f = float(check_positive(f, "f", finite=True))
     target = _vec(target, "target")
     if isinstance(light, DistantLight):
         if extent is None:
             raise ValueError("extent: required for a distant light")
         n = -light.direction
-        delta = _positive(extent, "extent") / frames
+        delta = float(check_positive(extent, "extent", finite=True)) / frames
         origin = target - f * n
         focal = None
     else:
@@ -588,10 +582,10 @@ def make_wire_sweeps(mask, *, radius=None, length=None):
     dict of str to WireSweep
         Keys ``"u"`` and ``"v"``.
     """
-    radius = mask.delta if radius is None else _positive(radius, "radius")
+    radius = mask.delta if radius is None else float(check_positive(radius, "radius", finite=True))
     if length is None:
         length = 1.5 * math.hypot(mask.n_u, mask.n_v) * mask.delta
-    length = _positive(length, "length")
+    length = float(check_positive(length, "length", finite=True))
     sweeps = {}
     for axis, e_move, e_wire, n in (("u", mask.e_u, mask.e_v, mask.n_u),
                                     ("v", mask.e_v, mask.e_u, mask.n_v)):

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_positive
+from shadowcam.synthetic.lab.raycast import as_rays
 
 #: Shape parameters of the procedural ridge terrain (metres, degrees). ``saddle`` is
 #: (b centre, half width, depth), ``horn`` (a, b, height, radius), ``bay`` (b centre,
@@ -267,15 +268,6 @@ def make_ridge_terrain(*, seed=0, **params):
                        axis_azimuth_deg=float(p["axis_azimuth_deg"]))
 
 
-def _check_rays(origins, directions):
-    origins = np.asarray(origins, dtype=np.float64)
-    directions = np.asarray(directions, dtype=np.float64)
-    if origins.ndim != 2 or origins.shape[1] != 3 or origins.shape != directions.shape:
-        raise ValueError(f"origins, directions: expected two (N, 3) arrays, got "
-                         f"{origins.shape} and {directions.shape}")
-    return origins, directions
-
-
 def intersect_heightfield(terrain, origins, directions, *, min_step=0.5, bisect_steps=30,
                           max_iter=4000):
     """First intersection of rays with the terrain surface.
@@ -302,7 +294,7 @@ def intersect_heightfield(terrain, origins, directions, *, min_step=0.5, bisect_
         Ray parameter of the hit (m), NaN for rays that leave the grid or rise above the
         highest terrain (sky).
     """
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     check_positive(min_step, "min_step")
     n = len(origins)
     dist = np.full(n, np.nan)
