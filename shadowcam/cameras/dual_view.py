@@ -215,7 +215,7 @@ def resample_dual_view(colours, u, v, *, shape, valid=None, method="mesh", **par
     check_in(method, "method", DUAL_VIEW_METHODS)
     height, width = (int(s) for s in shape)
     if height < 1 or width < 1:
-        raise ValueError(f"shape: must be positive, got {shape}")
+        raise ValueError(f"shape must be positive; got {shape}")
     ok = np.isfinite(u) & np.isfinite(v) & np.all(np.isfinite(colours), axis=2)
     if valid is not None:
         valid = np.asarray(valid, dtype=bool)

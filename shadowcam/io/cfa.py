@@ -71,7 +71,7 @@ def site_constants(values, shape):
     """
     values = np.asarray(values, np.float64)
     if values.shape != (2, 2):
-        raise ValueError(f"values must be (2, 2) per-site constants, got shape {values.shape}")
+        raise ValueError(f"values must be (2, 2) per-site constants; got shape {values.shape}")
     rows, cols = int(shape[0]), int(shape[1])
     return np.tile(values, (rows // 2 + 1, cols // 2 + 1))[:rows, :cols]
 

@@ -232,7 +232,7 @@ def write_png(path, rgb8):
     """Write an 8-bit ``(rows, cols, 3)`` (or single-channel) image as PNG."""
     arr = _as_hwc(rgb8, "rgb8")
     if arr.dtype != np.uint8:
-        raise ValueError(f"rgb8: expected uint8, got {arr.dtype}")
+        raise ValueError(f"rgb8 must be uint8; got {arr.dtype}")
     _write_oiio(path, arr, "uint8")
 
 

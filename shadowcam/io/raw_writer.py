@@ -33,7 +33,7 @@ _PACKABLE_BITS = tuple(_STORAGE_BITS)
 def format_capture_time(when):
     """Return `when` (a ``datetime.datetime``) as an EXIF date-time string."""
     if not isinstance(when, datetime.datetime):
-        raise ValueError(f"when: expected a datetime.datetime, got {type(when).__name__}")
+        raise ValueError(f"when must be a datetime.datetime; got {type(when).__name__}")
     return when.strftime("%Y:%m:%d %H:%M:%S")
 
 
@@ -41,7 +41,7 @@ def format_subseconds(when):
     """Return the sub-second part of `when` as EXIF SubSec digits: 3 digits (milliseconds)
     when that is exact, else 6 (microseconds)."""
     if not isinstance(when, datetime.datetime):
-        raise ValueError(f"when: expected a datetime.datetime, got {type(when).__name__}")
+        raise ValueError(f"when must be a datetime.datetime; got {type(when).__name__}")
     us = when.microsecond
     return f"{us // 1000:03d}" if us % 1000 == 0 else f"{us:06d}"
 
@@ -115,7 +115,7 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
     if not 0 < white_level <= max_value:
         raise ValueError(f"white_level: must be in (0, {max_value}], got {white_level}")
     if not 0 <= int(black_level) < white_level:
-        raise ValueError(f"black_level: must be in [0, white_level), got {black_level}")
+        raise ValueError(f"black_level must be in [0, white_level); got {black_level}")
     if int(raw.max()) > max_value:
         raise ValueError(f"raw: maximum {int(raw.max())} does not fit in {bit_depth} bits")
 

@@ -134,7 +134,7 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
     check_array(time, "time", ndim=2)
     time_std = np.broadcast_to(np.asarray(time_std, dtype=np.float64), time.shape)
     if int(radius) < 1:
-        raise ValueError(f"radius must be >= 1, got {radius!r}")
+        raise ValueError(f"radius must be >= 1; got {radius!r}")
     check_positive(range_sigma, "range_sigma")
     valid = np.isfinite(time)
     t64 = np.where(valid, time, np.nan).astype(np.float64)

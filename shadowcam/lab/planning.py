@@ -111,7 +111,7 @@ def plan_capture(*, pixel_width, mask_distance, depth, focal_length, frame_time,
     """
     n = int(image_pixels)
     if n < 1:
-        raise ValueError(f"image_pixels: must be a positive integer, got {image_pixels!r}")
+        raise ValueError(f"image_pixels must be a positive integer; got {image_pixels!r}")
     if mask_speed is None and wanted_dual_pixels is None:
         raise ValueError("mask_speed, wanted_dual_pixels: give at least one")
     geometry = dict(pixel_width=pixel_width, mask_distance=mask_distance, depth=depth,

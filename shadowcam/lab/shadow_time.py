@@ -559,7 +559,7 @@ def cfa_site_colours(shape, pattern):
     (H, W) int8 ndarray
     """
     if len(pattern) != 4 or set(pattern) - set("RGB"):
-        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB', got {pattern!r}")
+        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB'; got {pattern!r}")
     tile = np.array(["RGB".index(ch) for ch in pattern], np.int8).reshape(2, 2)
     rows = np.arange(shape[0])[:, None] % 2
     cols = np.arange(shape[1])[None, :] % 2

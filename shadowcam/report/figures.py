@@ -37,7 +37,7 @@ WHITE_PERCENTILE = 99.5
 def _new_figure(size):
     width, height = size
     if not (width > 0 and height > 0):
-        raise ValueError(f"size must be two positive numbers (inches), got {size!r}")
+        raise ValueError(f"size must be two positive numbers (inches); got {size!r}")
     figure = Figure(figsize=(width, height), dpi=FIGURE_DPI)
     FigureCanvasAgg(figure)
     return figure
@@ -95,7 +95,7 @@ def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
     """
     times = np.asarray(times)
     if times.ndim != 2 or min(times.shape) < 1:
-        raise ValueError(f"times must be a (rows, cols) array, got shape {times.shape}")
+        raise ValueError(f"times must be a (rows, cols) array; got shape {times.shape}")
     if not np.issubdtype(times.dtype, np.number):
         raise ValueError(f"times must be numeric, got dtype {times.dtype}")
     colours = colormaps[cmap].with_extremes(bad=NAN_GREY)
@@ -169,7 +169,7 @@ def error_histogram_figure(errors, *, limit=3.0, bins=60, unit="frame", size=(6.
         raise ValueError("errors must be a non-empty mapping of name -> 1-D array")
     check_positive(limit, "limit")
     if int(bins) < 1:
-        raise ValueError(f"bins must be a positive integer, got {bins!r}")
+        raise ValueError(f"bins must be a positive integer; got {bins!r}")
     figure = _new_figure(size)
     axes = figure.add_subplot()
     edges = np.linspace(-limit, limit, int(bins) + 1)

@@ -49,13 +49,13 @@ class SensorModel:
 
     def __post_init__(self):
         if not 8 <= int(self.bit_depth) <= 16:
-            raise ValueError(f"bit_depth: must be in 8..16, got {self.bit_depth}")
+            raise ValueError(f"bit_depth must be in 8..16; got {self.bit_depth}")
         if not 0 <= int(self.black_level) < self.white_level:
             raise ValueError(f"black_level: must be in [0, {self.white_level}), "
                              f"got {self.black_level}")
         check_positive(self.gain, "gain")
         if not self.read_noise >= 0:
-            raise ValueError(f"read_noise: must be >= 0, got {self.read_noise}")
+            raise ValueError(f"read_noise must be >= 0; got {self.read_noise}")
 
     @property
     def white_level(self):

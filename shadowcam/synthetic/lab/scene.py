@@ -88,7 +88,7 @@ class Texture:
         check_in(self.kind, "kind", TEXTURE_KINDS)
         colors = np.asarray(self.colors, dtype=np.float64)
         if colors.ndim != 2 or colors.shape[1] != 3 or colors.shape[0] < 2:
-            raise ValueError(f"colors: expected (K>=2, 3) albedos, got shape {colors.shape}")
+            raise ValueError(f"colors must be (K>=2, 3) albedos; got shape {colors.shape}")
         _set(self, colors=colors, scale=float(check_positive(self.scale, "scale", finite=True)))
 
 
@@ -167,7 +167,7 @@ class Material:
         if np.any(albedo < 0) or np.any(albedo > 1):
             raise ValueError(f"albedo: must lie in [0, 1], got {albedo}")
         if not 0 <= self.specular < 1:
-            raise ValueError(f"specular: must be in [0, 1), got {self.specular}")
+            raise ValueError(f"specular must be in [0, 1); got {self.specular}")
         _set(self, albedo=albedo, shininess=float(check_positive(self.shininess, "shininess", finite=True)))
 
 
@@ -201,7 +201,7 @@ class Box:
     def __post_init__(self):
         half = _vec(self.half_extents, "half_extents")
         if np.any(half <= 0):
-            raise ValueError(f"half_extents: must be positive, got {half}")
+            raise ValueError(f"half_extents must be positive; got {half}")
         _set(self, center=_vec(self.center, "center"), half_extents=half,
              yaw_deg=float(self.yaw_deg))
 
@@ -220,7 +220,7 @@ class GroundPlane:
 
     def __post_init__(self):
         if not np.isfinite(self.height):
-            raise ValueError(f"height: must be finite, got {self.height}")
+            raise ValueError(f"height must be finite; got {self.height}")
         _set(self, height=float(self.height))
 
 
@@ -310,7 +310,7 @@ class AreaLight:
     def __post_init__(self):
         check_in(self.shape, "shape", ("disc", "square"))
         if int(self.samples_per_side) < 1:
-            raise ValueError(f"samples_per_side: must be >= 1, got {self.samples_per_side}")
+            raise ValueError(f"samples_per_side must be >= 1; got {self.samples_per_side}")
         _set(self, position=_vec(self.position, "position"),
              normal=_unit(self.normal, "normal"), size=float(check_positive(self.size, "size", finite=True)),
              intensity=_vec(self.intensity, "intensity"),
@@ -542,7 +542,7 @@ def make_mask_plane(light, *, target, frames, f=0.045, fov_deg=44.0, extent=None
     """
     frames = int(frames)
     if frames < 2:
-        raise ValueError(f"frames: must be >= 2, got {frames}")
+        raise ValueError(f"frames must be >= 2; got {frames}")
     f = float(check_positive(f, "f", finite=True))
     target = _vec(target, "target")
     if isinstance(light, DistantLight):
@@ -704,7 +704,7 @@ def _tabletop(*, seed, height, width, frames, light_kind):
     elif light_kind == "distant":
         light = DistantLight(light_pos - aim, (2.0, 2.0, 2.0))
     else:
-        raise ValueError(f"light_kind: must be 'point', 'area' or 'distant', got {light_kind!r}")
+        raise ValueError(f"light_kind must be 'point', 'area' or 'distant'; got {light_kind!r}")
     if light_kind == "distant":  # plane between the scene and the light, clear of objects
         mask = make_mask_plane(light, target=aim, frames=frames, f=0.2, extent=0.26)
     else:

@@ -101,7 +101,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         raise ValueError(f"nuisances: unknown switch(es) {sorted(unknown)}; known: {sorted(NUISANCES)}")
     opts = dict(NUISANCES, **nuisances)
     if int(supersample) < 1:
-        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+        raise ValueError(f"supersample must be >= 1; got {supersample}")
     rows, cols = scene.camera.height, scene.camera.width
     s = int(supersample)
     s2 = s * s

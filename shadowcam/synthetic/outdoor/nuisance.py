@@ -124,7 +124,7 @@ def shake_offsets(frames, *, seed, max_px=1.0):
     dx, dy : (frames,) ndarray
     """
     if not max_px >= 0:
-        raise ValueError(f"max_px: must be >= 0, got {max_px}")
+        raise ValueError(f"max_px must be >= 0; got {max_px}")
     if max_px == 0:
         return np.zeros(frames), np.zeros(frames)
     rng = np.random.default_rng([int(seed), 47])
@@ -170,7 +170,7 @@ def cloud_transmittance(points_xy, t_s, *, start_xy, velocity_xy, sigma_m=250.0,
     (N,) ndarray in [1 - depth, 1]
     """
     if not 0 <= depth < 1:
-        raise ValueError(f"depth: must be in [0, 1), got {depth}")
+        raise ValueError(f"depth must be in [0, 1); got {depth}")
     centre = np.asarray(start_xy, dtype=np.float64) + np.asarray(velocity_xy) * float(t_s)
     r2 = ((np.asarray(points_xy) - centre) ** 2).sum(axis=1)
     return 1.0 - depth * np.exp(-0.5 * r2 / sigma_m**2)

@@ -141,7 +141,7 @@ def sample_grid(rows, cols, supersample=None):
     """
     s = 1 if supersample is None else int(supersample)
     if s < 1:
-        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+        raise ValueError(f"supersample must be >= 1; got {supersample}")
     offsets = (np.arange(s) + 0.5) / s
     r, c, oy, ox = np.meshgrid(np.arange(rows), np.arange(cols), offsets, offsets,
                                indexing="ij")
@@ -223,7 +223,7 @@ def trace_samples(scene, x, y, *, node_deg=HORIZON_NODE_DEG, fine_deg=HORIZON_FI
     SampleGeometry
     """
     if not 0 < fine_deg <= node_deg:
-        raise ValueError(f"fine_deg: must be in (0, node_deg], got {fine_deg}")
+        raise ValueError(f"fine_deg must be in (0, node_deg]; got {fine_deg}")
     origins, dirs = camera_rays(scene.camera, x, y)
     dist = intersect_heightfield(scene.terrain, origins, dirs)
     sky = np.isnan(dist)

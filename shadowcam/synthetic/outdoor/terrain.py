@@ -127,7 +127,7 @@ class Heightfield:
         z = np.asarray(self.z, dtype=np.float64)
         albedo = np.asarray(self.albedo, dtype=np.float64)
         if z.ndim != 2 or min(z.shape) < 2 or not np.all(np.isfinite(z)):
-            raise ValueError(f"z: expected a finite (nb, na) grid with nb, na >= 2, got {z.shape}")
+            raise ValueError(f"z must be a finite (nb, na) grid with nb, na >= 2; got {z.shape}")
         if albedo.shape != z.shape + (3,):
             raise ValueError(f"albedo: expected shape {z.shape + (3,)}, got {albedo.shape}")
         check_positive(self.spacing, "spacing")
@@ -338,7 +338,7 @@ def horizon_distances(terrain, *, ratio=1.05, first=1.0):
     """Horizontal probe distances (m) of :func:`horizon_angles`: geometric from `first` to the
     grid's diagonal, ``d[i+1] = ratio * d[i]``."""
     if not ratio > 1:
-        raise ValueError(f"ratio: must be > 1, got {ratio}")
+        raise ValueError(f"ratio must be > 1; got {ratio}")
     reach = float(np.hypot(*(np.array(terrain.z.shape) * terrain.spacing)))
     n = int(np.ceil(np.log(reach / first) / np.log(ratio))) + 1
     return first * ratio ** np.arange(n)
