@@ -342,7 +342,7 @@ def _make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.
     (NaN where the edge never passes or sky), ``edge_row (T, W)``, ``shift (T, 2)``,
     ``gain (T,)``, ``sky (H, W)``, ``interval``, ``lit_at_start (H, W)``.
     """
-    from shadowcam.outdoor.registration import apply_shift
+    from shadowcam.outdoor.translation import translate
 
     rng = np.random.default_rng(seed)
     nominal = np.arange(n_frames + len(drop))
@@ -376,7 +376,7 @@ def _make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.
         image = (radiance * gain * 0.5).astype(np.float32)
         shift = rng.uniform(-shake, shake, 2) if (shake and k) else np.zeros(2)
         if shake and k:
-            image = apply_shift(image, -shift)  # content moves by +shift
+            image = translate(image, -shift, method="opencv_cubic")  # content moves by +shift
         if noise:
             electrons = np.clip(image, 0, None) * 15000.0
             image = ((rng.poisson(electrons) + rng.normal(0, 4, image.shape)) / 15000.0).astype(np.float32)

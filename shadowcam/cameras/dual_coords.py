@@ -49,6 +49,8 @@ import xarray as xr
 from scipy.interpolate import RBFInterpolator
 from scipy.optimize import least_squares
 
+from shadowcam._shared.validation import check_array
+
 #: reason codes of the ``reason`` output variable
 REASON_FLAGS = {
     0: "ok",
@@ -79,10 +81,9 @@ def apply_homography(homography, points):
     """
     h = np.asarray(homography, dtype=np.float64)
     if h.shape != (3, 3) or not np.all(np.isfinite(h)):
-        raise ValueError(f"homography: expected a finite 3x3 matrix, got shape {h.shape}")
+        raise ValueError(f"homography must be a finite 3x3 matrix; got shape {h.shape}")
     p = np.asarray(points, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 2:
-        raise ValueError(f"points: expected shape (N, 2), got {p.shape}")
+    check_array(p, "points", shape=(None, 2))
     w = p @ h[2, :2] + h[2, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
         x = (p @ h[0, :2] + h[0, 2]) / w
@@ -332,8 +333,7 @@ def fit_time_to_plane(
     """
     times = np.asarray(times, dtype=np.float64)
     plane_xy = np.asarray(plane_xy, dtype=np.float64)
-    if times.ndim != 2 or times.shape[1] != 2:
-        raise ValueError(f"times: expected shape (N, 2), got {times.shape}")
+    check_array(times, "times", shape=(None, 2))
     if plane_xy.shape != times.shape:
         raise ValueError(f"plane_xy: shape {plane_xy.shape} differs from times {times.shape}")
     if not (np.all(np.isfinite(times)) and np.all(np.isfinite(plane_xy))):
@@ -342,9 +342,9 @@ def fit_time_to_plane(
     if unknown or not models:
         raise ValueError(f"models: unknown {unknown}; choose from {sorted(DUAL_COORD_MODELS)}")
     if k_folds < 2:
-        raise ValueError(f"k_folds: must be >= 2, got {k_folds}")
+        raise ValueError(f"k_folds must be >= 2; got {k_folds}")
     if unit_scale <= 0:
-        raise ValueError(f"unit_scale: must be > 0, got {unit_scale}")
+        raise ValueError(f"unit_scale must be > 0; got {unit_scale}")
     n = len(times)
     order = sorted(models, key=lambda m: DUAL_COORD_MODELS[m].n_params)
     fewest = DUAL_COORD_MODELS[order[0]].n_params + 2
@@ -420,8 +420,7 @@ def fit_time_to_plane(
 def _check_time_maps(t_u, t_v):
     t_u = np.asarray(t_u)
     t_v = np.asarray(t_v)
-    if t_u.ndim != 2:
-        raise ValueError(f"t_u: expected a (rows, cols) array, got shape {t_u.shape}")
+    check_array(t_u, "t_u", ndim=2)
     if t_v.shape != t_u.shape:
         raise ValueError(f"t_v: shape {t_v.shape} differs from t_u {t_u.shape}")
     return t_u, t_v
@@ -461,10 +460,10 @@ def dual_coords_uniform(
     t_u, t_v = _check_time_maps(t_u, t_v)
     n_u, n_v = (int(x) for x in n_frames)
     if n_u < 1 or n_v < 1:
-        raise ValueError(f"n_frames: must be positive, got {n_frames}")
+        raise ValueError(f"n_frames must be positive; got {n_frames}")
     height, width = (n_v, n_u) if dual_shape is None else (int(x) for x in dual_shape)
     if height < 1 or width < 1:
-        raise ValueError(f"dual_shape: must be positive, got {dual_shape}")
+        raise ValueError(f"dual_shape must be positive; got {dual_shape}")
     if scale is None:
         scale = (width / n_u, height / n_v)
     if offset is None:
@@ -556,7 +555,7 @@ def dual_coords_calibration(
         raise ValueError(f"cal_t_u: shape {cal_t_u.shape} differs from t_u {t_u.shape}")
     height, width = (int(x) for x in dual_shape)
     if height < 1 or width < 1:
-        raise ValueError(f"dual_shape: must be positive, got {dual_shape}")
+        raise ValueError(f"dual_shape must be positive; got {dual_shape}")
     on_plane = np.isfinite(cal_t_u) & np.isfinite(cal_t_v)
     if plane_mask is not None:
         plane_mask = np.asarray(plane_mask, dtype=bool)

@@ -38,6 +38,7 @@ import xarray as xr
 from scipy.spatial import cKDTree
 
 log = logging.getLogger(__name__)
+from shadowcam._shared.validation import check_array, check_in
 
 #: candidate (triangle, dual pixel) pairs processed at once by the mesh warp
 _CHUNK_CANDIDATES = 1 << 21
@@ -211,16 +212,14 @@ def resample_dual_view(colours, u, v, *, shape, valid=None, method="mesh", **par
     coverage : (height, width) bool ndarray
     """
     colours = np.asarray(colours)
-    if colours.ndim != 3:
-        raise ValueError(f"colours: expected (rows, cols, channel), got shape {colours.shape}")
+    check_array(colours, "colours", ndim=3)
     u, v = np.asarray(u), np.asarray(v)
     if u.shape != colours.shape[:2] or v.shape != colours.shape[:2]:
         raise ValueError(f"u/v: shapes {u.shape}, {v.shape} differ from colours {colours.shape[:2]}")
-    if method not in DUAL_VIEW_METHODS:
-        raise ValueError(f"method: unknown {method!r}; choose from {sorted(DUAL_VIEW_METHODS)}")
+    check_in(method, "method", DUAL_VIEW_METHODS)
     height, width = (int(s) for s in shape)
     if height < 1 or width < 1:
-        raise ValueError(f"shape: must be positive, got {shape}")
+        raise ValueError(f"shape must be positive; got {shape}")
     ok = np.isfinite(u) & np.isfinite(v) & np.all(np.isfinite(colours), axis=2)
     if valid is not None:
         valid = np.asarray(valid, dtype=bool)
@@ -249,8 +248,7 @@ def camera_colours(shadow_time, *, reference=None, sweeps=("u", "v")):
     """
     if reference is not None:
         ref = np.asarray(reference, dtype=np.float32)
-        if ref.ndim != 3:
-            raise ValueError(f"reference: expected (rows, cols, channel), got shape {ref.shape}")
+        check_array(ref, "reference", ndim=3)
         return ref
     if "lit_image" not in shadow_time:
         raise ValueError("shadow_time: no 'lit_image' variable and no reference frame given")

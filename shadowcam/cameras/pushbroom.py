@@ -21,6 +21,8 @@ resample_uniform_time : rows resampled to evenly spaced times.
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_positive
+
 
 def sample_along_edge(image, edge_row):
     """Return the colours of `image` at the edge curve.
@@ -68,8 +70,7 @@ def assemble_pushbroom(reference, edge_row):
         Row k = colours along the edge of frame k.
     """
     edge = np.asarray(edge_row)
-    if edge.ndim != 2:
-        raise ValueError(f"edge_row must be (T, W); got shape {edge.shape}")
+    check_array(edge, "edge_row", ndim=2)
     return np.stack([sample_along_edge(reference, row) for row in edge])
 
 
@@ -94,8 +95,7 @@ def resample_uniform_time(pushbroom, time_s, *, step_s):
     times = np.asarray(time_s, dtype=np.float64)
     if data.ndim != 3 or times.shape != (data.shape[0],):
         raise ValueError(f"pushbroom must be (T, W, C) and time_s (T,); got {data.shape}, {times.shape}")
-    if not step_s > 0:
-        raise ValueError(f"step_s must be positive; got {step_s}")
+    check_positive(step_s, "step_s")
     grid = np.arange(times[0], times[-1] + 1e-9 * step_s, step_s)
     after = np.clip(np.searchsorted(times, grid, side="right"), 1, times.size - 1)
     before = after - 1

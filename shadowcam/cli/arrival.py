@@ -9,7 +9,8 @@ add_parser : register the step and its options.
 run : compute and write the arrival map.
 """
 
-from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals, time_to_frame
+from shadowcam.io.frame_times import time_to_frame
+from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals
 from shadowcam.cli.options import parse_params
 from shadowcam.io.datasets import open_dataset, write_dataset
 from shadowcam.io.frame_times import median_interval
@@ -41,6 +42,6 @@ def run(args):
     coverage_s = edges["coverage_arrival_s"].values
     arrival, reason = combine_arrivals(edge_s, coverage_s, sky=sky, lit_at_start=lit,
                                        tolerance_s=params.get("tolerance_intervals", 1.5) * interval)
-    dataset = arrival_dataset(arrival, time_to_frame(arrival, time_s), reason, edge_arrival_s=edge_s,
+    dataset = arrival_dataset(arrival, time_to_frame(arrival, time_s, outside="clamp"), reason, edge_arrival_s=edge_s,
                               coverage_arrival_s=coverage_s, interval_s=interval)
     write_dataset(dataset, args.out, config=params, inputs=(photometry, edges), step="arrival")

@@ -44,7 +44,7 @@ from shadowcam.cameras.dual_coords import dual_coords_uniform
 from shadowcam.cameras.dual_view import resample_dual_view
 from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
 from shadowcam.synthetic.lab.scene import AreaLight, make_scene, make_wire_sweeps
-from shadowcam.synthetic.sensor import SensorModel, exposure_scale, raw_to_linear, simulate_raw
+from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
 from shadowcam.lab.shadow_time import sweep_shadow_times
 
 #: factor -> (unit, description)
@@ -130,7 +130,7 @@ def _to_linear(radiance, *, setting, reference, seed):
     sensor = _sensor_for(setting)
     target = setting.exposure or 0.8
     model = SensorModel() if sensor is None else sensor[0]
-    electrons = exposure_scale(reference, sensor=model, target_fraction=target)
+    electrons = electrons_per_unit_radiance(reference, sensor=model, target_fraction=target)
     if sensor is None:  # the mean DN without rounding, normalised
         span = model.white_level - model.black_level
         return (radiance * np.float32(electrons * model.gain / span)).astype(np.float32)

@@ -14,6 +14,8 @@ demosaic_bilinear : bilinear demosaic of an integer Bayer mosaic with OpenCV.
 import cv2
 import numpy as np
 
+from shadowcam._shared.validation import check_in
+
 _CHANNEL_OF_LETTER = {"R": 0, "G": 1, "B": 2}
 _RGB = "RGB"
 
@@ -69,7 +71,7 @@ def site_constants(values, shape):
     """
     values = np.asarray(values, np.float64)
     if values.shape != (2, 2):
-        raise ValueError(f"values must be (2, 2) per-site constants, got shape {values.shape}")
+        raise ValueError(f"values must be (2, 2) per-site constants; got shape {values.shape}")
     rows, cols = int(shape[0]), int(shape[1])
     return np.tile(values, (rows // 2 + 1, cols // 2 + 1))[:rows, :cols]
 
@@ -89,8 +91,7 @@ def opencv_bayer_code(pattern):
         (``COLOR_BayerBG2RGB`` ...) name the pattern from the second row; the
         four-letter aliases used here name it from the top-left pixel.
     """
-    if pattern not in ("RGGB", "BGGR", "GRBG", "GBRG"):
-        raise ValueError(f"pattern must be one of RGGB, BGGR, GRBG, GBRG; got {pattern!r}")
+    check_in(pattern, "pattern", ("RGGB", "BGGR", "GRBG", "GBRG"))
     return getattr(cv2, f"COLOR_Bayer{pattern}2RGB")
 
 

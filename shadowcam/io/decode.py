@@ -113,7 +113,7 @@ def _normalise_in_place(image, black, span):
     """``image = (image - black) / span`` in place; per-channel (3,) constants as scalars.
 
     numpy broadcasts a (3,) operand over the last axis with a slow inner loop
-    of length 3 (~40x slower than a scalar), so equal constants are applied as
+    of length 3 (far slower than a scalar; ``docs/benchmarks.md``), so equal constants are applied as
     scalars and different ones channel by channel on strided views; full
     (M, N, 3) maps are used as they are.
     """

@@ -12,9 +12,12 @@ AUTO_ORDER : preference order of ``timing.source: auto``.
 auto_candidates : the concrete timing specs ``auto`` tries, in order.
 median_interval : the median capture interval (the unit of the accuracy figures).
 find_gaps : intervals much longer than the median (dropped frames, pauses).
+time_to_frame : times -> fractional frame indices, piecewise linear in the frame times.
 """
 
 import numpy as np
+
+from shadowcam._shared.validation import check_in
 
 #: sources tried by ``timing: {source: auto}``, best first
 AUTO_ORDER = ("metadata", "filename", "sidecar")
@@ -76,3 +79,35 @@ def find_gaps(times_s, *, factor=1.5):
     return [{"after_frame": int(k), "interval_s": float(intervals[k]),
              "missing_frames": int(round(intervals[k] / step)) - 1}
             for k in np.nonzero(intervals > factor * step)[0]]
+
+
+#: what :func:`time_to_frame` gives for a finite time outside the frame times
+OUTSIDE_BEHAVIOURS = ("clamp", "nan")
+
+
+def time_to_frame(time_s, frame_times_s, *, outside):
+    """Fractional frame index of `time_s`, piecewise linear in the frame times.
+
+    The one time-to-frame convention of the library, used by the estimates and
+    the ground truth alike.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Times in seconds (any shape); NaN and infinite times give NaN.
+    frame_times_s : (T,) array_like
+        Increasing frame times in seconds.
+    outside : {"clamp", "nan"}, keyword-only
+        A finite time before the first / after the last frame gives frame
+        ``0`` / ``T - 1`` (``"clamp"``) or NaN (``"nan"``).
+
+    Returns
+    -------
+    float64 ndarray, shape of `time_s`
+    """
+    check_in(outside, "outside", OUTSIDE_BEHAVIOURS)
+    frames = np.asarray(frame_times_s, dtype=np.float64)
+    time = np.asarray(time_s, dtype=np.float64)
+    beyond = np.nan if outside == "nan" else None
+    out = np.interp(time, frames, np.arange(frames.size, dtype=np.float64), left=beyond, right=beyond)
+    return np.where(np.isfinite(time), out, np.nan)

@@ -7,9 +7,11 @@ Offers
 ------
 write_exr : linear float32 OpenEXR via OpenImageIO (NaN kept).
 read_image : any OpenImageIO-readable image as a float32 ``(rows, cols, channel)`` array.
-exposure_scale : robust exposure scale (percentile of the brightest channel).
+white_point : the linear value shown as white (percentile of the brightest channel).
 srgb_encode : linear [0, 1] -> sRGB-encoded [0, 1].
-preview_rgb8 : linear colour image -> 8-bit sRGB preview, holes in a neutral colour.
+tone_map : linear colour image -> display RGB in [0, 1] (sRGB), holes in a neutral colour;
+    the one tone map of the PNG previews and the report figures.
+preview_rgb8 : `tone_map` quantised to 8 bits.
 colormap_rgb8 : scalar map -> 8-bit colour-mapped preview, NaN in grey.
 write_png : write an 8-bit image as PNG.
 write_png_preview : `preview_rgb8` + `write_png`.
@@ -21,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from shadowcam._shared.atomic import atomic_path
+from shadowcam._shared.validation import check_array, check_in_interval, check_positive
 
 #: display colour of holes (NaN) in previews, sRGB-encoded [0, 1] (mid grey)
 HOLE_COLOUR = (0.5, 0.5, 0.5)
@@ -91,8 +94,8 @@ def read_image(path):
     return np.asarray(pixels, dtype=np.float32).reshape(inp.spec().height, inp.spec().width, -1)
 
 
-def exposure_scale(image, *, percentile=99.0):
-    """Robust exposure scale: the `percentile` of each finite pixel's brightest channel.
+def white_point(image, *, percentile=99.0):
+    """The linear value shown as white: the `percentile` of each finite pixel's brightest channel.
 
     Parameters
     ----------
@@ -105,8 +108,7 @@ def exposure_scale(image, *, percentile=99.0):
     float
         Positive scale (1.0 if the image has no positive finite value).
     """
-    if not 0 < percentile <= 100:
-        raise ValueError(f"percentile: must be in (0, 100], got {percentile}")
+    check_in_interval(percentile, "percentile", 0, 100)
     arr = _as_hwc(image)
     finite = np.all(np.isfinite(arr), axis=2)
     peak = arr[finite].max(axis=1) if finite.any() else np.zeros(0)
@@ -120,40 +122,52 @@ def srgb_encode(linear):
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
 
 
-def _to_uint8(display, holes, hole_colour):
+def _to_uint8(display, holes=None, hole_colour=HOLE_COLOUR):
     out = np.round(np.clip(display, 0, 1) * 255).astype(np.uint8)
-    out[holes] = np.round(np.asarray(hole_colour) * 255).astype(np.uint8)
+    if holes is not None:
+        out[holes] = np.round(np.asarray(hole_colour) * 255).astype(np.uint8)
     return out
 
 
-def preview_rgb8(image, *, percentile=99.0, scale=None, hole_colour=HOLE_COLOUR):
-    """8-bit sRGB preview of a linear image.
+def tone_map(image, *, percentile=99.0, scale=None, hole_colour=HOLE_COLOUR):
+    """Display RGB of a linear image: divided by its white point, sRGB-encoded.
 
     Parameters
     ----------
     image : (rows, cols[, channel]) ndarray
         Linear colour (1 channel -> grey, 3 -> RGB; extra channels dropped).
     percentile : float, keyword-only
-        Exposure: this percentile of the brightest channel maps to white.
+        Exposure: this percentile of the brightest channel maps to white (:func:`white_point`).
     scale : float, optional
-        Explicit exposure scale (overrides `percentile`).
+        Explicit white point (overrides `percentile`).
     hole_colour : (3,) sequence of float
         sRGB-encoded colour of pixels with a non-finite channel.
 
     Returns
     -------
-    (rows, cols, 3) uint8 ndarray
+    (rows, cols, 3) float64 ndarray
+        Values in [0, 1].
     """
     arr = _as_hwc(image).astype(np.float64)
     arr = np.repeat(arr, 3, axis=2) if arr.shape[2] == 1 else arr[..., :3]
     if arr.shape[2] != 3:
-        raise ValueError(f"image: expected 1 or >= 3 channels, got {arr.shape[2]}")
+        raise ValueError(f"image must have 1 or >= 3 channels; got {arr.shape[2]}")
     holes = ~np.all(np.isfinite(arr), axis=2)
-    scale = exposure_scale(arr, percentile=percentile) if scale is None else float(scale)
-    if not scale > 0:
-        raise ValueError(f"scale: must be > 0, got {scale}")
+    scale = white_point(arr, percentile=percentile) if scale is None else float(scale)
+    check_positive(scale, "scale")
     display = srgb_encode(np.nan_to_num(arr / scale, nan=0.0))
-    return _to_uint8(display, holes, hole_colour)
+    display[holes] = hole_colour
+    return display
+
+
+def preview_rgb8(image, **options):
+    """8-bit sRGB preview of a linear image: :func:`tone_map` (same options) quantised.
+
+    Returns
+    -------
+    (rows, cols, 3) uint8 ndarray
+    """
+    return _to_uint8(tone_map(image, **options))
 
 
 def colormap_rgb8(values, *, cmap="viridis", vmin=None, vmax=None, nan_colour=HOLE_COLOUR):
@@ -176,8 +190,7 @@ def colormap_rgb8(values, *, cmap="viridis", vmin=None, vmax=None, nan_colour=HO
     from matplotlib import colormaps
 
     arr = np.asarray(values, dtype=np.float64)
-    if arr.ndim != 2:
-        raise ValueError(f"values: expected (rows, cols), got shape {arr.shape}")
+    check_array(arr, "values", ndim=2)
     if cmap not in colormaps:
         raise ValueError(f"cmap: unknown colormap {cmap!r}")
     finite = np.isfinite(arr)
@@ -195,7 +208,7 @@ def write_png(path, rgb8):
     """Write an 8-bit ``(rows, cols, 3)`` (or single-channel) image as PNG."""
     arr = _as_hwc(rgb8, "rgb8")
     if arr.dtype != np.uint8:
-        raise ValueError(f"rgb8: expected uint8, got {arr.dtype}")
+        raise ValueError(f"rgb8 must be uint8; got {arr.dtype}")
     _write_oiio(path, arr, "uint8")
 
 

@@ -1,11 +1,9 @@
 """A sweep's Bayer mosaics, read fast: DNG raw data straight from the TIFF structure, checked against rawpy.
 
-rawpy (LibRaw) hands over a DNG's mosaic at about 4 ns per pixel when the
-file is uncompressed and 20-27 ns when it is lossless-JPEG compressed (what
-cameras write) -- as long as, or longer than, everything else the
-shadow-time pipeline does with the frame. tifffile (with imagecodecs'
-codecs) reads the same data at about 0.5 ns and 8-13 ns per pixel. A
-:class:`MosaicReader` decodes the first frame of a sweep both ways and reads
+rawpy (LibRaw) hands over a DNG's mosaic several times slower than tifffile
+(with imagecodecs' codecs) reads the same data, and about as long as
+everything else the shadow-time pipeline does with the frame (figures in
+``docs/benchmarks.md``). A :class:`MosaicReader` decodes the first frame of a sweep both ways and reads
 the rest directly only if the two mosaics are equal; every later frame must
 then have the same raw-image layout, compression and level tags as the first
 (so the levels rawpy reported hold), else it is read with rawpy. DNGs with a

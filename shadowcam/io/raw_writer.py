@@ -22,6 +22,8 @@ from unittest import mock
 
 import numpy as np
 
+from shadowcam._shared.validation import check_in, check_positive
+
 #: sensor bit depth -> stored BitsPerSample (pidng's 14-bit packer is broken, so 14-bit
 #: data are stored in 16-bit samples; WhiteLevel still says 2**14 - 1)
 _STORAGE_BITS = {8: 8, 10: 10, 12: 12, 14: 16, 16: 16}
@@ -31,7 +33,7 @@ _PACKABLE_BITS = tuple(_STORAGE_BITS)
 def format_capture_time(when):
     """Return `when` (a ``datetime.datetime``) as an EXIF date-time string."""
     if not isinstance(when, datetime.datetime):
-        raise ValueError(f"when: expected a datetime.datetime, got {type(when).__name__}")
+        raise ValueError(f"when must be a datetime.datetime; got {type(when).__name__}")
     return when.strftime("%Y:%m:%d %H:%M:%S")
 
 
@@ -39,7 +41,7 @@ def format_subseconds(when):
     """Return the sub-second part of `when` as EXIF SubSec digits: 3 digits (milliseconds)
     when that is exact, else 6 (microseconds)."""
     if not isinstance(when, datetime.datetime):
-        raise ValueError(f"when: expected a datetime.datetime, got {type(when).__name__}")
+        raise ValueError(f"when must be a datetime.datetime; got {type(when).__name__}")
     us = when.microsecond
     return f"{us // 1000:03d}" if us % 1000 == 0 else f"{us:06d}"
 
@@ -106,16 +108,14 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
     rows, cols = raw.shape
     if rows % 2 or cols % 2 or rows == 0:
         raise ValueError(f"raw: rows and cols must be even and positive, got {raw.shape}")
-    if compression not in ("none", "ljpeg"):
-        raise ValueError(f"compression: must be 'none' or 'ljpeg', got {compression!r}")
-    if bit_depth not in _PACKABLE_BITS:
-        raise ValueError(f"bit_depth: must be one of {_PACKABLE_BITS}, got {bit_depth}")
+    check_in(compression, "compression", ("none", "ljpeg"))
+    check_in(bit_depth, "bit_depth", _PACKABLE_BITS)
     max_value = 2**bit_depth - 1
     white_level = max_value if white_level is None else int(white_level)
     if not 0 < white_level <= max_value:
         raise ValueError(f"white_level: must be in (0, {max_value}], got {white_level}")
     if not 0 <= int(black_level) < white_level:
-        raise ValueError(f"black_level: must be in [0, white_level), got {black_level}")
+        raise ValueError(f"black_level must be in [0, white_level); got {black_level}")
     if int(raw.max()) > max_value:
         raise ValueError(f"raw: maximum {int(raw.max())} does not fit in {bit_depth} bits")
 
@@ -149,8 +149,7 @@ def write_dng(path, raw, *, bit_depth, black_level, white_level=None, capture_ti
         if capture_time.microsecond:
             tags.set(Tag.SubsecTimeOriginal, format_subseconds(capture_time))
     if exposure_time is not None:
-        if not exposure_time > 0:
-            raise ValueError(f"exposure_time: must be positive seconds, got {exposure_time}")
+        check_positive(exposure_time, "exposure_time")
         tags.set(Tag.ExposureTime, [[int(round(exposure_time * 1e6)), 1000000]])
 
     path = Path(path)

@@ -37,6 +37,8 @@ import json
 
 import numpy as np
 
+from shadowcam._shared.validation import check_in
+
 #: targets of the foundation issue; the shadow-time p95 depends on the noise condition
 ACCURACY_TARGETS = {
     "shadow_time_p95_frames": {"noise_free": 0.1, "raw12": 0.3, "comparison": "<="},
@@ -224,8 +226,7 @@ def check_targets(report, *, noise="noise_free"):
         ``target``, ``sweep``, ``value``, ``threshold``, ``comparison``, ``pass``.
     """
     p95 = ACCURACY_TARGETS["shadow_time_p95_frames"]
-    if noise not in ("noise_free", "raw12"):
-        raise ValueError(f"noise: expected 'noise_free' or 'raw12', got {noise!r}")
+    check_in(noise, "noise", ("noise_free", "raw12"))
     rows = []
     for sweep, stats in report.get("shadow_time", {}).items():
         for target, key, threshold, comparison in (

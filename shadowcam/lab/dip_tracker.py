@@ -198,12 +198,12 @@ class DipTracker:
 
     def __init__(self, shape, *, half_window=4, owned=None, saturation_level=0.999):
         if len(shape) != 2 or min(shape) < 1:
-            raise ValueError(f"shape must be (H, W) with positive sizes, got {shape!r}")
+            raise ValueError(f"shape must be (H, W) with positive sizes; got {shape!r}")
         if int(half_window) < 1:
-            raise ValueError(f"half_window must be >= 1, got {half_window!r}")
+            raise ValueError(f"half_window must be >= 1; got {half_window!r}")
         start, stop = (0, np.iinfo(np.int64).max) if owned is None else (int(owned[0]), int(owned[1]))
         if not 0 <= start < stop:
-            raise ValueError(f"owned must be (start, stop) with 0 <= start < stop, got {owned!r}")
+            raise ValueError(f"owned must be (start, stop) with 0 <= start < stop; got {owned!r}")
         self.shape = tuple(int(s) for s in shape)
         self.half_window = h = int(half_window)
         self.owned = (start, stop)

@@ -20,6 +20,8 @@ shifted : an image shifted by a neighbour offset, filled outside.
 import numba as nb
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_positive
+
 
 def shifted(array, dr, dc, fill):
     """`array` shifted so that ``out[r, c] = array[r + dr, c + dc]`` (fill outside)."""
@@ -129,13 +131,11 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         Standard deviation of the refined times under the weights' noise model.
     """
     time = np.asarray(time)
-    if time.ndim != 2:
-        raise ValueError(f"time must be 2-D (H, W), got shape {time.shape}")
+    check_array(time, "time", ndim=2)
     time_std = np.broadcast_to(np.asarray(time_std, dtype=np.float64), time.shape)
     if int(radius) < 1:
-        raise ValueError(f"radius must be >= 1, got {radius!r}")
-    if not range_sigma > 0:
-        raise ValueError(f"range_sigma must be > 0, got {range_sigma!r}")
+        raise ValueError(f"radius must be >= 1; got {radius!r}")
+    check_positive(range_sigma, "range_sigma")
     valid = np.isfinite(time)
     t64 = np.where(valid, time, np.nan).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -35,7 +35,7 @@ _GREEN_KERNEL = np.array([[0, 1, 0], [1, 4, 1], [0, 1, 0]], np.float64) / 4
 
 def _check_pattern(pattern):
     if not isinstance(pattern, str) or sorted(pattern) != ["B", "G", "G", "R"]:
-        raise ValueError(f"pattern must be a Bayer pattern such as 'RGGB', got {pattern!r}")
+        raise ValueError(f"pattern must be a Bayer pattern such as 'RGGB'; got {pattern!r}")
 
 
 @nb.njit(cache=True)
@@ -165,7 +165,7 @@ def bilinear_channels(values, *, pattern):
     """
     values = np.asarray(values, np.float64)
     if values.ndim != 2 or min(values.shape) < 2:
-        raise ValueError(f"values must be a 2-D mosaic of at least 2x2, got shape {values.shape}")
+        raise ValueError(f"values must be a 2-D mosaic of at least 2x2; got shape {values.shape}")
     _check_pattern(pattern)
     letters = site_constants(np.arange(4).reshape(2, 2), values.shape).astype(int)
     out = np.empty(values.shape + (3,))

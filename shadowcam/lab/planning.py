@@ -24,22 +24,15 @@ plan_capture : r, dual pixels and frames per sweep, plus the recommended mask sp
     wanted dual resolution.
 """
 
-import math
-
-
-def _positive(name, value):
-    value = float(value)
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name}: must be a positive finite number, got {value!r}")
-    return value
+from shadowcam._shared.validation import check_positive
 
 
 def _geometry(pixel_width, mask_distance, depth, focal_length, frame_time):
-    w = _positive("pixel_width", pixel_width)
-    h = _positive("mask_distance", mask_distance)
-    d = _positive("depth", depth)
-    f = _positive("focal_length", focal_length)
-    t = _positive("frame_time", frame_time)
+    w = check_positive(float(pixel_width), "pixel_width", finite=True)
+    h = check_positive(float(mask_distance), "mask_distance", finite=True)
+    d = check_positive(float(depth), "depth", finite=True)
+    f = check_positive(float(focal_length), "focal_length", finite=True)
+    t = check_positive(float(frame_time), "frame_time", finite=True)
     if not d > f:
         raise ValueError(f"depth: must exceed focal_length ({d} <= {f}); give both in one unit")
     return w * h * (d - f) / (f * d * t)
@@ -69,7 +62,7 @@ def dual_resolution_ratio(*, pixel_width, mask_distance, depth, focal_length, ma
     float
         ``r = W h (D - f) / (f D u t)``; frames the shadow needs to cross one camera pixel.
     """
-    u = _positive("mask_speed", mask_speed)
+    u = check_positive(float(mask_speed), "mask_speed", finite=True)
     return _geometry(pixel_width, mask_distance, depth, focal_length, frame_time) / u
 
 
@@ -89,7 +82,7 @@ def mask_speed_for_ratio(ratio, *, pixel_width, mask_distance, depth, focal_leng
     float
         ``u = W h (D - f) / (f D r t)`` (length per second).
     """
-    r = _positive("ratio", ratio)
+    r = check_positive(float(ratio), "ratio", finite=True)
     return _geometry(pixel_width, mask_distance, depth, focal_length, frame_time) / r
 
 
@@ -118,7 +111,7 @@ def plan_capture(*, pixel_width, mask_distance, depth, focal_length, frame_time,
     """
     n = int(image_pixels)
     if n < 1:
-        raise ValueError(f"image_pixels: must be a positive integer, got {image_pixels!r}")
+        raise ValueError(f"image_pixels must be a positive integer; got {image_pixels!r}")
     if mask_speed is None and wanted_dual_pixels is None:
         raise ValueError("mask_speed, wanted_dual_pixels: give at least one")
     geometry = dict(pixel_width=pixel_width, mask_distance=mask_distance, depth=depth,
@@ -129,7 +122,7 @@ def plan_capture(*, pixel_width, mask_distance, depth, focal_length, frame_time,
         out.update(mask_speed=float(mask_speed), ratio=r, dual_pixels=r * n,
                    frames_per_sweep=r * n, exceeds_camera=bool(r > 1))
     if wanted_dual_pixels is not None:
-        r = _positive("wanted_dual_pixels", wanted_dual_pixels) / n
+        r = check_positive(float(wanted_dual_pixels), "wanted_dual_pixels", finite=True) / n
         speed = mask_speed_for_ratio(r, **geometry)
         out.update(wanted_dual_pixels=float(wanted_dual_pixels), recommended_ratio=r,
                    recommended_mask_speed=speed,

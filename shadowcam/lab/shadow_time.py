@@ -29,6 +29,7 @@ import numba as nb
 import numpy as np
 from scipy.special import ndtri
 
+from shadowcam._shared.validation import check_in_interval, check_positive
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
 
@@ -226,8 +227,7 @@ def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
     replaced by the nearest valid edge), then the parabola through the
     smoothed minimum and its neighbours gives the sub-frame offset.
     """
-    if not sigma > 0:
-        raise ValueError(f"sigma must be > 0, got {sigma!r}")
+    check_positive(sigma, "sigma")
     win = summary.window.astype(np.float64)
     k = win.shape[0]
     radius = max(1, int(np.ceil(3 * sigma)))
@@ -281,8 +281,7 @@ def detection_threshold(n_frames, *, false_alarm=1e-3):
     deviations with probability about ``n_frames * Q(z)``; ``z`` is chosen so
     that this is `false_alarm`.
     """
-    if not 0 < false_alarm < 1:
-        raise ValueError(f"false_alarm must be in (0, 1), got {false_alarm!r}")
+    check_in_interval(false_alarm, "false_alarm", 0, 1, closed="neither")
     return float(-ndtri(false_alarm / max(int(n_frames), 1)))
 
 
@@ -566,7 +565,7 @@ def cfa_site_colours(shape, pattern):
     (H, W) int8 ndarray
     """
     if len(pattern) != 4 or set(pattern) - set("RGB"):
-        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB', got {pattern!r}")
+        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB'; got {pattern!r}")
     tile = np.array(["RGB".index(ch) for ch in pattern], np.int8).reshape(2, 2)
     rows = np.arange(shape[0])[:, None] % 2
     cols = np.arange(shape[1])[None, :] % 2

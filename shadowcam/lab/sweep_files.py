@@ -188,7 +188,7 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
         Frames decoded before each tracker update (memory: ``block_frames`` frames,
         4 bytes per pixel each for RAW, 12 for RGB, next to the tracker's ~220
         bytes per pixel). The tracker reads and writes its state once per
-        update: 16 frames take 8.1 ns per pixel-frame on one core, 8 frames 9.3.
+        update, so larger blocks cost less per frame (``docs/benchmarks.md``).
     saturation_level : float, optional
 
     Returns

@@ -33,6 +33,8 @@ from shadowcam.io.frame_store import iter_store_frames
 from shadowcam.io.frame_times import median_interval
 
 log = logging.getLogger(__name__)
+from shadowcam._shared.validation import check_array, check_in, check_positive, check_same_shape
+from shadowcam.outdoor.translation import translate
 
 #: condition -> {statistic: bound} (errors in median capture intervals)
 TARGETS = {
@@ -64,10 +66,8 @@ def arrival_errors(estimate_s, truth_s, *, evaluate, interval_s):
     estimate = np.asarray(estimate_s, dtype=np.float64)
     truth = np.asarray(truth_s, dtype=np.float64)
     evaluate = np.asarray(evaluate, dtype=bool)
-    if not (estimate.shape == truth.shape == evaluate.shape):
-        raise ValueError(f"estimate_s {estimate.shape}, truth_s {truth.shape}, evaluate {evaluate.shape} must match")
-    if not interval_s > 0:
-        raise ValueError(f"interval_s must be positive; got {interval_s}")
+    check_same_shape({"estimate_s": estimate, "truth_s": truth, "evaluate": evaluate})
+    check_positive(interval_s, "interval_s")
     pixels = evaluate & np.isfinite(truth)
     found = pixels & np.isfinite(estimate)
     error = (estimate[found] - truth[found]) / interval_s
@@ -141,8 +141,7 @@ def check_targets(stats, *, condition, estimator="combined"):
         ``{target, sweep, value, threshold, comparison, pass}`` (the layout of
         :func:`shadowcam.lab.accuracy.check_targets`; ``sweep`` names the estimator).
     """
-    if condition not in TARGETS:
-        raise ValueError(f"condition must be one of {sorted(TARGETS)}; got {condition!r}")
+    check_in(condition, "condition", TARGETS)
     return [
         {"target": name, "sweep": estimator, "value": stats[name], "threshold": bound, "comparison": "<=",
          "pass": bool(stats[name] <= bound)}
@@ -206,8 +205,7 @@ def edge_errors(edge_row, truth_edge_row, *, unambiguous=None):
     """Median and p95 absolute edge-row error (pixels) where both exist (and the GT column is unambiguous)."""
     edge = np.asarray(edge_row, dtype=np.float64)
     gt = np.asarray(truth_edge_row, dtype=np.float64)
-    if edge.shape != gt.shape:
-        raise ValueError(f"edge_row {edge.shape} and truth_edge_row {gt.shape} must match")
+    check_same_shape({"edge_row": edge, "truth_edge_row": gt})
     use = np.isfinite(edge) & np.isfinite(gt)
     if unambiguous is not None:
         use &= np.asarray(unambiguous, dtype=bool)
@@ -239,19 +237,9 @@ def map_to_truth_camera(values, *, shift_row, shift_col):
     -------
     (H, W) float64 ndarray
     """
-    from scipy.ndimage import map_coordinates
-
     values = np.asarray(values, dtype=np.float64)
-    if values.ndim != 2:
-        raise ValueError(f"values must be (H, W), got shape {values.shape}")
-    if shift_row == 0 and shift_col == 0:
-        return values.copy()
-    rows, cols = np.indices(values.shape, dtype=np.float64)
-    coords = np.stack([rows + shift_row, cols + shift_col])
-    missing = ~np.isfinite(values)
-    sampled = map_coordinates(np.where(missing, 0.0, values), coords, order=1, mode="constant", cval=np.nan)
-    touched = map_coordinates(missing.astype(np.float64), coords, order=1, mode="constant", cval=1.0)
-    return np.where(touched > 0, np.nan, sampled)
+    check_array(values, "values", ndim=2)
+    return translate(values, (shift_row, shift_col), method="linear_nan")
 
 
 def edges_to_truth_camera(edge_row, *, shift_row, shift_col):
@@ -261,8 +249,7 @@ def edges_to_truth_camera(edge_row, *, shift_row, shift_col):
     (linear between columns, NaN past the image); its row moves by ``-shift_row``.
     """
     edge = np.asarray(edge_row, dtype=np.float64)
-    if edge.ndim != 2:
-        raise ValueError(f"edge_row must be (T, W), got shape {edge.shape}")
+    check_array(edge, "edge_row", ndim=2)
     width = edge.shape[1]
     if width < 2:
         raise ValueError(f"edge_row needs at least 2 columns, got {width}")

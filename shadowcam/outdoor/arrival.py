@@ -22,10 +22,11 @@ ARRIVAL_REASONS : reason code -> name (CF flag meanings).
 arrival_from_edges : arrival time of every pixel from the per-frame edge rows.
 CoverageCrossing : streaming first downward 0.5-crossing of per-pixel coverage.
 combine_arrivals : the final arrival map and its reasons.
-time_to_frame : fractional frame index of times, piecewise linear in the frame times.
 """
 
 import numpy as np
+
+from shadowcam._shared.validation import check_same_shape
 
 #: reason code -> meaning (stored as CF flag_values / flag_meanings)
 ARRIVAL_REASONS = {
@@ -36,14 +37,6 @@ ARRIVAL_REASONS = {
     4: "sky",
 }
 REASON_CODE = {name: code for code, name in ARRIVAL_REASONS.items()}
-
-
-def time_to_frame(time_s, frame_times_s):
-    """Fractional frame index of `time_s`, piecewise linear in the frame times (NaN stays NaN)."""
-    frames = np.asarray(frame_times_s, dtype=np.float64)
-    time = np.asarray(time_s, dtype=np.float64)
-    out = np.interp(time, frames, np.arange(frames.size, dtype=np.float64))
-    return np.where(np.isfinite(time), out, np.nan)
 
 
 def arrival_from_edges(edge_row, time_s, *, eligible):
@@ -169,8 +162,7 @@ def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start):
     """
     edge_s = np.asarray(edge_s, dtype=np.float64)
     coverage_s = np.asarray(coverage_s, dtype=np.float64)
-    if edge_s.shape != coverage_s.shape:
-        raise ValueError(f"edge_s {edge_s.shape} and coverage_s {coverage_s.shape} must match")
+    check_same_shape({"edge_s": edge_s, "coverage_s": coverage_s})
     with np.errstate(invalid="ignore"):
         agree = np.abs(edge_s - coverage_s) <= tolerance_s
     use_edge = np.isfinite(edge_s) & (agree | np.isnan(coverage_s))

@@ -13,6 +13,8 @@ difference_band : pixels whose coverage dropped between two frames, widened.
 import cv2
 import numpy as np
 
+from shadowcam._shared.validation import check_positive
+
 
 def difference_band(previous, current, *, valid=None, min_drop=0.2, margin=2):
     """Return the band where the shadow edge moved between two frames.
@@ -36,8 +38,7 @@ def difference_band(previous, current, *, valid=None, min_drop=0.2, margin=2):
     curr = np.asarray(current, dtype=np.float32)
     if prev.shape != curr.shape or prev.ndim != 2:
         raise ValueError(f"previous {prev.shape} and current {curr.shape} must be the same (H, W) shape")
-    if not min_drop > 0:
-        raise ValueError(f"min_drop must be positive; got {min_drop}")
+    check_positive(min_drop, "min_drop")
     with np.errstate(invalid="ignore"):
         drop = (prev - curr) >= np.float32(min_drop)  # NaN never counts as a drop
     if valid is not None:

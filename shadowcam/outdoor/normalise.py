@@ -33,10 +33,12 @@ aligned_luminance : one frame's registered luminance from the pass's results.
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array
 from shadowcam.outdoor.photometric import estimate_gain, lit_at_start, luminance
-from shadowcam.outdoor.registration import (apply_shift, block_all, block_mean, pyramid_levels, registration_factor,
+from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
                                     shift_coarse_to_fine, static_weight)
 from shadowcam.outdoor.sky_mask import auto_sky_mask
+from shadowcam.outdoor.translation import translate
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
@@ -116,8 +118,7 @@ class SequenceNormaliser:
             self._last = (np.zeros(2), seed, seed)
 
     def _start(self, frame):
-        if frame.ndim != 3:
-            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
+        check_array(frame, "frame", ndim=3)
         height, width = frame.shape[:2]
         if self._sky is None:
             self._sky = auto_sky_mask(frame, **self._sky_params)
@@ -144,8 +145,7 @@ class SequenceNormaliser:
     def update(self, frame):
         """Process the next frame ``(H, W, C)`` (frame 0 sets the reference)."""
         frame = np.asarray(frame, dtype=np.float32)
-        if frame.ndim != 3:
-            raise ValueError(f"frame must be (H, W, C); got shape {frame.shape}")
+        check_array(frame, "frame", ndim=3)
         k = self._k
         if k == 0:
             self._start(frame)
@@ -164,7 +164,7 @@ class SequenceNormaliser:
             shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
                                             levels=self._registration_levels)
             shift = shift * factor
-            luma = apply_shift(raw, shift)
+            luma = translate(raw, shift, method="opencv_cubic")
             del raw, small
             small = block_mean(luma, factor)
             gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
@@ -364,4 +364,4 @@ def part_frames(start, stop, *, overlap=2):
 
 def aligned_luminance(frame, shift):
     """Registered luminance ``(H, W)`` float32 of `frame` ``(H, W, C)`` given its shift (row, col)."""
-    return apply_shift(luminance(frame), shift)
+    return translate(luminance(frame), shift, method="opencv_cubic")

@@ -26,6 +26,8 @@ coverage : per-pixel lit fraction of a frame from its lit and shadow levels.
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_positive, check_same_shape
+
 
 def luminance(image):
     """Return the mean over the last (channel) axis.
@@ -68,8 +70,7 @@ def exposure_gains(exposure_s):
         if no frame has an exposure time).
     """
     exposure = np.asarray(exposure_s, dtype=np.float64)
-    if exposure.ndim != 1:
-        raise ValueError(f"exposure_s must be 1-D (one value per frame); got shape {exposure.shape}")
+    check_array(exposure, "exposure_s", ndim=1)
     known = np.isfinite(exposure) & (exposure > 0)
     out = np.full(exposure.shape, np.nan)
     if known.any():
@@ -144,10 +145,8 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
     luma = np.asarray(luma, dtype=np.float64)
     ref = np.asarray(reference_luma, dtype=np.float64)
     pixels = np.asarray(pixels, dtype=bool)
-    if not (luma.shape == ref.shape == pixels.shape):
-        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and pixels {pixels.shape} must match")
-    if not prior > 0:
-        raise ValueError(f"prior must be positive; got {prior}")
+    check_same_shape({"luma": luma, "reference_luma": ref, "pixels": pixels})
+    check_positive(prior, "prior")
     use = pixels & (ref > 0)
     ratio = luma[use] / ref[use]
     if ratio.size < 10:
@@ -185,8 +184,7 @@ def coverage(luma, *, lit_level, shadow_level):
     luma = np.asarray(luma, dtype=np.float32)
     lit = np.asarray(lit_level, dtype=np.float32)
     shadow = np.asarray(shadow_level, dtype=np.float32)
-    if not (luma.shape == lit.shape == shadow.shape):
-        raise ValueError(f"luma {luma.shape}, lit_level {lit.shape}, shadow_level {shadow.shape} must match")
+    check_same_shape({"luma": luma, "lit_level": lit, "shadow_level": shadow})
     span = lit - shadow
     out = luma - shadow
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -10,15 +10,14 @@ the strongest feature of the image).
 
 Convention: a frame whose content moved by ``(shift_row, shift_col)``
 satisfies ``frame(r, c) = reference(r - shift_row, c - shift_col)``;
-:func:`apply_shift` samples the frame at ``(r + shift_row, c + shift_col)``
-to align it with the reference.
+:func:`shadowcam.outdoor.translation.translate` samples the frame at ``(r + shift_row,
+c + shift_col)`` to align it with the reference.
 
 Range: one Lucas-Kanade level converges from a start within a few pixels of
 the band-pass scale and rejects a solution more than ``max_shift`` (5) pixels
 from its start. :func:`shift_coarse_to_fine` first solves on ``2**levels``-times
 reduced images (block means) and refines level by level, so the range grows
-to about ``4 * 2**levels`` pixels (measured on a multi-scale texture: one level
-recovers 4 px, not 6; two coarser levels 16 px, not 24).
+to about ``4 * 2**levels`` pixels (``docs/benchmarks.md``).
 
 Offers
 ------
@@ -28,7 +27,6 @@ static_weight : weight mask of pixels whose illumination state did not change.
 shift_lucas_kanade_LucasKanade1981 : translation by iterative least squares.
 shift_coarse_to_fine : the same on a pyramid of block means, coarse levels first (large shifts).
 pyramid_levels : number of coarser levels an image of a given shape supports.
-apply_shift : resample an image so that it aligns with the reference.
 registration_factor : integer downsampling factor that brings a frame to a working size.
 block_mean : mean over factor x factor blocks (area downsampling; a shift scales by 1/factor).
 block_all : True where all pixels of a factor x factor block are (masks at the working size).
@@ -36,6 +34,9 @@ block_all : True where all pixels of a factor x factor block are (masks at the w
 
 import cv2
 import numpy as np
+
+from shadowcam._shared.validation import check_array, check_positive, check_same_shape
+from shadowcam.outdoor.translation import translate
 
 _EPS = 1e-3
 
@@ -54,8 +55,7 @@ def bandpass_log(luma, *, inner_sigma=0.7, outer_sigma=3.0):
     (H, W) float32 ndarray
     """
     luma = np.asarray(luma, dtype=np.float32)
-    if luma.ndim != 2:
-        raise ValueError(f"luma must be 2-D (H, W); got shape {luma.shape}")
+    check_array(luma, "luma", ndim=2)
     logl = np.log(np.maximum(luma, 0) + _EPS)
     smooth = cv2.GaussianBlur(logl, (0, 0), inner_sigma)
     return smooth - cv2.GaussianBlur(logl, (0, 0), outer_sigma)
@@ -97,8 +97,7 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_
     if not (luma.shape == ref.shape == lit.shape) or luma.ndim != 2:
         raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and lit_reference {lit.shape} "
                          "must be the same (H, W) shape")
-    if not gain > 0:
-        raise ValueError(f"gain must be positive; got {gain}")
+    check_positive(gain, "gain")
     changed = lit & (luma < max_ratio * gain * ref)
     # the reference's own shadow edge: a small move of it changes pixels less than max_ratio
     changed |= lit & (cv2.dilate((~lit).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
@@ -152,8 +151,7 @@ def block_mean(image, factor):
         translation ``d`` of `image` is a translation ``d / factor`` of the result.
     """
     image = np.asarray(image)
-    if image.ndim != 2:
-        raise ValueError(f"image must be 2-D (H, W); got shape {image.shape}")
+    check_array(image, "image", ndim=2)
     factor = int(factor)
     if factor < 1:
         raise ValueError(f"factor must be >= 1; got {factor}")
@@ -170,32 +168,6 @@ def block_all(mask, factor):
     if int(factor) == 1:
         return mask
     return block_mean(mask.astype(np.float32), factor) >= np.float32(1.0)
-
-
-def apply_shift(image, shift, *, interpolation=cv2.INTER_CUBIC):
-    """Resample `image` at ``(r + shift_row, c + shift_col)`` (edges replicated).
-
-    Parameters
-    ----------
-    image : (H, W) or (H, W, C) ndarray
-    shift : (2,) array_like
-        ``(shift_row, shift_col)`` in pixels.
-
-    Returns
-    -------
-    ndarray
-        Same shape and dtype (float32 stays float32).
-    """
-    image = np.asarray(image)
-    if image.ndim not in (2, 3):
-        raise ValueError(f"image must be (H, W) or (H, W, C); got shape {image.shape}")
-    d_row, d_col = (float(s) for s in shift)
-    if d_row == 0 and d_col == 0:
-        return image.copy()
-    matrix = np.float32([[1, 0, d_col], [0, 1, d_row]])
-    height, width = image.shape[:2]
-    return cv2.warpAffine(image, matrix, (width, height), flags=interpolation | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
 
 
 def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, initial=(0.0, 0.0),
@@ -237,8 +209,7 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
         weight = np.zeros(luma.shape)
         weight[4:-4, 4:-4] = 1.0
     weight = np.asarray(weight, dtype=np.float64)
-    if not (luma.shape == ref.shape == weight.shape):
-        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and weight {weight.shape} must match")
+    check_same_shape({"luma": luma, "reference_luma": ref, "weight": weight})
     target = bandpass_log(ref).astype(np.float64)
     grad_row, grad_col = np.gradient(target)
     normal = np.array([[np.sum(weight * grad_row**2), np.sum(weight * grad_row * grad_col)],
@@ -249,7 +220,7 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
         return start, float("nan")
     error = None
     for _ in range(max_iter):
-        error = bandpass_log(apply_shift(luma, shift)).astype(np.float64) - target
+        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
         rhs = -np.array([np.sum(weight * grad_row * error), np.sum(weight * grad_col * error)])
         step = np.linalg.solve(normal, rhs)
         shift += step
@@ -257,7 +228,7 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = bandpass_log(apply_shift(luma, shift)).astype(np.float64) - target
+    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
     residual = float(np.sqrt(np.sum(weight * error**2) / max(np.sum(weight), 1.0)))
     return shift, residual
 
@@ -355,8 +326,7 @@ def shift_coarse_to_fine(luma, reference_luma, *, weight=None, initial=(0.0, 0.0
     if weight is None:
         weight = np.ones(luma.shape, dtype=np.float32)
     weight = np.asarray(weight, dtype=np.float32)
-    if weight.shape != luma.shape:
-        raise ValueError(f"weight {weight.shape} must match luma {luma.shape}")
+    check_same_shape({"weight": weight, "luma": luma})
     n_levels = pyramid_levels(luma.shape, levels=levels, min_size=min_size)
     start = np.asarray(initial, dtype=np.float64).copy()
     coarse = start

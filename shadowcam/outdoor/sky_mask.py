@@ -19,6 +19,8 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from shadowcam._shared.validation import check_array
+
 
 def auto_sky_mask(image, *, min_blue_fraction=0.36, max_log_gradient=0.3, max_log_brightness=0.7,
                   close_radius=1):
@@ -44,8 +46,7 @@ def auto_sky_mask(image, *, min_blue_fraction=0.36, max_log_gradient=0.3, max_lo
         True for sky. Empty when no top-border pixel qualifies.
     """
     image = np.asarray(image, dtype=np.float32)
-    if image.ndim != 3 or image.shape[2] != 3:
-        raise ValueError(f"image must be (H, W, 3) RGB; got shape {image.shape}")
+    check_array(image, "image", shape=(None, None, 3))
     total = image.sum(axis=2)
     with np.errstate(divide="ignore", invalid="ignore"):
         blue = np.where(total > 0, image[..., 2] / total, 0.0)

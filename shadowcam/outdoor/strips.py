@@ -7,7 +7,7 @@ Its spatial dependencies across columns are:
 
 * the registration shift: cubic resampling reads columns ``floor(c + shift_col) - 1
   .. + 2``, so ``ceil(max |shift_col|) + 2`` columns (bits independent of the cut:
-  :func:`shadowcam.outdoor.translation.translate_cubic_Keys1981`);
+  :func:`shadowcam.outdoor.translation.translate`, ``"cubic_Keys1981"``);
 * the frame-differencing band: the coverage drop is widened by ``margin``
   columns (:func:`shadowcam.outdoor.frame_difference.difference_band`);
 * ``band_fraction``, a whole-frame mean: reassembled exactly from per-strip

@@ -13,7 +13,7 @@ the pixel is fully lit and well above the edge. Memory is a few ``(H, W)``
 arrays plus the ``(T, W)`` edges.
 
 Every step but the frame differencing's widening (``margin`` columns) and the
-registration shift (:func:`shadowcam.outdoor.translation.translate_cubic_Keys1981`,
+registration shift (:func:`shadowcam.outdoor.translation.translate`, ``"cubic_Keys1981"``,
 whose bits do not depend on where the frame is cut) works column by column,
 so column strips of the frames can be tracked as separate jobs and merged
 exactly (:mod:`shadowcam.outdoor.strips`).
@@ -30,7 +30,7 @@ from shadowcam.outdoor.arrival import CoverageCrossing
 from shadowcam.outdoor.edge_tracking import column_edges
 from shadowcam.outdoor.frame_difference import difference_band
 from shadowcam.outdoor.photometric import coverage, luminance
-from shadowcam.outdoor.translation import translate_cubic_Keys1981
+from shadowcam.outdoor.translation import translate
 
 
 class EdgeTracker:
@@ -103,7 +103,7 @@ class EdgeTracker:
         k = self._k
         if k >= self.time_s.size:
             raise ValueError(f"more frames than frame times ({self.time_s.size})")
-        luma = translate_cubic_Keys1981(luminance(frame), self.shift[k]) / np.float32(self.gain_lit[k])
+        luma = translate(luminance(frame), self.shift[k], method="cubic_Keys1981") / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
         band = None

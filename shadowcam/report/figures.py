@@ -2,14 +2,15 @@
 
 Every function takes arrays and returns a :class:`matplotlib.figure.Figure` of a fixed
 pixel size (``size`` inches x :data:`FIGURE_DPI`); :func:`save_png` writes one. Linear
-radiance is shown with a percentile white point and a display gamma; pixels without a
-value (NaN) are drawn in :data:`NAN_GREY`.
+radiance is shown through the tone map of the PNG previews
+(:func:`shadowcam.io.images.tone_map`, white point at :data:`WHITE_PERCENTILE`); pixels
+without a value (NaN) are drawn in :data:`NAN_GREY`.
 
 Offers
 ------
 FIGURE_DPI : dots per inch of every figure (image size = size x FIGURE_DPI pixels).
 NAN_GREY : RGB colour of pixels without a value.
-display_rgb : linear image -> displayable RGB in [0, 1], NaN -> grey.
+WHITE_PERCENTILE : percentile of the brightest channel shown as white.
 primal_figure : the camera (primal) image.
 time_map_figure : a shadow-time map with colour bar.
 dual_view_figure : the dual view, next to the ground-truth reciprocal view if given.
@@ -25,63 +26,21 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
+from shadowcam._shared.validation import check_positive
+from shadowcam.io.images import HOLE_COLOUR, tone_map
+
 FIGURE_DPI = 100
-NAN_GREY = (0.5, 0.5, 0.5)
+NAN_GREY = HOLE_COLOUR
+WHITE_PERCENTILE = 99.5
 
 
 def _new_figure(size):
     width, height = size
     if not (width > 0 and height > 0):
-        raise ValueError(f"size must be two positive numbers (inches), got {size!r}")
+        raise ValueError(f"size must be two positive numbers (inches); got {size!r}")
     figure = Figure(figsize=(width, height), dpi=FIGURE_DPI)
     FigureCanvasAgg(figure)
     return figure
-
-
-def _as_image(image, name):
-    image = np.asarray(image)
-    if image.ndim == 2:
-        image = image[..., np.newaxis]
-    if image.ndim != 3 or image.shape[2] not in (1, 3) or min(image.shape[:2]) < 1:
-        raise ValueError(
-            f"{name} must be a (rows, cols) or (rows, cols, 1|3) array, got shape {image.shape}"
-        )
-    if not np.issubdtype(image.dtype, np.number):
-        raise ValueError(f"{name} must be numeric, got dtype {image.dtype}")
-    if image.shape[2] == 1:
-        image = np.repeat(image, 3, axis=2)
-    return image
-
-
-def display_rgb(image, *, percentile=99.5, gamma=1 / 2.2):
-    """Map a linear image to displayable RGB.
-
-    Parameters
-    ----------
-    image : (rows, cols) or (rows, cols, 1|3) ndarray
-        Linear radiance; NaN where there is no value.
-    percentile : float, optional
-        Percentile of the finite values mapped to white (0 < percentile <= 100).
-    gamma : float, optional
-        Display exponent applied after scaling.
-
-    Returns
-    -------
-    rgb : (rows, cols, 3) float32 ndarray
-        Values in [0, 1]; pixels with a NaN channel are :data:`NAN_GREY`.
-    """
-    image = _as_image(image, "image").astype(np.float32, copy=False)
-    if not 0 < percentile <= 100:
-        raise ValueError(f"percentile must be in (0, 100], got {percentile!r}")
-    if not gamma > 0:
-        raise ValueError(f"gamma must be positive, got {gamma!r}")
-    missing = ~np.all(np.isfinite(image), axis=2)
-    finite = image[~missing]
-    white = np.percentile(finite, percentile) if finite.size else 1.0
-    white = white if white > 0 else 1.0
-    rgb = np.clip(np.nan_to_num(image / np.float32(white)), 0, 1) ** np.float32(gamma)
-    rgb[missing] = NAN_GREY
-    return rgb.astype(np.float32)
 
 
 def _show_image(axes, rgb, title, *, xlabel="col", ylabel="row"):
@@ -106,7 +65,7 @@ def primal_figure(image, *, title="primal (camera) image", size=(5.0, 5.0)):
     -------
     matplotlib.figure.Figure
     """
-    rgb = display_rgb(image)
+    rgb = tone_map(image, percentile=WHITE_PERCENTILE)
     figure = _new_figure(size)
     _show_image(figure.add_subplot(), rgb, title)
     figure.tight_layout()
@@ -136,7 +95,7 @@ def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
     """
     times = np.asarray(times)
     if times.ndim != 2 or min(times.shape) < 1:
-        raise ValueError(f"times must be a (rows, cols) array, got shape {times.shape}")
+        raise ValueError(f"times must be a (rows, cols) array; got shape {times.shape}")
     if not np.issubdtype(times.dtype, np.number):
         raise ValueError(f"times must be numeric, got dtype {times.dtype}")
     colours = colormaps[cmap].with_extremes(bad=NAN_GREY)
@@ -176,9 +135,9 @@ def dual_view_figure(dual_view, *, reciprocal=None, size=None):
     -------
     matplotlib.figure.Figure
     """
-    panels = [("dual view (shadow camera)", display_rgb(dual_view))]
+    panels = [("dual view (shadow camera)", tone_map(dual_view, percentile=WHITE_PERCENTILE))]
     if reciprocal is not None:
-        panels.append(("ground-truth reciprocal view", display_rgb(reciprocal)))
+        panels.append(("ground-truth reciprocal view", tone_map(reciprocal, percentile=WHITE_PERCENTILE)))
     figure = _new_figure(size or (5.0 * len(panels), 5.0))
     for index, (title, rgb) in enumerate(panels, start=1):
         _show_image(figure.add_subplot(1, len(panels), index), rgb, title,
@@ -208,10 +167,9 @@ def error_histogram_figure(errors, *, limit=3.0, bins=60, unit="frame", size=(6.
     """
     if not hasattr(errors, "items") or not errors:
         raise ValueError("errors must be a non-empty mapping of name -> 1-D array")
-    if not limit > 0:
-        raise ValueError(f"limit must be positive, got {limit!r}")
+    check_positive(limit, "limit")
     if int(bins) < 1:
-        raise ValueError(f"bins must be a positive integer, got {bins!r}")
+        raise ValueError(f"bins must be a positive integer; got {bins!r}")
     figure = _new_figure(size)
     axes = figure.add_subplot()
     edges = np.linspace(-limit, limit, int(bins) + 1)

@@ -17,7 +17,9 @@ pushbroom_figure : the ridge pushbroom beside the real view.
 import numpy as np
 from matplotlib import colormaps
 
-from shadowcam.report.figures import NAN_GREY, _new_figure, display_rgb
+from shadowcam._shared.validation import check_array
+from shadowcam.io.images import tone_map
+from shadowcam.report.figures import NAN_GREY, WHITE_PERCENTILE, _new_figure
 
 
 #: images are shown at most this many pixels wide / high (a 24 MP frame is decimated)
@@ -36,7 +38,7 @@ def _extent(shape, step):
 
 def _masked_rgb(image, sky, step=1):
     """Display RGB of `image` (already decimated by `step`), sky grey."""
-    rgb = display_rgb(image)
+    rgb = tone_map(image, percentile=WHITE_PERCENTILE)
     sky = np.asarray(sky, dtype=bool)[::step, ::step]
     rgb[sky[: rgb.shape[0], : rgb.shape[1]]] = NAN_GREY
     return rgb
@@ -143,8 +145,7 @@ def arrival_map_figure(arrival_s, *, sky, size=(6.5, 4.5)):
     matplotlib.figure.Figure
     """
     arrival = np.asarray(arrival_s, dtype=np.float64) / 60.0
-    if arrival.ndim != 2:
-        raise ValueError(f"arrival_s must be (H, W); got {arrival.shape}")
+    check_array(arrival, "arrival_s", ndim=2)
     arrival = np.where(np.asarray(sky, dtype=bool), np.nan, arrival)
     figure = _new_figure(size)
     axes = figure.add_subplot()
@@ -189,7 +190,7 @@ def pushbroom_figure(view, pushbroom, time_s, *, sky, size=(11.0, 4.5)):
     axes.set_xlabel("col")
     axes.set_ylabel("row")
     axes = figure.add_subplot(1, 2, 2)
-    axes.imshow(display_rgb(pushbroom[:, ::step]), interpolation="nearest", origin="lower", aspect="auto",
+    axes.imshow(tone_map(pushbroom[:, ::step], percentile=WHITE_PERCENTILE), interpolation="nearest", origin="lower", aspect="auto",
                 extent=(0, pushbroom.shape[1], times[0] / 60, times[-1] / 60))
     axes.set_title("ridge pushbroom (colour along the edge)")
     axes.set_xlabel("col")

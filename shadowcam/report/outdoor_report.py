@@ -17,7 +17,7 @@ from shadowcam._shared.atomic import atomic_path
 from shadowcam.cameras.pushbroom import resample_uniform_time
 from shadowcam.io.frame_times import median_interval
 from shadowcam.outdoor.arrival import ARRIVAL_REASONS
-from shadowcam.outdoor.registration import apply_shift
+from shadowcam.outdoor.translation import translate
 from shadowcam.report.figures import save_png
 from shadowcam.report.outdoor_figures import (
     arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure, pushbroom_figure,
@@ -100,7 +100,7 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
     for k in picks:  # registered, divided by their lit gain, decimated for display
         frame = frames["image"].isel(time=int(k)).values
         shift = (float(photometry["shift_row"][k]), float(photometry["shift_col"][k]))
-        shown.append(apply_shift(frame, shift)[::step, ::step] / np.float32(photometry["gain"].values[k]))
+        shown.append(translate(frame, shift, method="opencv_cubic")[::step, ::step] / np.float32(photometry["gain"].values[k]))
         del frame
     save_png(keyframes_figure(shown, [edges["edge_row"].values[k] for k in picks], time_s[picks], sky=sky,
                               is_keyframe=edges["is_keyframe"].values[picks], step=step), outdir / "keyframes.png")

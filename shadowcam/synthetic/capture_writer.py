@@ -132,7 +132,7 @@ def write_lab_capture(options, out_dir):
     """Render the lab capture described by `options` into `out_dir` (see :func:`write_capture`)."""
     from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
     from shadowcam.synthetic.lab.scene import make_scene
-    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     started = time.perf_counter()
     scene = make_scene(options["scene"], seed=options["seed"], height=options["height"],
@@ -142,7 +142,7 @@ def write_lab_capture(options, out_dir):
                                calibration=options["calibration"])
     log.info("static rays cast in %.2f s", time.perf_counter() - started)
     sensor = SensorModel(bit_depth=options["bit_depth"])
-    scale = exposure_scale(renderer.reference, sensor=sensor,
+    scale = electrons_per_unit_radiance(renderer.reference, sensor=sensor,
                            target_fraction=options["exposure"])
     write = _frame_writer(options, sensor, scale)
     ext = options["format"]
@@ -224,7 +224,7 @@ def write_outdoor_capture(options, out_dir):
     """
     from shadowcam.synthetic.outdoor.capture import NUISANCES, edge_speed, render_outdoor_capture
     from shadowcam.synthetic.outdoor.render import make_outdoor_scene
-    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     started = time.perf_counter()
     outdoor = outdoor_options(options.get("outdoor"))
@@ -240,7 +240,7 @@ def write_outdoor_capture(options, out_dir):
     gt = capture.ground_truth
     log.info("scene, frames and ground truth rendered in %.2f s", time.perf_counter() - started)
     sensor = SensorModel(bit_depth=options["bit_depth"])
-    scale = exposure_scale(gt["reference_radiance"].values, sensor=sensor,
+    scale = electrons_per_unit_radiance(gt["reference_radiance"].values, sensor=sensor,
                            target_fraction=options["exposure"])
     write = _frame_writer(options, sensor, scale)
     ext = options["format"]

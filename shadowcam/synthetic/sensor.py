@@ -14,7 +14,7 @@ Offers
 ------
 SensorModel : bit depth, black level, gain, read noise (white level derived).
 mosaic_rggb : (rows, cols, 3) RGB -> (rows, cols) RGGB mosaic.
-exposure_scale : electrons per unit radiance placing a percentile of a reference at a target.
+electrons_per_unit_radiance : electrons per unit radiance placing a percentile of a reference at a target.
 simulate_raw : radiance -> integer DN (mosaic or per-channel RGB), noisy or noise-free.
 raw_to_linear : DN -> float32 normalised so that black = 0 and white level = 1.
 """
@@ -22,6 +22,8 @@ raw_to_linear : DN -> float32 normalised so that black = 0 and white level = 1.
 from dataclasses import dataclass
 
 import numpy as np
+
+from shadowcam._shared.validation import check_array, check_in_interval, check_positive
 
 
 @dataclass(frozen=True)
@@ -47,14 +49,13 @@ class SensorModel:
 
     def __post_init__(self):
         if not 8 <= int(self.bit_depth) <= 16:
-            raise ValueError(f"bit_depth: must be in 8..16, got {self.bit_depth}")
+            raise ValueError(f"bit_depth must be in 8..16; got {self.bit_depth}")
         if not 0 <= int(self.black_level) < self.white_level:
             raise ValueError(f"black_level: must be in [0, {self.white_level}), "
                              f"got {self.black_level}")
-        if not self.gain > 0:
-            raise ValueError(f"gain: must be positive, got {self.gain}")
+        check_positive(self.gain, "gain")
         if not self.read_noise >= 0:
-            raise ValueError(f"read_noise: must be >= 0, got {self.read_noise}")
+            raise ValueError(f"read_noise must be >= 0; got {self.read_noise}")
 
     @property
     def white_level(self):
@@ -74,15 +75,14 @@ def mosaic_rggb(image):
     (rows, cols) ndarray, same dtype
     """
     image = np.asarray(image)
-    if image.ndim != 3 or image.shape[2] != 3:
-        raise ValueError(f"image: expected (rows, cols, 3), got {image.shape}")
+    check_array(image, "image", shape=(None, None, 3))
     out = image[:, :, 1].copy()
     out[0::2, 0::2] = image[0::2, 0::2, 0]
     out[1::2, 1::2] = image[1::2, 1::2, 2]
     return out
 
 
-def exposure_scale(reference, *, sensor, target_fraction=0.8, percentile=99.5):
+def electrons_per_unit_radiance(reference, *, sensor, target_fraction=0.8, percentile=99.5):
     """Electrons per unit radiance so that a percentile of `reference` reaches a target.
 
     Parameters
@@ -99,11 +99,9 @@ def exposure_scale(reference, *, sensor, target_fraction=0.8, percentile=99.5):
     -------
     float
     """
-    if not 0 < target_fraction <= 1:
-        raise ValueError(f"target_fraction: must be in (0, 1], got {target_fraction}")
+    check_in_interval(target_fraction, "target_fraction", 0, 1)
     level = float(np.percentile(mosaic_rggb(reference), percentile))
-    if not level > 0:
-        raise ValueError("reference: the percentile is not positive (black render?)")
+    check_positive(level, "reference")
     span = sensor.white_level - sensor.black_level
     return target_fraction * span / sensor.gain / level
 
@@ -117,7 +115,7 @@ def simulate_raw(radiance, *, sensor, scale, seed=None, noise=True, mosaic=True)
         Linear radiance (>= 0).
     sensor : SensorModel
     scale : float
-        Electrons per unit radiance (``exposure_scale``).
+        Electrons per unit radiance (``electrons_per_unit_radiance``).
     seed : int or sequence of int, optional
         Seed of ``numpy.random.default_rng``, e.g. ``[seed, sweep_index, frame]``;
         required when `noise` is True.
@@ -132,10 +130,8 @@ def simulate_raw(radiance, *, sensor, scale, seed=None, noise=True, mosaic=True)
         (rows, cols) or (rows, cols, 3) DN in ``[0, white_level]``.
     """
     radiance = np.asarray(radiance)
-    if radiance.ndim != 3 or radiance.shape[2] != 3:
-        raise ValueError(f"radiance: expected (rows, cols, 3), got {radiance.shape}")
-    if not (np.isfinite(scale) and scale > 0):
-        raise ValueError(f"scale: must be a positive number, got {scale}")
+    check_array(radiance, "radiance", shape=(None, None, 3))
+    check_positive(scale, "scale", finite=True)
     if noise and seed is None:
         raise ValueError("seed: required when noise is True")
     signal = mosaic_rggb(radiance) if mosaic else radiance

@@ -46,3 +46,15 @@ def test_candidates_intervals_and_gaps():
     assert find_gaps(times) == [{"after_frame": 2, "interval_s": 112.0, "missing_frames": 1}]
     with pytest.raises(ValueError, match="increase"):
         median_interval(times[::-1])
+
+
+def test_time_to_frame_is_piecewise_linear_and_clamps_or_gives_nan_outside():
+    from shadowcam.io.frame_times import time_to_frame
+
+    times, frames = [-5.0, 0.0, 15.0, 70.0, 130.0, np.nan, np.inf], [0.0, 10.0, 20.0, 120.0]
+    np.testing.assert_allclose(time_to_frame(times, frames, outside="clamp"),
+                               [0.0, 0.0, 1.5, 2.5, 3.0, np.nan, np.nan])
+    np.testing.assert_allclose(time_to_frame(times, frames, outside="nan"),
+                               [np.nan, 0.0, 1.5, 2.5, np.nan, np.nan, np.nan])
+    with pytest.raises(ValueError, match="outside"):
+        time_to_frame(times, frames, outside="wrap")

@@ -6,7 +6,7 @@ import pytest
 from shadowcam.io.images import (
     HOLE_COLOUR,
     colormap_rgb8,
-    exposure_scale,
+    white_point,
     preview_rgb8,
     read_image,
     srgb_encode,
@@ -36,7 +36,7 @@ def test_preview_exposure_and_holes(tmp_path):
     img = np.full((20, 20, 3), 0.2, np.float32)
     img[0, 0] = 50.0  # one hot pixel (0.25% of the image) must not set the exposure
     img[5, 5] = np.nan
-    assert exposure_scale(img, percentile=99.0) == pytest.approx(0.2)
+    assert white_point(img, percentile=99.0) == pytest.approx(0.2)
     out = preview_rgb8(img)
     assert out.dtype == np.uint8 and out.shape == (20, 20, 3)
     assert (out[1, 1] == 255).all()  # the bulk at the percentile maps to white

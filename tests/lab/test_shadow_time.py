@@ -144,7 +144,7 @@ def test_dataset_has_units_and_flag_meanings(wire_sweep):
     assert ds.attrs["n_frames_u"] == 20
 
 
-def test_stores_of_two_sweeps_give_one_dataset_equal_to_each_sweep_alone():
+def test_stores_of_two_sweeps_give_one_dataset_equal_to_each_sweep_alone(wire_sweep):
     import xarray as xr
 
     from shadowcam.lab.shadow_time import shadow_time_of_stores

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from shadowcam.outdoor.arrival import REASON_CODE, CoverageCrossing, arrival_from_edges, combine_arrivals, time_to_frame
+from shadowcam.outdoor.arrival import REASON_CODE, CoverageCrossing, arrival_from_edges, combine_arrivals
 
 
 def test_edge_crossing_is_exact_for_a_linearly_moving_edge_with_irregular_times():
@@ -42,7 +42,3 @@ def test_combine_prefers_agreeing_edges_and_labels_reasons():
     assert reason[0].tolist() == [REASON_CODE[n] for n in
                                   ("edge_crossing", "coverage_crossing", "coverage_crossing", "edge_crossing", "sky")]
 
-
-def test_time_to_frame_is_piecewise_linear():
-    np.testing.assert_allclose(time_to_frame([0.0, 15.0, 70.0, np.nan], [0.0, 10.0, 20.0, 120.0]),
-                               [0.0, 1.5, 2.5, np.nan])

@@ -24,7 +24,8 @@ from shadowcam.cli import main
 from shadowcam.io.datasets import write_netcdf
 from shadowcam.outdoor.datasets import photometry_part_dataset
 from shadowcam.outdoor.normalise import merge_parts, normalise_frames, normalise_part, part_frames
-from shadowcam.outdoor.registration import (apply_shift, block_all, block_mean, registration_factor,
+from shadowcam.outdoor.translation import translate
+from shadowcam.outdoor.registration import (block_all, block_mean, registration_factor,
                                     shift_lucas_kanade_LucasKanade1981)
 
 NUISANCES = dict(shake=0.5, noise=True, gain_steps=True, jitter=0.2, drop=(7, 15), sun_fade=0.6)
@@ -57,7 +58,7 @@ def test_registration_factor_and_block_means():
 @pytest.mark.parametrize("factor", [2, 4])
 def test_shift_on_reduced_frames_scales_back(shift, factor):
     reference = _texture()
-    frame = apply_shift(reference, (-shift[0], -shift[1]))  # content moved by +shift
+    frame = translate(reference, (-shift[0], -shift[1]), method="opencv_cubic")  # content moved by +shift
     estimate, _ = shift_lucas_kanade_LucasKanade1981(block_mean(frame, factor), block_mean(reference, factor))
     # 128 x 160 working image at factor 4: ~0.03 reduced pixels of precision
     np.testing.assert_allclose(estimate * factor, shift, atol=0.15)  # pixels
@@ -116,7 +117,7 @@ def test_large_shake_on_reduced_frames_is_recovered_coarse_to_fine():
     reference[400:] *= 0.1  # a static shadow below row 400: the rest is lit
     rgb = np.stack([reference, 0.9 * reference, 0.7 * reference], axis=-1)
     shake = np.array([[0.0, 0.0], [8.4, -11.3], [-3.1, 2.7], [6.5, 9.2]])  # rows, cols; 14-18 px jumps
-    frames = [apply_shift(rgb, -s) for s in shake]  # content moves by +shake
+    frames = [translate(rgb, -s, method="opencv_cubic") for s in shake]  # content moves by +shake
     options = dict(sky=np.zeros(reference.shape, bool), registration_size=320)  # factor 2
     result = normalise_frames(iter(frames), registration_levels=2, **options)
     # pixels of the full frames; ~0.03 reduced px on this texture (block means alias its finest scale)

@@ -5,7 +5,8 @@ import cv2
 import numpy as np
 import pytest
 
-from shadowcam.outdoor.registration import (apply_shift, bandpass_log, pyramid_levels, shift_coarse_to_fine,
+from shadowcam.outdoor.translation import translate
+from shadowcam.outdoor.registration import (bandpass_log, pyramid_levels, shift_coarse_to_fine,
                                     shift_lucas_kanade_LucasKanade1981, static_weight)
 
 
@@ -18,7 +19,7 @@ def _texture(seed=0, shape=(64, 80)):
 @pytest.mark.parametrize("shift", [(0.3, -0.45), (-0.8, 0.6), (0.05, 0.0)])
 def test_recovers_known_subpixel_shift(shift):
     ref = _texture()
-    frame = apply_shift(ref, (-shift[0], -shift[1]))  # content moves by +shift
+    frame = translate(ref, (-shift[0], -shift[1]), method="opencv_cubic")  # content moves by +shift
     estimate, residual = shift_lucas_kanade_LucasKanade1981(frame, ref)
     np.testing.assert_allclose(estimate, shift, atol=0.02)
     assert residual < 0.05
@@ -26,10 +27,10 @@ def test_recovers_known_subpixel_shift(shift):
 
 def test_apply_shift_keeps_dtype_and_zero_shift_is_identity():
     ref = _texture()
-    assert apply_shift(ref, (0.3, 0.2)).dtype == np.float32
-    np.testing.assert_array_equal(apply_shift(ref, (0, 0)), ref)
+    assert translate(ref, (0.3, 0.2), method="opencv_cubic").dtype == np.float32
+    np.testing.assert_array_equal(translate(ref, (0, 0), method="opencv_cubic"), ref)
     with pytest.raises(ValueError, match="image"):
-        apply_shift(np.ones(5), (0, 0))
+        translate(np.ones(5), (0, 0), method="opencv_cubic")
 
 
 def test_moving_shadow_is_masked_and_does_not_bias_the_shift():
@@ -40,7 +41,7 @@ def test_moving_shadow_is_masked_and_does_not_bias_the_shift():
     frame = ref.copy()
     frame[25:] *= 0.1  # the shadow climbed 15 rows
     true = (0.4, -0.3)
-    frame = apply_shift(frame * 1.3, (-true[0], -true[1]))
+    frame = translate(frame * 1.3, (-true[0], -true[1]), method="opencv_cubic")
     lit_ref = np.zeros_like(lit)
     lit_ref[:40] = True
     weight = static_weight(frame, ref_lit, lit_reference=lit_ref, gain=1.3)
@@ -69,7 +70,7 @@ def _multiscale_texture(shape=(256, 320), seed=3):
 @pytest.mark.parametrize("shift", [(9.3, -11.6), (-7.25, 6.8)])
 def test_coarse_to_fine_recovers_a_shift_beyond_one_level(shift):
     ref = _multiscale_texture()
-    frame = apply_shift(ref, (-shift[0], -shift[1]))  # content moves by +shift
+    frame = translate(ref, (-shift[0], -shift[1]), method="opencv_cubic")  # content moves by +shift
     single, single_residual = shift_lucas_kanade_LucasKanade1981(frame, ref)
     assert not np.isfinite(single_residual) or np.abs(single - shift).max() > 1  # one level: out of range
     estimate, residual = shift_coarse_to_fine(frame, ref, levels=2)
@@ -80,7 +81,7 @@ def test_coarse_to_fine_recovers_a_shift_beyond_one_level(shift):
 def test_coarse_to_fine_keeps_the_single_level_solution_for_small_shifts():
     ref = _multiscale_texture(seed=4)
     shift = (0.4, -0.7)
-    frame = apply_shift(ref, (-shift[0], -shift[1]))
+    frame = translate(ref, (-shift[0], -shift[1]), method="opencv_cubic")
     weight = np.zeros(ref.shape, np.float32)
     weight[8:-8, 8:-8] = 1
     single = shift_lucas_kanade_LucasKanade1981(frame, ref, weight=weight)

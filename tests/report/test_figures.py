@@ -50,15 +50,17 @@ def test_time_map_draws_nan_grey_and_values_in_colour(time_map):
     assert len(figure.axes) == 2  # image + colour bar
 
 
-def test_display_rgb_white_point_gamma_and_nan():
+def test_figures_use_the_preview_tone_map():
+    from shadowcam.io.images import srgb_encode, tone_map
+
     image = np.zeros((4, 4, 3), np.float32)
     image[0, 0] = 2.0  # the brightest value maps to white
     image[1, 1] = 0.5
     image[2, 2, 1] = np.nan
-    rgb = figures.display_rgb(image, percentile=100, gamma=0.5)
-    assert rgb.dtype == np.float32 and rgb.shape == (4, 4, 3)
+    rgb = tone_map(image, percentile=100)
+    assert rgb.shape == (4, 4, 3)
     np.testing.assert_allclose(rgb[0, 0], 1.0)
-    np.testing.assert_allclose(rgb[1, 1], np.sqrt(0.25), rtol=1e-6)
+    np.testing.assert_allclose(rgb[1, 1], srgb_encode(0.25), rtol=1e-6)
     np.testing.assert_allclose(rgb[2, 2], figures.NAN_GREY)
     np.testing.assert_allclose(rgb[3, 3], 0.0)
 
@@ -104,8 +106,7 @@ def test_error_histogram_counts_every_finite_value():
     "call, name",
     [
         (lambda: figures.time_map_figure(np.zeros((2, 2, 2))), "times"),
-        (lambda: figures.display_rgb(np.zeros((2, 2, 2))), "image"),
-        (lambda: figures.display_rgb(np.zeros((2, 2)), percentile=0), "percentile"),
+        (lambda: figures.primal_figure(np.zeros((2, 2, 2))), "image"),
         (lambda: figures.error_histogram_figure({}), "errors"),
         (lambda: figures.primal_figure(np.zeros((2, 2)), size=(0, 1)), "size"),
     ],

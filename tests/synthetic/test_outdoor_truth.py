@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from shadowcam.synthetic.outdoor.truth import (classify, fractional_frame, pushbroom_bins,
+from shadowcam.io.frame_times import time_to_frame
+from shadowcam.synthetic.outdoor.truth import (classify, pushbroom_bins,
                                      pushbroom_edge, sample_rows)
 
 
@@ -34,7 +35,7 @@ def test_classes_bins_and_fractional_frames():
     np.testing.assert_array_equal(c["shadow_class"], [3, 3, 0])
     np.testing.assert_array_equal(c["relit_after_arrival"], [True, False, True])
     t = np.array([0.0, 10.0, 30.0])
-    np.testing.assert_allclose(fractional_frame([5.0, 20.0, 30.0], t), [0.5, 1.5, 2.0])
+    np.testing.assert_allclose(time_to_frame([5.0, 20.0, 30.0], t, outside="nan"), [0.5, 1.5, 2.0])
     T = np.array([[5.0, 25.0], [np.inf, 30.0]])
     cls = np.array([[3, 3], [1, 3]])
     ref = np.ones((2, 2, 3))

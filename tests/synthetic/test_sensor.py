@@ -5,7 +5,7 @@ import pytest
 
 from shadowcam.synthetic.sensor import (
     SensorModel,
-    exposure_scale,
+    electrons_per_unit_radiance,
     mosaic_rggb,
     raw_to_linear,
     simulate_raw,
@@ -67,6 +67,6 @@ def test_levels_clip_and_normalise():
 def test_exposure_scale_places_percentile_at_target():
     sensor = SensorModel(bit_depth=12, black_level=256)
     ref = np.random.default_rng(1).uniform(0, 0.01, (64, 64, 3))
-    scale = exposure_scale(ref, sensor=sensor, target_fraction=0.5, percentile=99.5)
+    scale = electrons_per_unit_radiance(ref, sensor=sensor, target_fraction=0.5, percentile=99.5)
     level = np.percentile(mosaic_rggb(ref), 99.5)
     assert scale * level == pytest.approx(0.5 * (4095 - 256))

@@ -5,6 +5,7 @@ All functions are pure and work on batches of rays: ``origins``, ``directions`` 
 
 Offers
 ------
+as_rays : ray origins and directions as checked float64 (N, 3) arrays.
 RayHits : result of ``intersect_scene`` (distance, point, normal, object_id, albedo).
 intersect_sphere, intersect_box, intersect_ground, intersect_back_plane :
     nearest hit distance (and normal, for boxes) with one object.
@@ -17,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_same_shape
 from shadowcam.synthetic.lab.scene import BackPlane, Box, GroundPlane, Sphere, texture_albedo
 
 #: default minimum hit distance (scene units) to avoid self-intersection
@@ -25,13 +27,11 @@ T_MIN = 1e-9
 SURFACE_OFFSET = 1e-7
 
 
-def _check_rays(origins, directions):
-    origins = np.asarray(origins, dtype=np.float64)
+def as_rays(origins, directions):
+    """Return `origins` and `directions` as float64 ``(N, 3)`` arrays of one shape (checked)."""
+    origins = check_array(np.asarray(origins, dtype=np.float64), "origins", shape=(None, 3))
     directions = np.asarray(directions, dtype=np.float64)
-    if origins.ndim != 2 or origins.shape[1] != 3:
-        raise ValueError(f"origins: expected (N, 3), got {origins.shape}")
-    if directions.shape != origins.shape:
-        raise ValueError(f"directions: expected {origins.shape}, got {directions.shape}")
+    check_same_shape({"origins": origins, "directions": directions})
     return origins, directions
 
 
@@ -51,7 +51,7 @@ def intersect_sphere(origins, directions, center, radius, *, t_min=T_MIN):
     (N,) ndarray
         Distance along the (unit) direction; ``inf`` where missed.
     """
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     oc = origins - center
     b = np.einsum("ij,ij->i", oc, directions)
     c = np.einsum("ij,ij->i", oc, oc) - radius * radius
@@ -79,7 +79,7 @@ def intersect_box(origins, directions, center, half_extents, rotation, *, t_min=
     normal : (N, 3) ndarray
         Outward world normal of the face hit (undefined where missed).
     """
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     o = (origins - center) @ rotation  # rotation^T (origins - center), row-wise
     d = directions @ rotation
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -104,7 +104,7 @@ def intersect_box(origins, directions, center, half_extents, rotation, *, t_min=
 
 def intersect_ground(origins, directions, height, *, t_min=T_MIN):
     """Distance to the infinite plane ``y = height`` (``inf`` where missed)."""
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (height - origins[:, 1]) / directions[:, 1]
     return np.where(np.isfinite(t) & (t > t_min), t, np.inf)
@@ -112,7 +112,7 @@ def intersect_ground(origins, directions, height, *, t_min=T_MIN):
 
 def intersect_back_plane(origins, directions, plane, *, t_min=T_MIN):
     """Distance to a finite BackPlane rectangle (``inf`` where missed)."""
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     n = plane.normal
     with np.errstate(divide="ignore", invalid="ignore"):
         t = ((plane.center - origins) @ n) / (directions @ n)
@@ -200,7 +200,7 @@ def intersect_scene(objects, origins, directions, *, t_min=T_MIN):
     -------
     RayHits
     """
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     n = len(origins)
     best = np.full(n, np.inf)
     ids = np.full(n, -1, dtype=np.int64)
@@ -247,7 +247,7 @@ def occluded(objects, origins, directions, max_distance):
     -------
     (N,) bool ndarray
     """
-    origins, directions = _check_rays(origins, directions)
+    origins, directions = as_rays(origins, directions)
     max_distance = np.broadcast_to(np.asarray(max_distance, dtype=np.float64), (len(origins),))
     blocked = np.zeros(len(origins), dtype=bool)
     for obj in objects:
@@ -290,8 +290,7 @@ def wire_occlusion_interval(points, light_points, sweep, mask, *, distant=False)
     """
     points = np.asarray(points, dtype=np.float64)
     light_points = np.asarray(light_points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    check_array(points, "points", shape=(None, 3))
     if light_points.shape != points.shape:
         raise ValueError(f"light_points: expected {points.shape}, got {light_points.shape}")
     seg = light_points if distant else light_points - points

@@ -160,7 +160,7 @@ def trace_light_paths(objects, camera, light, *, supersample=4):
     """
     supersample = int(supersample)
     if supersample < 1:
-        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+        raise ValueError(f"supersample must be >= 1; got {supersample}")
     rows, cols = camera.height, camera.width
     x, y = _subpixel_grid(rows, cols, supersample)
     per_pixel = supersample * supersample

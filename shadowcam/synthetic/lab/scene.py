@@ -26,6 +26,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_in, check_in_interval, check_positive
+
 UP = (0.0, 1.0, 0.0)
 
 
@@ -42,12 +44,6 @@ def _unit(value, name):
     if norm == 0:
         raise ValueError(f"{name}: must not be the zero vector")
     return arr / norm
-
-
-def _positive(value, name):
-    if not (np.isfinite(value) and value > 0):
-        raise ValueError(f"{name}: must be a positive number, got {value!r}")
-    return float(value)
 
 
 def _set(obj, **values):
@@ -89,12 +85,11 @@ class Texture:
     seed: int = 0
 
     def __post_init__(self):
-        if self.kind not in TEXTURE_KINDS:
-            raise ValueError(f"kind: must be one of {TEXTURE_KINDS}, got {self.kind!r}")
+        check_in(self.kind, "kind", TEXTURE_KINDS)
         colors = np.asarray(self.colors, dtype=np.float64)
         if colors.ndim != 2 or colors.shape[1] != 3 or colors.shape[0] < 2:
-            raise ValueError(f"colors: expected (K>=2, 3) albedos, got shape {colors.shape}")
-        _set(self, colors=colors, scale=_positive(self.scale, "scale"))
+            raise ValueError(f"colors must be (K>=2, 3) albedos; got shape {colors.shape}")
+        _set(self, colors=colors, scale=float(check_positive(self.scale, "scale", finite=True)))
 
 
 def texture_albedo(texture, coords):
@@ -112,8 +107,7 @@ def texture_albedo(texture, coords):
         Linear albedo.
     """
     coords = np.asarray(coords, dtype=np.float64)
-    if coords.ndim != 2 or coords.shape[1] != 2:
-        raise ValueError(f"coords: expected (N, 2), got {coords.shape}")
+    check_array(coords, "coords", shape=(None, 2))
     colors = texture.colors
     s = coords / texture.scale
     if texture.kind == "checker":
@@ -173,8 +167,8 @@ class Material:
         if np.any(albedo < 0) or np.any(albedo > 1):
             raise ValueError(f"albedo: must lie in [0, 1], got {albedo}")
         if not 0 <= self.specular < 1:
-            raise ValueError(f"specular: must be in [0, 1), got {self.specular}")
-        _set(self, albedo=albedo, shininess=_positive(self.shininess, "shininess"))
+            raise ValueError(f"specular must be in [0, 1); got {self.specular}")
+        _set(self, albedo=albedo, shininess=float(check_positive(self.shininess, "shininess", finite=True)))
 
 
 # --------------------------------------------------------------------------- objects
@@ -189,7 +183,7 @@ class Sphere:
     material: Material = field(default_factory=Material)
 
     def __post_init__(self):
-        _set(self, center=_vec(self.center, "center"), radius=_positive(self.radius, "radius"))
+        _set(self, center=_vec(self.center, "center"), radius=float(check_positive(self.radius, "radius", finite=True)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -207,7 +201,7 @@ class Box:
     def __post_init__(self):
         half = _vec(self.half_extents, "half_extents")
         if np.any(half <= 0):
-            raise ValueError(f"half_extents: must be positive, got {half}")
+            raise ValueError(f"half_extents must be positive; got {half}")
         _set(self, center=_vec(self.center, "center"), half_extents=half,
              yaw_deg=float(self.yaw_deg))
 
@@ -226,7 +220,7 @@ class GroundPlane:
 
     def __post_init__(self):
         if not np.isfinite(self.height):
-            raise ValueError(f"height: must be finite, got {self.height}")
+            raise ValueError(f"height must be finite; got {self.height}")
         _set(self, height=float(self.height))
 
 
@@ -245,8 +239,8 @@ class BackPlane:
     material: Material = field(default_factory=Material)
 
     def __post_init__(self):
-        _set(self, center=_vec(self.center, "center"), width=_positive(self.width, "width"),
-             height=_positive(self.height, "height"), yaw_deg=float(self.yaw_deg))
+        _set(self, center=_vec(self.center, "center"), width=float(check_positive(self.width, "width", finite=True)),
+             height=float(check_positive(self.height, "height", finite=True)), yaw_deg=float(self.yaw_deg))
 
     @property
     def axis_x(self):
@@ -314,12 +308,11 @@ class AreaLight:
     samples_per_side: int = 4
 
     def __post_init__(self):
-        if self.shape not in ("disc", "square"):
-            raise ValueError(f"shape: must be 'disc' or 'square', got {self.shape!r}")
+        check_in(self.shape, "shape", ("disc", "square"))
         if int(self.samples_per_side) < 1:
-            raise ValueError(f"samples_per_side: must be >= 1, got {self.samples_per_side}")
+            raise ValueError(f"samples_per_side must be >= 1; got {self.samples_per_side}")
         _set(self, position=_vec(self.position, "position"),
-             normal=_unit(self.normal, "normal"), size=_positive(self.size, "size"),
+             normal=_unit(self.normal, "normal"), size=float(check_positive(self.size, "size", finite=True)),
              intensity=_vec(self.intensity, "intensity"),
              samples_per_side=int(self.samples_per_side))
 
@@ -417,7 +410,7 @@ class OrthographicCamera:
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-9):
             raise ValueError("R: must be a (3, 3) rotation matrix")
         _set(self, R=R, center=_vec(self.center, "center"),
-             pixel_size=_positive(self.pixel_size, "pixel_size"),
+             pixel_size=float(check_positive(self.pixel_size, "pixel_size", finite=True)),
              width=int(self.width), height=int(self.height))
 
 
@@ -430,8 +423,7 @@ def look_at_camera(center, target, *, fov_x_deg, width, height, up=UP):
         raise ValueError("up: must not be parallel to the viewing direction")
     right /= np.linalg.norm(right)
     down = np.cross(forward, right)
-    if not 0 < fov_x_deg < 180:
-        raise ValueError(f"fov_x_deg: must be in (0, 180), got {fov_x_deg}")
+    check_in_interval(fov_x_deg, "fov_x_deg", 0, 180, closed="neither")
     focal = width / 2.0 / math.tan(math.radians(fov_x_deg) / 2.0)
     K = np.array([[focal, 0.0, width / 2.0], [0.0, focal, height / 2.0], [0.0, 0.0, 1.0]])
     return PinholeCamera(K=K, R=np.stack([right, down, forward]), center=center,
@@ -550,20 +542,19 @@ def make_mask_plane(light, *, target, frames, f=0.045, fov_deg=44.0, extent=None
     """
     frames = int(frames)
     if frames < 2:
-        raise ValueError(f"frames: must be >= 2, got {frames}")
-    f = _positive(f, "f")
+        raise ValueError(f"frames must be >= 2; got {frames}")
+    f = float(check_positive(f, "f", finite=True))
     target = _vec(target, "target")
     if isinstance(light, DistantLight):
         if extent is None:
             raise ValueError("extent: required for a distant light")
         n = -light.direction
-        delta = _positive(extent, "extent") / frames
+        delta = float(check_positive(extent, "extent", finite=True)) / frames
         origin = target - f * n
         focal = None
     else:
         n = _unit(target - light.center, "target - light position")
-        if not 0 < fov_deg < 180:
-            raise ValueError(f"fov_deg: must be in (0, 180), got {fov_deg}")
+        check_in_interval(fov_deg, "fov_deg", 0, 180, closed="neither")
         delta = 2 * f * math.tan(math.radians(fov_deg) / 2) / frames
         origin = light.center + f * n
         focal = f
@@ -591,10 +582,10 @@ def make_wire_sweeps(mask, *, radius=None, length=None):
     dict of str to WireSweep
         Keys ``"u"`` and ``"v"``.
     """
-    radius = mask.delta if radius is None else _positive(radius, "radius")
+    radius = mask.delta if radius is None else float(check_positive(radius, "radius", finite=True))
     if length is None:
         length = 1.5 * math.hypot(mask.n_u, mask.n_v) * mask.delta
-    length = _positive(length, "length")
+    length = float(check_positive(length, "length", finite=True))
     sweeps = {}
     for axis, e_move, e_wire, n in (("u", mask.e_u, mask.e_v, mask.n_u),
                                     ("v", mask.e_v, mask.e_u, mask.n_v)):
@@ -713,7 +704,7 @@ def _tabletop(*, seed, height, width, frames, light_kind):
     elif light_kind == "distant":
         light = DistantLight(light_pos - aim, (2.0, 2.0, 2.0))
     else:
-        raise ValueError(f"light_kind: must be 'point', 'area' or 'distant', got {light_kind!r}")
+        raise ValueError(f"light_kind must be 'point', 'area' or 'distant'; got {light_kind!r}")
     if light_kind == "distant":  # plane between the scene and the light, clear of objects
         mask = make_mask_plane(light, target=aim, frames=frames, f=0.2, extent=0.26)
     else:
@@ -745,8 +736,7 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     -------
     Scene
     """
-    if name not in SCENES:
-        raise ValueError(f"name: unknown scene {name!r}; choose one of {sorted(SCENES)}")
+    check_in(name, "name", SCENES)
     for key, value in (("height", height), ("width", width)):
         if int(value) < 2 or int(value) % 2:
             raise ValueError(f"{key}: must be an even number >= 2, got {value}")

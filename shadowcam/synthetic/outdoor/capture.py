@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadowcam.io.frame_times import time_to_frame
 from shadowcam.synthetic.outdoor import nuisance as nz
 from shadowcam.synthetic.outdoor import truth as gt
 from shadowcam.synthetic.outdoor.render import frame_radiance, sample_grid, sky_colour, trace_samples
@@ -100,7 +101,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         raise ValueError(f"nuisances: unknown switch(es) {sorted(unknown)}; known: {sorted(NUISANCES)}")
     opts = dict(NUISANCES, **nuisances)
     if int(supersample) < 1:
-        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+        raise ValueError(f"supersample must be >= 1; got {supersample}")
     rows, cols = scene.camera.height, scene.camera.width
     s = int(supersample)
     s2 = s * s
@@ -193,13 +194,13 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         "relit_after_arrival": var(rc, classes["relit_after_arrival"].reshape(img), "1", "lit again after the first shadowed frame"),
         "cause": var(rc, cause.reshape(img), "1", "class 3: 1 cast shadow, 2 attached shadow"),
         "arrival_time_s": var(rc, arrival.reshape(img), "s", "time the sun is first blocked at the pixel centre"),
-        "arrival_frame": var(rc, gt.fractional_frame(arrival, times).reshape(img), "frame", "arrival time as a fractional frame index"),
+        "arrival_frame": var(rc, time_to_frame(arrival, times, outside="nan").reshape(img), "frame", "arrival time as a fractional frame index"),
         "first_shadowed_frame": var(rc, first.reshape(img).astype(np.int32), "frame", "first frame with the pixel centre unlit (-1 never)"),
         "lit_center": var(trc, lit_centre.reshape(len(times), rows, cols), "1", "pixel-centre point lit by the sun at frame k"),
         "subpixel_arrival_time_s": var(("row", "col", "subpixel"), sub_img, "s", "arrival time of the render samples (+inf never, -inf at start, NaN sky)"),
         "subpixel_offsets": var(("subpixel", "xy"), offsets.astype(np.float32), "pixel", "sample offsets (x, y) from the pixel corner"),
         "arrival_time_half_coverage_s": var(rc, half, "s", "median of the sub-pixel arrival times"),
-        "arrival_frame_half_coverage": var(rc, gt.fractional_frame(half, times), "frame", "half-coverage arrival as a fractional frame index"),
+        "arrival_frame_half_coverage": var(rc, time_to_frame(half, times, outside="nan"), "frame", "half-coverage arrival as a fractional frame index"),
         "subpixel_sky_fraction": var(rc, sub_sky.mean(axis=2).astype(np.float32), "1", "fraction of the sub-pixel samples that are sky"),
         "sky_fraction": var(rc, sub_sky.mean(axis=2).astype(np.float32), "1", "fraction of the rendered pixel footprint that is sky"),
         "position_world": var(rcc, position, "m", "terrain point at the pixel centre (x east, y north, z up)"),

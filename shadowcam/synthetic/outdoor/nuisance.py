@@ -7,11 +7,14 @@ auto_exposure : auto-exposure gain per frame: 1/3-EV steps from centre-weighted 
     plus shutter flicker.
 metered_level : the centre-weighted mean that auto-exposure meters.
 shake_offsets : per-frame camera shake (dx, dy) in pixels, AR(1) jitter plus gust jolts.
-apply_shake : shift an image by a sub-pixel offset (cubic spline, edges replicated).
+apply_shake : move an image's content by a sub-pixel offset (cubic spline, edges replicated).
 cloud_transmittance : sun-term transmittance of a soft cloud shadow drifting over the ground.
 """
 
 import numpy as np
+
+from shadowcam._shared.validation import check_positive
+from shadowcam.outdoor.translation import translate
 
 
 def capture_times(duration_s, frames, *, seed, irregular=True, dropped=0):
@@ -43,8 +46,7 @@ def capture_times(duration_s, frames, *, seed, irregular=True, dropped=0):
         raise ValueError(f"frames: need at least 2, got {frames}")
     if not 0 <= dropped <= max(0, (frames - 2) // 4):
         raise ValueError(f"dropped: must be in [0, {(frames - 2) // 4}], got {dropped}")
-    if not duration_s > 0:
-        raise ValueError(f"duration_s: must be positive, got {duration_s}")
+    check_positive(duration_s, "duration_s")
     rng = np.random.default_rng([int(seed), 41])
     slots = frames + dropped
     intervals = np.ones(slots - 1)
@@ -122,7 +124,7 @@ def shake_offsets(frames, *, seed, max_px=1.0):
     dx, dy : (frames,) ndarray
     """
     if not max_px >= 0:
-        raise ValueError(f"max_px: must be >= 0, got {max_px}")
+        raise ValueError(f"max_px must be >= 0; got {max_px}")
     if max_px == 0:
         return np.zeros(frames), np.zeros(frames)
     rng = np.random.default_rng([int(seed), 47])
@@ -143,13 +145,9 @@ def shake_offsets(frames, *, seed, max_px=1.0):
 def apply_shake(image, dx, dy):
     """``out(u, v) = image(u - dx, v - dy)`` for a (rows, cols, C) image: cubic spline,
     edges replicated, clipped at 0 (radiance stays non-negative)."""
-    from scipy.ndimage import shift
-
     if dx == 0 and dy == 0:
         return image
-    out = np.empty_like(image)
-    for c in range(image.shape[2]):
-        shift(image[:, :, c], (dy, dx), output=out[:, :, c], order=3, mode="nearest")
+    out = translate(image, (-dy, -dx), method="spline")
     return np.clip(out, 0, None, out=out)
 
 
@@ -172,7 +170,7 @@ def cloud_transmittance(points_xy, t_s, *, start_xy, velocity_xy, sigma_m=250.0,
     (N,) ndarray in [1 - depth, 1]
     """
     if not 0 <= depth < 1:
-        raise ValueError(f"depth: must be in [0, 1), got {depth}")
+        raise ValueError(f"depth must be in [0, 1); got {depth}")
     centre = np.asarray(start_xy, dtype=np.float64) + np.asarray(velocity_xy) * float(t_s)
     r2 = ((np.asarray(points_xy) - centre) ** 2).sum(axis=1)
     return 1.0 - depth * np.exp(-0.5 * r2 / sigma_m**2)

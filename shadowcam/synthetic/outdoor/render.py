@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from shadowcam._shared.validation import check_in
 from shadowcam.synthetic.lab.scene import camera_rays, look_at_camera
 from shadowcam.synthetic.outdoor.sun import SunPath, sun_colour
 from shadowcam.synthetic.outdoor.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
@@ -99,8 +100,7 @@ def make_outdoor_scene(name="ridge", *, seed=0, height=128, width=192, latitude_
     -------
     OutdoorScene
     """
-    if name not in OUTDOOR_SCENES:
-        raise ValueError(f"name: unknown outdoor scene {name!r}; known: {sorted(OUTDOOR_SCENES)}")
+    check_in(name, "name", OUTDOOR_SCENES)
     if int(height) < 8 or int(width) < 8:
         raise ValueError(f"height, width: need at least 8 pixels, got {height}x{width}")
     if not 0.5 <= end_elevation_deg < start_elevation_deg <= 40.0:
@@ -141,7 +141,7 @@ def sample_grid(rows, cols, supersample=None):
     """
     s = 1 if supersample is None else int(supersample)
     if s < 1:
-        raise ValueError(f"supersample: must be >= 1, got {supersample}")
+        raise ValueError(f"supersample must be >= 1; got {supersample}")
     offsets = (np.arange(s) + 0.5) / s
     r, c, oy, ox = np.meshgrid(np.arange(rows), np.arange(cols), offsets, offsets,
                                indexing="ij")
@@ -223,7 +223,7 @@ def trace_samples(scene, x, y, *, node_deg=HORIZON_NODE_DEG, fine_deg=HORIZON_FI
     SampleGeometry
     """
     if not 0 < fine_deg <= node_deg:
-        raise ValueError(f"fine_deg: must be in (0, node_deg], got {fine_deg}")
+        raise ValueError(f"fine_deg must be in (0, node_deg]; got {fine_deg}")
     origins, dirs = camera_rays(scene.camera, x, y)
     dist = intersect_heightfield(scene.terrain, origins, dirs)
     sky = np.isnan(dist)

@@ -34,8 +34,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from shadowcam._shared.validation import check_array
 from shadowcam.synthetic.outdoor.nuisance import apply_shake, shake_offsets
-from shadowcam.outdoor.registration import apply_shift
+from shadowcam.outdoor.translation import translate
 from shadowcam.synthetic.sensor import simulate_raw
 
 log = logging.getLogger(__name__)
@@ -72,8 +73,7 @@ def steady_frame(image, *, dx, dy):
         made with (:func:`shadowcam.synthetic.outdoor.nuisance.apply_shake`), edges replicated.
     """
     image = np.asarray(image, dtype=np.float32)
-    if image.ndim != 3:
-        raise ValueError(f"image must be (H, W, C); got shape {image.shape}")
+    check_array(image, "image", ndim=3)
     return apply_shake(image, -float(dx), -float(dy))
 
 
@@ -117,8 +117,7 @@ def upsample_frame(image, *, rows, cols):
         Pixel centres map to pixel centres (OpenCV ``INTER_LINEAR``).
     """
     image = np.asarray(image, dtype=np.float32)
-    if image.ndim != 3:
-        raise ValueError(f"image must be (H, W, C); got shape {image.shape}")
+    check_array(image, "image", ndim=3)
     if rows < 1 or cols < 1:
         raise ValueError(f"rows and cols must be positive; got {rows}, {cols}")
     return cv2.resize(image, (int(cols), int(rows)), interpolation=cv2.INTER_LINEAR).reshape(rows, cols, -1)
@@ -136,7 +135,7 @@ def sample_mosaic(image, *, rows, cols, sensor, scale, seed, shake=(0.0, 0.0)):
     sensor : shadowcam.synthetic.sensor.SensorModel
         Bit depth, black level, gain, read noise.
     scale : float
-        Electrons per unit of `image` (:func:`shadowcam.synthetic.sensor.exposure_scale`); the same
+        Electrons per unit of `image` (:func:`shadowcam.synthetic.sensor.electrons_per_unit_radiance`); the same
         for every frame, so that the capture's own exposure changes are kept.
     seed : int or sequence of int
         Noise seed (``numpy.random.default_rng``).
@@ -156,7 +155,7 @@ def sample_mosaic(image, *, rows, cols, sensor, scale, seed, shake=(0.0, 0.0)):
         raise ValueError(f"image must have 3 channels (RGB); got {big.shape[2]}")
     dx, dy = (float(v) for v in shake)
     if dx or dy:
-        big = np.maximum(apply_shift(big, (-dy, -dx)), np.float32(0))
+        big = np.maximum(translate(big, (-dy, -dx), method="opencv_cubic"), np.float32(0))
     return simulate_raw(big, sensor=sensor, scale=scale, seed=seed, noise=True, mosaic=True)
 
 
@@ -219,7 +218,7 @@ def write_sample(source, outdir, manifest_out, *, name, size="6000x4000", frames
     from shadowcam.io.decode import read_frame
     from shadowcam.io.manifest import checksums_for
     from shadowcam.io.raw_writer import write_dng
-    from shadowcam.synthetic.sensor import SensorModel, exposure_scale
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     rows, cols = parse_size(size)
     if source.get("kind") != "outdoor" or len(source["sweeps"]) != 1:
@@ -238,7 +237,7 @@ def write_sample(source, outdir, manifest_out, *, name, size="6000x4000", frames
     def steady(k):
         return steady_frame(read_frame(sweep["paths"][first + k]), dx=source_dx[k], dy=source_dy[k])
 
-    scale = exposure_scale(upsample_frame(steady(0), rows=rows, cols=cols), sensor=sensor, target_fraction=0.7)
+    scale = electrons_per_unit_radiance(upsample_frame(steady(0), rows=rows, cols=cols), sensor=sensor, target_fraction=0.7)
     outdir = Path(outdir)
     (outdir / "frames").mkdir(parents=True, exist_ok=True)
     start_time = datetime.datetime(2026, 1, 15, 16, 0, 0)

@@ -45,9 +45,9 @@ def solar_direction(hour_angle_deg, *, latitude_deg, declination_deg):
         (east, north, up) components.
     """
     if not -90.0 <= latitude_deg <= 90.0:
-        raise ValueError(f"latitude_deg: must be in [-90, 90], got {latitude_deg}")
+        raise ValueError(f"latitude_deg must be in [-90, 90]; got {latitude_deg}")
     if not -23.5 <= declination_deg <= 23.5:
-        raise ValueError(f"declination_deg: must be in [-23.5, 23.5], got {declination_deg}")
+        raise ValueError(f"declination_deg must be in [-23.5, 23.5]; got {declination_deg}")
     h = np.radians(np.asarray(hour_angle_deg, dtype=np.float64))
     phi, delta = np.radians(latitude_deg), np.radians(declination_deg)
     east = -np.cos(delta) * np.sin(h)
@@ -74,7 +74,7 @@ def elevation_azimuth(directions):
     """Elevation and compass azimuth (degrees) of (..., 3) unit vectors (east, north, up)."""
     d = np.asarray(directions, dtype=np.float64)
     if d.shape[-1] != 3:
-        raise ValueError(f"directions: expected (..., 3), got {d.shape}")
+        raise ValueError(f"directions must be (..., 3); got {d.shape}")
     elevation = np.degrees(np.arcsin(np.clip(d[..., 2], -1.0, 1.0)))
     azimuth = np.degrees(np.arctan2(d[..., 0], d[..., 1])) % 360.0
     return elevation, azimuth

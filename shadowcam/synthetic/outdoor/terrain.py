@@ -31,6 +31,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from shadowcam._shared.validation import check_array, check_positive
+from shadowcam.synthetic.lab.raycast import as_rays
+
 #: Shape parameters of the procedural ridge terrain (metres, degrees). ``saddle`` is
 #: (b centre, half width, depth), ``horn`` (a, b, height, radius), ``bay`` (b centre,
 #: half width, recess depth), ``summit`` (a, b, height, radius).
@@ -124,11 +127,10 @@ class Heightfield:
         z = np.asarray(self.z, dtype=np.float64)
         albedo = np.asarray(self.albedo, dtype=np.float64)
         if z.ndim != 2 or min(z.shape) < 2 or not np.all(np.isfinite(z)):
-            raise ValueError(f"z: expected a finite (nb, na) grid with nb, na >= 2, got {z.shape}")
+            raise ValueError(f"z must be a finite (nb, na) grid with nb, na >= 2; got {z.shape}")
         if albedo.shape != z.shape + (3,):
             raise ValueError(f"albedo: expected shape {z.shape + (3,)}, got {albedo.shape}")
-        if not self.spacing > 0:
-            raise ValueError(f"spacing: must be positive, got {self.spacing}")
+        check_positive(self.spacing, "spacing")
         gb, ga = np.gradient(z, self.spacing)
         # world gradient from (a, b) gradient: d/dx = da/dx d/da + db/dx d/db
         s, c = np.sin(np.radians(self.axis_azimuth_deg)), np.cos(np.radians(self.axis_azimuth_deg))
@@ -266,15 +268,6 @@ def make_ridge_terrain(*, seed=0, **params):
                        axis_azimuth_deg=float(p["axis_azimuth_deg"]))
 
 
-def _check_rays(origins, directions):
-    origins = np.asarray(origins, dtype=np.float64)
-    directions = np.asarray(directions, dtype=np.float64)
-    if origins.ndim != 2 or origins.shape[1] != 3 or origins.shape != directions.shape:
-        raise ValueError(f"origins, directions: expected two (N, 3) arrays, got "
-                         f"{origins.shape} and {directions.shape}")
-    return origins, directions
-
-
 def intersect_heightfield(terrain, origins, directions, *, min_step=0.5, bisect_steps=30,
                           max_iter=4000):
     """First intersection of rays with the terrain surface.
@@ -301,9 +294,8 @@ def intersect_heightfield(terrain, origins, directions, *, min_step=0.5, bisect_
         Ray parameter of the hit (m), NaN for rays that leave the grid or rise above the
         highest terrain (sky).
     """
-    origins, directions = _check_rays(origins, directions)
-    if not min_step > 0:
-        raise ValueError(f"min_step: must be positive, got {min_step}")
+    origins, directions = as_rays(origins, directions)
+    check_positive(min_step, "min_step")
     n = len(origins)
     dist = np.full(n, np.nan)
     s = np.zeros(n)
@@ -346,7 +338,7 @@ def horizon_distances(terrain, *, ratio=1.05, first=1.0):
     """Horizontal probe distances (m) of :func:`horizon_angles`: geometric from `first` to the
     grid's diagonal, ``d[i+1] = ratio * d[i]``."""
     if not ratio > 1:
-        raise ValueError(f"ratio: must be > 1, got {ratio}")
+        raise ValueError(f"ratio must be > 1; got {ratio}")
     reach = float(np.hypot(*(np.array(terrain.z.shape) * terrain.spacing)))
     n = int(np.ceil(np.log(reach / first) / np.log(ratio))) + 1
     return first * ratio ** np.arange(n)
@@ -394,8 +386,7 @@ def horizon_angles(terrain, points, azimuths_rad, *, min_elevation_rad, max_elev
     """
     points = np.asarray(points, dtype=np.float64)
     az = np.asarray(azimuths_rad, dtype=np.float64).ravel()
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    check_array(points, "points", shape=(None, 3))
     if pairwise and len(az) != len(points):
         raise ValueError(f"azimuths_rad: pairwise needs one azimuth per point ({len(points)}), "
                          f"got {len(az)}")

@@ -13,7 +13,6 @@ classify : shadow classes and masks of pixel centres from their lit-per-frame ta
 pushbroom_edge : ``pb_edge_y`` and ``pb_n_transitions`` from pixel-centre arrival times.
 sample_rows : image sampled at fractional rows per (frame, column) (linear in the row).
 pushbroom_bins : ``pb_bin`` / ``pb_bin_count``.
-fractional_frame : times -> fractional frame indices (piecewise linear in the frame times).
 """
 
 import numpy as np
@@ -70,12 +69,6 @@ DEFINITIONS = {
                      "ExposureTime metadata carries only the step part (ae_ev)",
 }
 
-
-def fractional_frame(times, frame_times):
-    """Times -> fractional frame indices (linear between frame times; NaN stays NaN)."""
-    frame_times = np.asarray(frame_times, dtype=np.float64)
-    return np.interp(times, frame_times, np.arange(len(frame_times)), left=np.nan,
-                     right=np.nan)
 
 
 def arrival_times(geometry, sun, frame_times, *, bisect_steps=30):
