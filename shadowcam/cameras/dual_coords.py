@@ -15,7 +15,7 @@ Two ways (paper section II-A):
   are mapped to the dual grid by a rectangular plane window (default: the
   bounding box of the calibration points) whose edges are the grid's edges.
 
-Dual pixel convention (docs/architecture.md): the centre of dual column ``i``
+Dual pixel convention (docs/contracts.md): the centre of dual column ``i``
 is ``u = i`` (row ``j``: ``v = j``), so the grid edges are at ``-0.5`` and
 ``width - 0.5``.
 
@@ -633,7 +633,7 @@ DUAL_COORD_METHODS = {
 
 
 def dual_coords_dataset(u, v, valid, *, info, method, reason=None):
-    """Assemble the ``dual_coords`` Dataset of docs/architecture.md.
+    """Assemble the ``dual_coords`` Dataset of docs/contracts.md.
 
     Parameters
     ----------

@@ -264,7 +264,7 @@ def camera_colours(shadow_time, *, reference=None, sweeps=("u", "v")):
 
 
 def dual_view_dataset(image, coverage, *, method, params=None, channels=("R", "G", "B")):
-    """Assemble the ``dual_view`` Dataset of docs/architecture.md.
+    """Assemble the ``dual_view`` Dataset of docs/contracts.md.
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Ground truth of synthetic captures in the standard form (docs/architecture.md).
+"""Ground truth of synthetic captures in the standard form (docs/contracts.md).
 
 Standard form (an ``xarray.Dataset``):
 

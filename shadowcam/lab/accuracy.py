@@ -1,6 +1,6 @@
 """Accuracy of shadow times, dual coordinates and dual views against ground truth.
 
-Metrics (synthetic data with exact ground truth, docs/architecture.md form):
+Metrics (synthetic data with exact ground truth, docs/contracts.md form):
 
 * shadow time, per sweep, over lit pixels with a GT time: absolute error
   median, 95th percentile, RMSE, fraction > 1 frame; coverage = fraction of

@@ -128,7 +128,7 @@ GT_DEFINITIONS = {
     "pixel_centre": "arrival_time_s",
     "half_coverage": "arrival_time_half_coverage_s",
 }
-#: the definition the targets are checked against (see docs/architecture.md)
+#: the definition the targets are checked against (see docs/contracts.md)
 PRIMARY_DEFINITION = "pixel_centre"
 
 

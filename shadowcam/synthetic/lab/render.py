@@ -478,7 +478,7 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
     -------
     CaptureRenderer
         With ``reference`` (rows, cols, 3) float32, ``ground_truth`` (xarray.Dataset, the
-        standard GT names of docs/architecture.md plus P, N, cosines, distances, calibration
+        standard GT names of docs/contracts.md plus P, N, cosines, distances, calibration
         GT) and ``homography`` ((3, 3), or None without calibration).
     """
     cam, light, mask = scene.camera, scene.light, scene.mask
