@@ -9,12 +9,9 @@ add_parser : register the step and its options.
 run : compute and write the arrival map.
 """
 
-from shadowcam.io.frame_times import time_to_frame
-from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals
 from shadowcam.cli.options import parse_params
 from shadowcam.io.datasets import open_dataset, write_dataset
-from shadowcam.io.frame_times import median_interval
-from shadowcam.outdoor.datasets import arrival_dataset
+from shadowcam.outdoor.arrival import arrival_map
 
 
 def add_parser(subparsers, name):
@@ -34,14 +31,5 @@ def run(args):
     params = parse_params(args.params, allowed={"tolerance_intervals"})
     photometry = open_dataset(args.photometry)
     edges = open_dataset(args.edges)
-    time_s = edges["time_s"].values
-    interval = median_interval(time_s)
-    sky = photometry["sky"].values.astype(bool)
-    lit = photometry["lit_at_start"].values.astype(bool)
-    edge_s = arrival_from_edges(edges["edge_row"].values, time_s, eligible=lit & ~sky)
-    coverage_s = edges["coverage_arrival_s"].values
-    arrival, reason = combine_arrivals(edge_s, coverage_s, sky=sky, lit_at_start=lit,
-                                       tolerance_s=params.get("tolerance_intervals", 1.5) * interval)
-    dataset = arrival_dataset(arrival, time_to_frame(arrival, time_s, outside="clamp"), reason, edge_arrival_s=edge_s,
-                              coverage_arrival_s=coverage_s, interval_s=interval)
+    dataset = arrival_map(photometry, edges, tolerance_intervals=params.get("tolerance_intervals", 1.5))
     write_dataset(dataset, args.out, config=params, inputs=(photometry, edges), step="arrival")

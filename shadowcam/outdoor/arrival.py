@@ -22,11 +22,15 @@ ARRIVAL_REASONS : reason code -> name (CF flag meanings).
 arrival_from_edges : arrival time of every pixel from the per-frame edge rows.
 CoverageCrossing : streaming first downward 0.5-crossing of per-pixel coverage.
 combine_arrivals : the final arrival map and its reasons.
+arrival_dataset : the arrival-time map over (row, col) with reasons.
+arrival_map : the arrival dataset of a capture from its photometry and edges datasets.
 """
 
 import numpy as np
+import xarray as xr
 
-from shadowcam._shared.validation import check_same_shape
+from shadowcam._shared.validation import check_positive, check_same_shape
+from shadowcam.io.frame_times import median_interval, time_to_frame
 
 #: reason code -> meaning (stored as CF flag_values / flag_meanings)
 ARRIVAL_REASONS = {
@@ -175,3 +179,59 @@ def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start):
     reason[sky] = REASON_CODE["sky"]
     arrival[sky | ~np.asarray(lit_at_start, dtype=bool)] = np.nan
     return arrival, reason
+
+def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverage_arrival_s, interval_s):
+    """Assemble the arrival map.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``arrival_time_s``, ``arrival_frame``, ``reason`` (CF flags),
+        ``edge_arrival_s``, ``coverage_arrival_s`` over ``(row, col)``;
+        attr ``median_interval_s``.
+    """
+    cam = ("row", "col")
+    codes = sorted(ARRIVAL_REASONS)
+    data = {
+        "arrival_time_s": (cam, np.asarray(arrival_s), {"units": "s", "long_name": "shadow arrival time since the first frame"}),
+        "arrival_frame": (cam, np.asarray(arrival_frame), {"units": "frame", "long_name": "arrival as fractional frame (piecewise linear in time_s)"}),
+        "reason": (cam, np.asarray(reason, np.uint8), {
+            "long_name": "how the arrival was obtained, or why there is none",
+            "flag_values": np.array(codes, np.uint8), "flag_meanings": " ".join(ARRIVAL_REASONS[c] for c in codes)}),
+        "edge_arrival_s": (cam, np.asarray(edge_arrival_s), {"units": "s", "long_name": "arrival from the tracked edge crossing the pixel centre"}),
+        "coverage_arrival_s": (cam, np.asarray(coverage_arrival_s), {"units": "s", "long_name": "arrival from the pixel's lit fraction crossing 0.5"}),
+    }
+    dataset = xr.Dataset(data)
+    dataset.attrs["median_interval_s"] = float(interval_s)
+    return dataset
+
+
+def arrival_map(photometry, edges, *, tolerance_intervals=1.5):
+    """The arrival-time map of a capture (edge crossing checked against coverage crossing).
+
+    Parameters
+    ----------
+    photometry : xarray.Dataset
+        First-pass result: ``sky`` and ``lit_at_start`` over ``(row, col)``.
+    edges : xarray.Dataset
+        Tracked edges: ``edge_row (time, col)``, ``coverage_arrival_s (row, col)``, coord ``time_s``.
+    tolerance_intervals : float, keyword-only
+        Largest disagreement between the edge and coverage crossings, in median
+        capture intervals, for the edge crossing to be kept.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`arrival_dataset`; ``arrival_frame`` clamped to the sequence.
+    """
+    check_positive(tolerance_intervals, "tolerance_intervals")
+    time_s = edges["time_s"].values
+    interval = median_interval(time_s)
+    sky = photometry["sky"].values.astype(bool)
+    lit = photometry["lit_at_start"].values.astype(bool)
+    edge_s = arrival_from_edges(edges["edge_row"].values, time_s, eligible=lit & ~sky)
+    coverage_s = edges["coverage_arrival_s"].values
+    arrival, reason = combine_arrivals(edge_s, coverage_s, sky=sky, lit_at_start=lit,
+                                       tolerance_s=tolerance_intervals * interval)
+    return arrival_dataset(arrival, time_to_frame(arrival, time_s, outside="clamp"), reason,
+                           edge_arrival_s=edge_s, coverage_arrival_s=coverage_s, interval_s=interval)

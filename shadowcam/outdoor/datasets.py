@@ -10,14 +10,11 @@ photometry_arrays : the dict :class:`shadowcam.outdoor.tracking.EdgeTracker` tak
 photometry_part_dataset : one time part of the first pass (per-frame values, running minimum).
 photometry_part_arrays : the dict :func:`shadowcam.outdoor.normalise.merge_parts` takes, from that dataset.
 edges_dataset : tracked edges over (time, col), keyframes, interpolation flags.
-arrival_dataset : the arrival-time map over (row, col) with reasons.
 pushbroom_dataset : the ridge pushbroom over (time, col, channel).
 """
 
 import numpy as np
 import xarray as xr
-
-from shadowcam.outdoor.arrival import ARRIVAL_REASONS
 
 _CHANNELS = np.array(["R", "G", "B"], dtype=object)
 
@@ -171,31 +168,6 @@ def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpo
     }
     return xr.Dataset(data, coords=_frame_coords(time_s, photometry))
 
-
-def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverage_arrival_s, interval_s):
-    """Assemble the arrival map.
-
-    Returns
-    -------
-    xarray.Dataset
-        ``arrival_time_s``, ``arrival_frame``, ``reason`` (CF flags),
-        ``edge_arrival_s``, ``coverage_arrival_s`` over ``(row, col)``;
-        attr ``median_interval_s``.
-    """
-    cam = ("row", "col")
-    codes = sorted(ARRIVAL_REASONS)
-    data = {
-        "arrival_time_s": (cam, np.asarray(arrival_s), {"units": "s", "long_name": "shadow arrival time since the first frame"}),
-        "arrival_frame": (cam, np.asarray(arrival_frame), {"units": "frame", "long_name": "arrival as fractional frame (piecewise linear in time_s)"}),
-        "reason": (cam, np.asarray(reason, np.uint8), {
-            "long_name": "how the arrival was obtained, or why there is none",
-            "flag_values": np.array(codes, np.uint8), "flag_meanings": " ".join(ARRIVAL_REASONS[c] for c in codes)}),
-        "edge_arrival_s": (cam, np.asarray(edge_arrival_s), {"units": "s", "long_name": "arrival from the tracked edge crossing the pixel centre"}),
-        "coverage_arrival_s": (cam, np.asarray(coverage_arrival_s), {"units": "s", "long_name": "arrival from the pixel's lit fraction crossing 0.5"}),
-    }
-    dataset = xr.Dataset(data)
-    dataset.attrs["median_interval_s"] = float(interval_s)
-    return dataset
 
 
 def pushbroom_dataset(pushbroom, edge_row, time_s):

@@ -42,3 +42,27 @@ def test_combine_prefers_agreeing_edges_and_labels_reasons():
     assert reason[0].tolist() == [REASON_CODE[n] for n in
                                   ("edge_crossing", "coverage_crossing", "coverage_crossing", "edge_crossing", "sky")]
 
+
+
+def test_arrival_map_of_a_tracked_capture_matches_its_exact_arrivals(make_timelapse):
+    import xarray as xr
+
+    from shadowcam.outdoor.arrival import arrival_map
+    from shadowcam.outdoor.datasets import photometry_dataset
+    from shadowcam.outdoor.edges import track_edges
+    from shadowcam.outdoor.normalise import normalise_frames
+
+    scene = make_timelapse(width=40, n_frames=30, seed=5)
+    frames = xr.Dataset({"image": (("time", "row", "col", "channel"), np.asarray(scene["frames"]))},
+                        coords={"time_s": ("time", scene["time_s"])})
+    photometry = photometry_dataset(normalise_frames(iter(scene["frames"])), scene["time_s"])
+    arrival = arrival_map(photometry, track_edges(frames, photometry))
+    found = np.isfinite(arrival["arrival_time_s"].values) & np.isfinite(scene["arrival_s"])
+    assert found.sum() > 0.5 * np.isfinite(scene["arrival_s"]).sum()
+    error = np.abs(arrival["arrival_time_s"].values - scene["arrival_s"])[found] / scene["interval"]
+    assert np.median(error) < 0.25  # capture intervals (the clean-capture target)
+    frame = arrival["arrival_frame"].values[found]
+    assert frame.min() >= 0 and frame.max() <= len(scene["time_s"]) - 1
+    assert arrival["reason"].attrs["flag_meanings"].split()[0] == "edge_crossing"
+    with pytest.raises(ValueError, match="tolerance_intervals"):
+        arrival_map(photometry, track_edges(frames, photometry), tolerance_intervals=0)
