@@ -380,23 +380,32 @@ def intersect_through_optics(objects, optics, origins, directions, *, max_intera
 # --------------------------------------------------------------------------- set-ups
 
 
-def mirror_setup(camera, *, distance=0.08, radius=0.035, fov_x_deg=24.0):
-    """A catadioptric set-up: the camera turns round to look at a convex spherical mirror.
+def mirror_setup(camera, *, offset=0.2, distance=0.08, radius=0.035, fov_x_deg=30.0,
+                 deflection_deg=90.0):
+    """A catadioptric set-up: a camera looks at the scene in a convex spherical mirror.
 
-    The mirror's centre lies `distance` behind `camera` on its optical axis; the new camera
-    keeps the centre, image size and up direction of `camera`, looks at the mirror centre
-    and so sees the scene reflected about its former viewing direction.
+    The mirror's centre M lies `offset` along the optical axis (forward direction f) of
+    `camera` from its centre (negative: behind it). The new camera sits at ``M + distance g``, with g the direction f turned
+    by `deflection_deg` about the camera's up axis, and aims at the mirror point whose
+    normal bisects f and g, so that it sees the scene reflected about (roughly) the former
+    viewing direction; ``deflection_deg = 0`` with ``offset = -distance`` puts it at the
+    former camera centre, looking straight back at the mirror. It keeps the image size and up direction of `camera`.
 
     Parameters
     ----------
     camera : PinholeCamera
         The direct-view camera of the scene.
+    offset : float
+        Signed position of the mirror centre along the former optical axis (scene units).
     distance : float
-        Camera centre to mirror centre (scene units); must exceed `radius`.
+        New camera centre to mirror centre; must exceed `radius`.
     radius : float
         Mirror radius.
     fov_x_deg : float
         Horizontal field of view of the camera that looks at the mirror.
+    deflection_deg : float
+        Angle at the mirror between the directions to the camera and to the scene, in
+        [0, 150] (larger = more oblique reflection, stronger distortion).
 
     Returns
     -------
@@ -408,10 +417,17 @@ def mirror_setup(camera, *, distance=0.08, radius=0.035, fov_x_deg=24.0):
     distance, radius = _positive(distance, "distance"), _positive(radius, "radius")
     if distance <= radius:
         raise ValueError(f"distance: must exceed radius ({radius}), got {distance}")
-    centre = camera.center - distance * camera.R[2]
-    up = -camera.R[1]
-    new = look_at_camera(camera.center, centre, fov_x_deg=fov_x_deg, width=camera.width,
-                         height=camera.height, up=up)
+    if not 0 <= deflection_deg <= 150:
+        raise ValueError(f"deflection_deg: must be in [0, 150], got {deflection_deg!r}")
+    forward, up = camera.R[2], -camera.R[1]
+    centre = camera.center + float(offset) * forward
+    a = math.radians(deflection_deg)
+    side = np.cross(up, forward)  # the camera's left: turning f toward it about up
+    toward_camera = math.cos(a) * forward + math.sin(a) * side
+    bisector = forward + toward_camera
+    bisector /= np.linalg.norm(bisector)
+    new = look_at_camera(centre + distance * toward_camera, centre + radius * bisector,
+                         fov_x_deg=fov_x_deg, width=camera.width, height=camera.height, up=up)
     return new, (SphereMirror(centre, radius),)
 
 
