@@ -385,11 +385,14 @@ def mirror_setup(camera, *, offset=0.2, distance=0.08, radius=0.035, fov_x_deg=3
     """A catadioptric set-up: a camera looks at the scene in a convex spherical mirror.
 
     The mirror's centre M lies `offset` along the optical axis (forward direction f) of
-    `camera` from its centre (negative: behind it). The new camera sits at ``M + distance g``, with g the direction f turned
-    by `deflection_deg` about the camera's up axis, and aims at the mirror point whose
-    normal bisects f and g, so that it sees the scene reflected about (roughly) the former
-    viewing direction; ``deflection_deg = 0`` with ``offset = -distance`` puts it at the
-    former camera centre, looking straight back at the mirror. It keeps the image size and up direction of `camera`.
+    `camera` from its centre (negative: behind it). The new camera sits at
+    ``M + distance g``, with g the direction f turned by `deflection_deg` about the camera's
+    up axis, and aims at the mirror point whose normal bisects f and g, so that it sees the
+    scene reflected about (roughly) the former viewing direction; ``deflection_deg = 0``
+    with ``offset = -distance`` puts it at the former camera centre, looking straight back
+    at the mirror. It keeps the image size and up direction of `camera`. Its pixels whose
+    rays miss the mirror see the scene directly (``edges.EdgePoints.through_optics`` tells
+    the two apart for edge points).
 
     Parameters
     ----------
