@@ -6,4 +6,5 @@ Modules
 dual_coords : shadow times -> dual (shadow-camera) coordinates ``u, v``.
 dual_view : dual view: resample camera colours onto the ``(v, u)`` dual grid.
 pushbroom : ridge pushbroom (paper section VII, Fig. 18): the image along the moving shadow edge.
+straightness : straightness of straight scene edges in an image: do straight lines stay straight?
 """

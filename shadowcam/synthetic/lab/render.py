@@ -8,6 +8,10 @@ sweep is the reference image minus the contributions of the paths blocked in eac
 accumulated with a difference array over time (no per-frame ray casting at all). Partial
 wire coverage of a pixel's sub-samples gives a smooth dip.
 
+Optical elements on the camera side (``optics``: mirrors, thick glass; paper section V) bend
+the primary rays only: shading, shadow times and all ground truth follow the bent ray, while
+the light, its shadow rays, the wire and the reciprocal render ignore the elements.
+
 Radiometry: radiance ``L = f_r I cos_L / d_L^2`` (point / area samples of intensity I) or
 ``f_r E cos_L`` (distant light, irradiance E), with the reciprocal BRDF of
 ``scene.Material``; a point must face both the light and the viewer.
@@ -34,6 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import xarray as xr
 
+from shadowcam.synthetic.lab.optics import intersect_through_optics
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_scene, occluded, wire_occlusion_interval
 from shadowcam.synthetic.lab.scene import (
     DistantLight,
@@ -108,15 +113,32 @@ def _brdf(objects, object_id, albedo, normal, to_light, to_view):
     return f
 
 
-def _shade(objects, hits_sel, camera, light):
+def _primary_hits(objects, camera, x, y, optics):
+    """Hits of the camera rays through pixel-edge (x, y), bent by `optics`.
+
+    Returns (hits, to_view, path_length): without optics `to_view` and `path_length` are
+    None (the view direction is toward the camera centre); with optics `to_view` (N, 3) is
+    the reverse of the bent ray's last direction and `path_length` (N,) the unfolded length
+    of the camera ray from the camera centre to the hit.
+    """
+    origins, dirs = camera_rays(camera, x, y)
+    if not optics:
+        return intersect_scene(objects, origins, dirs), None, None
+    hits, bent = intersect_through_optics(objects, optics, origins, dirs)
+    return hits, -bent.directions, np.where(hits.hit, bent.path_length + hits.distance, np.nan)
+
+
+def _shade(objects, hits_sel, camera, light, to_view=None):
     """Per light sample: (to_light_end, radiance (n, 3)) for the hit points in `hits_sel`.
 
-    `hits_sel` is (point, normal, object_id, albedo). Yields one entry per light sample;
-    radiance is 0 where the point does not face the light/viewer or is occluded.
+    `hits_sel` is (point, normal, object_id, albedo); `to_view` (n, 3) overrides the
+    direction toward the camera centre. Yields one entry per light sample; radiance is 0
+    where the point does not face the light/viewer or is occluded.
     """
     points, normal, object_id, albedo = hits_sel
     positions, directions, weights = light_samples(light)
-    to_view = _view_dirs(camera, points)
+    if to_view is None:
+        to_view = _view_dirs(camera, points)
     cos_c = (normal * to_view).sum(axis=1)
     n_samples = len(weights)
     for k in range(n_samples):
@@ -143,7 +165,7 @@ def _shade(objects, hits_sel, camera, light):
         yield end, radiance, ok
 
 
-def trace_light_paths(objects, camera, light, *, supersample=4):
+def trace_light_paths(objects, camera, light, *, supersample=4, optics=()):
     """Cast primary rays and scene shadow rays once for a view.
 
     Parameters
@@ -153,6 +175,8 @@ def trace_light_paths(objects, camera, light, *, supersample=4):
     light : PointLight, AreaLight or DistantLight
     supersample : int
         Sub-samples per pixel side (stratum centres of a regular grid; 1 = pixel centre).
+    optics : sequence of optical elements
+        Mirrors / thick glass that bend the primary rays (``optics``); empty = direct view.
 
     Returns
     -------
@@ -167,12 +191,12 @@ def trace_light_paths(objects, camera, light, *, supersample=4):
     parts = {"pixel": [], "points": [], "light": [], "radiance": []}
     for start in range(0, len(x), _CHUNK):
         sl = slice(start, start + _CHUNK)
-        origins, dirs = camera_rays(camera, x[sl], y[sl])
-        hits = intersect_scene(objects, origins, dirs)
+        hits, to_view, _ = _primary_hits(objects, camera, x[sl], y[sl], optics)
         sel = np.flatnonzero(hits.hit)
         pixel = (start + sel) // per_pixel
         data = (hits.point[sel], hits.normal[sel], hits.object_id[sel], hits.albedo[sel])
-        for end, radiance, ok in _shade(objects, data, camera, light):
+        to_view = None if to_view is None else to_view[sel]
+        for end, radiance, ok in _shade(objects, data, camera, light, to_view):
             parts["pixel"].append(pixel[ok])
             parts["points"].append(data[0][ok])
             parts["light"].append(np.asarray(end)[ok])
@@ -278,8 +302,11 @@ def _pixel_centres(camera):
     return _subpixel_grid(camera.height, camera.width, 1)
 
 
-def _surface_terms(objects, points, normal, hit, eye_camera, light):
-    """cos_L, cos_C, dist_L, dist_C and scene visibility of the light centre, (N,) each."""
+def _surface_terms(objects, points, normal, hit, eye_camera, light, to_view=None, dist_c=None):
+    """cos_L, cos_C, dist_L, dist_C and scene visibility of the light centre, (N,) each.
+
+    `to_view` (N, 3) and `dist_c` (N,) override the direction toward and the distance to
+    the eye camera's centre (camera rays bent by optics)."""
     n = len(points)
     centre = light.direction if isinstance(light, DistantLight) else light.center
     if isinstance(light, DistantLight):
@@ -289,9 +316,11 @@ def _surface_terms(objects, points, normal, hit, eye_camera, light):
         rel = centre - points
         dist_l = np.linalg.norm(rel, axis=1)
         to_light = rel / dist_l[:, None]
-    to_view = _view_dirs(eye_camera, points)
-    dist_c = (np.full(n, np.inf) if isinstance(eye_camera, OrthographicCamera)
-              else np.linalg.norm(eye_camera.center - points, axis=1))
+    if to_view is None:
+        to_view = _view_dirs(eye_camera, points)
+    if dist_c is None:
+        dist_c = (np.full(n, np.inf) if isinstance(eye_camera, OrthographicCamera)
+                  else np.linalg.norm(eye_camera.center - points, axis=1))
     with np.errstate(invalid="ignore"):
         cos_l = (normal * to_light).sum(axis=1)
         cos_c = (normal * to_view).sum(axis=1)
@@ -304,8 +333,13 @@ def _surface_terms(objects, points, normal, hit, eye_camera, light):
     return cos_l, cos_c, dist_l, dist_c, lit
 
 
-def pixel_centre_ground_truth(objects, camera, light, mask, sweeps):
+def pixel_centre_ground_truth(objects, camera, light, mask, sweeps, *, optics=()):
     """Exact ground truth at camera pixel centres.
+
+    With `optics` every quantity follows the bent camera ray: ``P`` is where it meets the
+    scene, ``cos_C`` uses the ray's last direction, ``dist_C`` is the unfolded path length
+    from the camera centre and ``depth`` its component along the camera's optical axis
+    (the depth of the virtual point on the unbent camera ray).
 
     Parameters
     ----------
@@ -314,6 +348,8 @@ def pixel_centre_ground_truth(objects, camera, light, mask, sweeps):
     light : PointLight, AreaLight or DistantLight (area lights use their centre)
     mask : MaskPlane
     sweeps : dict of str to WireSweep
+    optics : sequence of optical elements
+        Mirrors / thick glass that bend the primary rays; empty = direct view.
 
     Returns
     -------
@@ -326,11 +362,14 @@ def pixel_centre_ground_truth(objects, camera, light, mask, sweeps):
     """
     rows, cols = camera.height, camera.width
     x, y = _pixel_centres(camera)
-    origins, dirs = camera_rays(camera, x, y)
-    hits = intersect_scene(objects, origins, dirs)
+    hits, to_view, unfolded = _primary_hits(objects, camera, x, y, optics)
     cos_l, cos_c, dist_l, dist_c, lit = _surface_terms(objects, hits.point, hits.normal,
-                                                       hits.hit, camera, light)
-    _, depth = project(camera, hits.point)
+                                                       hits.hit, camera, light, to_view,
+                                                       unfolded)
+    if unfolded is None:
+        _, depth = project(camera, hits.point)
+    else:
+        depth = unfolded * (camera_rays(camera, x, y)[1] @ camera.R[2])
     out = {"P": hits.point, "N": hits.normal, "hit": hits.hit, "lit": lit, "cos_L": cos_l,
            "cos_C": cos_c, "dist_L": dist_l, "dist_C": dist_c, "depth": depth,
            "object_id": hits.object_id}
@@ -371,12 +410,15 @@ def plane_homography(camera, plane):
     return H / H[2, 2]
 
 
-def render_reciprocal(objects, camera, light, mask, *, supersample=4):
+def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=()):
     """The reciprocal render and the dual-pixel geometry.
 
     The view from the dual camera (``scene.dual_camera``: pinhole at the light centre, or
     orthographic for a distant light) lit by a point light at the camera centre with the
     light's intensity (irradiance for a distant light); its pixel grid is the dual grid.
+    The camera's optical elements play no part in it; with `optics` the camera pixel of a
+    dual point has no closed form, so ``dual_cam_visible`` is False and ``dual_cam_xy``
+    NaN everywhere.
 
     Returns
     -------
@@ -399,7 +441,7 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4):
     xy, depth = project(camera, np.nan_to_num(hits.point))
     inside = ((depth > 0) & (xy[:, 0] >= 0) & (xy[:, 0] <= camera.width)
               & (xy[:, 1] >= 0) & (xy[:, 1] <= camera.height))
-    visible &= inside
+    visible &= inside & (not optics)
     cam_xy = np.where(visible[:, None], xy - 0.5, np.nan)
     shape = (dual.height, dual.width)
     return {"reciprocal": reciprocal, "dual_P": hits.point.reshape(*shape, 3),
@@ -479,14 +521,18 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
     CaptureRenderer
         With ``reference`` (rows, cols, 3) float32, ``ground_truth`` (xarray.Dataset, the
         standard GT names of docs/contracts.md plus P, N, cosines, distances, calibration
-        GT) and ``homography`` ((3, 3), or None without calibration).
+        GT) and ``homography`` ((3, 3), or None without calibration or when the scene's
+        optics bend the camera rays, which leaves no plane homography).
     """
-    cam, light, mask = scene.camera, scene.light, scene.mask
-    paths = trace_light_paths(scene.objects, cam, light, supersample=supersample)
+    cam, light, mask, optics = scene.camera, scene.light, scene.mask, scene.optics
+    paths = trace_light_paths(scene.objects, cam, light, supersample=supersample,
+                              optics=optics)
     reference = render_image(paths)
     log.info("traced %d light paths for %dx%d pixels", len(paths.pixel), cam.height, cam.width)
-    gt = pixel_centre_ground_truth(scene.objects, cam, light, mask, scene.sweeps)
-    recip = render_reciprocal(scene.objects, cam, light, mask, supersample=supersample)
+    gt = pixel_centre_ground_truth(scene.objects, cam, light, mask, scene.sweeps,
+                                   optics=optics)
+    recip = render_reciprocal(scene.objects, cam, light, mask, supersample=supersample,
+                              optics=optics)
     f32 = np.float32
     rc, vu = ("row", "col"), ("v", "u")
     data = {
@@ -518,10 +564,12 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
     cal_paths = None
     if calibration:
         cal = calibration_scene(scene)
-        cal_paths = trace_light_paths(cal.objects, cam, light, supersample=supersample)
-        cgt = pixel_centre_ground_truth(cal.objects, cam, light, mask, scene.sweeps)
+        cal_paths = trace_light_paths(cal.objects, cam, light, supersample=supersample,
+                                      optics=optics)
+        cgt = pixel_centre_ground_truth(cal.objects, cam, light, mask, scene.sweeps,
+                                        optics=optics)
         plane = cal.back_plane
-        homography = plane_homography(cam, plane)
+        homography = None if optics else plane_homography(cam, plane)
         xy = plane.plane_coords(cgt["P"].reshape(-1, 3)).reshape(cam.height, cam.width, 2)
         data.update({
             "t_cal_u": (rc, cgt["t_u"].astype(f32), "frame",
@@ -530,9 +578,11 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
                         "analytic shadow time of calibration sweep cal_v"),
             "plane_xy": (rc + ("plane_axis",), xy.astype(f32), "scene_unit",
                          "back-plane coordinates (x, y) at pixel centre (calibration scene)"),
-            "calibration_homography": (("h_row", "h_col"), homography, "1",
-                                       "camera (col, row) pixel-centre index -> plane (x, y)"),
         })
+        if homography is not None:
+            data["calibration_homography"] = (
+                ("h_row", "h_col"), homography, "1",
+                "camera (col, row) pixel-centre index -> plane (x, y)")
     ds = xr.Dataset(
         {k: (dims, val, {"units": units, "long_name": name})
          for k, (dims, val, units, name) in data.items()},

@@ -7,7 +7,8 @@ has its centre at ``(x, y) = (c + 0.5, r + 0.5)``.
 
 Offers
 ------
-Texture, Material : procedural albedo (checker, discs, bricks) and a Blinn-Phong specular term.
+Texture, Material : procedural albedo (checker, discs, bricks, coloured squares) and a
+    Blinn-Phong specular term.
 Sphere, Box, GroundPlane, BackPlane : scene objects (box yawed about +y; ground infinite;
     the finite back plane carries 2-D plane coordinates (x, y) and is the calibration plane).
 PointLight, DistantLight, AreaLight : lights; ``light_samples`` gives their stratified samples.
@@ -60,7 +61,9 @@ def yaw_matrix(yaw_deg):
 
 # --------------------------------------------------------------------------- materials
 
-TEXTURE_KINDS = ("checker", "discs", "bricks")
+TEXTURE_KINDS = ("checker", "discs", "bricks", "squares")
+#: side of a square of the ``squares`` texture, as a fraction of the cell size `scale`
+SQUARE_FILL = 0.6
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,14 +72,18 @@ class Texture:
 
     Parameters
     ----------
-    kind : {"checker", "discs", "bricks"}
+    kind : {"checker", "discs", "bricks", "squares"}
     colors : (K, 3) array_like
         Linear albedos: checker uses 2, discs uses background + K-1 disc colours,
-        bricks uses brick colour(s) then mortar as the last entry.
+        bricks uses brick colour(s) then mortar as the last entry, squares uses background
+        + K-1 square colours.
     scale : float
-        Checker square / disc spacing / brick height, in scene units.
+        Checker square / disc spacing / brick height / squares cell size, in scene units.
+        A square of side ``SQUARE_FILL scale`` sits centred in every cell
+        ``[i scale, (i + 1) scale) x [j scale, (j + 1) scale)``, so its edges are straight
+        lines of texture coordinates.
     seed : int
-        Seeds disc placement and per-brick colour variation.
+        Seeds disc placement, per-brick colour variation and square colours.
     """
 
     kind: str
@@ -125,6 +132,16 @@ def texture_albedo(texture, coords):
         out = colors[pick] * shade[row % 64, col % 64][:, None]
         out[mortar] = colors[-1]
         return np.clip(out, 0.0, 1.0)
+    if texture.kind == "squares":
+        cell = np.floor(s).astype(np.int64)
+        margin = (1.0 - SQUARE_FILL) / 2.0
+        frac = s - cell
+        inside = np.all((frac >= margin) & (frac < 1.0 - margin), axis=1)
+        rng = np.random.default_rng(texture.seed)
+        pick = rng.integers(1, len(colors), size=(32, 32))
+        out = np.repeat(colors[:1], len(s), axis=0)
+        out[inside] = colors[pick[cell[inside, 0] % 32, cell[inside, 1] % 32]]
+        return out
     # discs: one disc (radius 0.3 scale) jittered in every cell of a 1-scale grid
     cell = np.floor(s).astype(np.int64)
     rng = np.random.default_rng(texture.seed)
@@ -645,7 +662,11 @@ def wire_shadow_time(points, sweep, light):
 
 @dataclass(frozen=True, eq=False)
 class Scene:
-    """A renderable lab scene: objects, one light, a camera, the mask plane and sweeps."""
+    """A renderable lab scene: objects, one light, a camera, the mask plane and sweeps.
+
+    `optics` holds optical elements (``optics.OPTICAL_ELEMENTS``: mirrors, thick glass) that
+    bend the camera's primary rays only; empty = the camera sees the scene directly.
+    """
 
     name: str
     objects: tuple
@@ -654,6 +675,7 @@ class Scene:
     mask: MaskPlane
     sweeps: dict
     seed: int = 0
+    optics: tuple = ()
 
     @property
     def back_plane(self):
@@ -669,15 +691,15 @@ def calibration_scene(scene):
     return replace(scene, name=f"{scene.name}_calibration", objects=(plane,))
 
 
-def _tabletop(*, seed, height, width, frames, light_kind):
+def _tabletop(*, seed, height, width, frames, light_kind, back_texture="discs"):
     rng = np.random.default_rng([seed, 1234])
     jit = lambda s: rng.uniform(-s, s)  # noqa: E731
     ground_y = -0.05
     tex_sphere = Texture("checker", [[0.15, 0.25, 0.6], [0.85, 0.8, 0.65]], 0.012, seed)
     tex_ground = Texture("bricks", [[0.55, 0.3, 0.22], [0.5, 0.35, 0.25], [0.62, 0.6, 0.55]],
                          0.012, seed)
-    tex_back = Texture("discs", [[0.75, 0.75, 0.72], [0.8, 0.2, 0.2], [0.2, 0.55, 0.25],
-                                 [0.2, 0.3, 0.75], [0.85, 0.7, 0.15]], 0.05, seed)
+    tex_back = Texture(back_texture, [[0.75, 0.75, 0.72], [0.8, 0.2, 0.2], [0.2, 0.55, 0.25],
+                                      [0.2, 0.3, 0.75], [0.85, 0.7, 0.15]], 0.05, seed)
     shade = lambda c: np.clip(np.asarray(c) * rng.uniform(0.9, 1.1, 3), 0, 1)  # noqa: E731
     radii = (0.034, 0.022, 0.013)
     xz = ((-0.06, -0.04), (0.015, 0.04), (0.075, 0.0))
@@ -712,18 +734,25 @@ def _tabletop(*, seed, height, width, frames, light_kind):
     return objects, light, camera, mask
 
 
+def _tabletop_squares(**options):
+    return _tabletop(**options, back_texture="squares")
+
+
 #: preset scene name -> builder(seed, height, width, frames, light_kind)
-SCENES = {"tabletop": _tabletop}
+SCENES = {"tabletop": _tabletop, "tabletop_squares": _tabletop_squares}
 
 
-def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="point"):
+def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="point",
+               optics=None):
     """Build a preset scene.
 
     Parameters
     ----------
     name : str
         Preset name, a key of ``SCENES`` (``"tabletop"``: three spheres and a yawed box on a
-        brick-textured ground in front of a disc-textured back plane, light beside the camera).
+        brick-textured ground in front of a disc-textured back plane, light beside the camera;
+        ``"tabletop_squares"``: the same with coloured squares on the back plane, whose
+        edges are straight world lines).
     seed : int
         Varies texture layout, colours and object placement slightly.
     height, width : int
@@ -731,6 +760,11 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     frames : int
         Frames per sweep (= dual grid size).
     light_kind : {"point", "area", "distant"}
+    optics : dict, optional
+        Optical elements on the camera side (paper section V), e.g. ``{"kind": "mirror"}``
+        (the camera looks at the scene in a convex spherical mirror) or
+        ``{"kind": "glass", "shape": "slab", "index": 1.5}``; the other keys are the options
+        of ``optics.mirror_setup`` / ``optics.glass_setup``. None = direct view.
 
     Returns
     -------
@@ -743,5 +777,10 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     objects, light, camera, mask = SCENES[name](seed=int(seed), height=int(height),
                                                 width=int(width), frames=int(frames),
                                                 light_kind=light_kind)
+    elements = ()
+    if optics is not None:
+        from shadowcam.synthetic.lab.optics import optics_setup  # optics builds on scene
+
+        camera, elements = optics_setup(optics, camera)
     return Scene(name=name, objects=tuple(objects), light=light, camera=camera, mask=mask,
-                 sweeps=make_wire_sweeps(mask), seed=int(seed))
+                 sweeps=make_wire_sweeps(mask), seed=int(seed), optics=tuple(elements))

@@ -1,0 +1,151 @@
+"""Tests of shadowcam.synthetic.lab.optics and edges: camera rays bent by mirrors and thick
+glass (paper section V), ground truth along the bent ray, straight edges in the dual view."""
+
+import math
+
+import numpy as np
+import pytest
+
+from shadowcam.cameras.straightness import edge_straightness
+from shadowcam.synthetic.lab.edges import square_edge_points
+from shadowcam.synthetic.lab.optics import (
+    GlassSlab,
+    GlassSphere,
+    PlaneMirror,
+    SphereMirror,
+    reflect,
+    refract,
+    trace_through_optics,
+)
+from shadowcam.synthetic.lab.render import pixel_centre_ground_truth, prepare_capture
+from shadowcam.synthetic.lab.scene import PinholeCamera, make_scene
+
+H = W = 32
+T = 24
+GT_KEYS = ("P", "hit", "lit", "t_u_all", "t_v_all", "dist_C", "cos_C", "depth", "object_id")
+
+
+def _gt(scene, camera=None, optics=()):
+    return pixel_centre_ground_truth(scene.objects, camera or scene.camera, scene.light,
+                                     scene.mask, scene.sweeps, optics=optics)
+
+
+def test_reflection_and_snell_law_with_total_internal_reflection():
+    n = np.array([[0.0, 0.0, 1.0]])
+    a = math.radians(40)
+    d = np.array([[math.sin(a), 0.0, -math.cos(a)]])
+    assert np.allclose(reflect(d, n), [[math.sin(a), 0.0, math.cos(a)]], atol=1e-15)
+    inside, ok = refract(d, n, 1.5)  # entering: sin r = sin i / 1.5
+    assert ok[0] and math.isclose(inside[0, 0], math.sin(a) / 1.5, abs_tol=1e-15)
+    out, ok = refract(inside, -n, 1.5)  # leaving through a parallel face: back to d
+    assert ok[0] and np.allclose(out, d, atol=1e-15)
+    steep = np.array([[math.sin(math.radians(50)), 0.0, math.cos(math.radians(50))]])
+    _, ok = refract(steep, n, 1.5)  # leaving at 50 deg > critical angle 41.8 deg
+    assert not ok[0]
+
+
+def test_total_internal_reflection_marks_the_ray_as_no_hit():
+    sphere = GlassSphere((0.0, 0.0, 0.0), 1.0, 1.5)
+    origins = np.array([[0.9, 0.0, 0.0], [0.1, 0.0, 0.0]])
+    dirs = np.array([[0.0, 1.0, 0.0], [0.0, 1.0, 0.0]])  # incidence sin = 0.9 and 0.1
+    bent = trace_through_optics((sphere,), origins, dirs)
+    assert not bent.valid[0] and np.all(np.isnan(bent.directions[0]))
+    assert bent.valid[1] and bent.interactions[1] == 1
+
+
+def test_thick_slab_shifts_a_ray_by_the_analytic_lateral_offset():
+    thickness, index, i = 0.02, 1.5, math.radians(35)
+    slab = GlassSlab((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), thickness, index)
+    d = np.array([[math.sin(i), 0.0, -math.cos(i)]])
+    o = np.array([[0.0, 0.0, 0.1]])
+    bent = trace_through_optics((slab,), o, d)
+    r = math.asin(math.sin(i) / index)
+    assert bent.interactions[0] == 2 and np.allclose(bent.directions, d, atol=1e-14)
+    offset = np.linalg.norm(np.cross(bent.origins[0] - o[0], d[0]))
+    assert math.isclose(offset, thickness * math.sin(i - r) / math.cos(r), rel_tol=1e-12)
+    assert math.isclose(bent.path_length[0],
+                        (0.1 - thickness / 2) / math.cos(i) + thickness / math.cos(r),
+                        rel_tol=1e-12)
+
+
+def test_slab_of_index_one_leaves_the_ground_truth_unchanged():
+    scene = make_scene("tabletop", height=H, width=W, frames=T)
+    cam = scene.camera
+    slab = GlassSlab(cam.center + 0.1 * cam.R[2], cam.R[2] + 0.4 * cam.R[0], 0.03, 1.0)
+    direct, through = _gt(scene), _gt(scene, optics=(slab,))
+    assert np.array_equal(direct["hit"], through["hit"])
+    assert np.array_equal(direct["object_id"], through["object_id"])
+    for key in ("P", "t_u_all", "t_v_all", "dist_C", "cos_C", "depth"):
+        np.testing.assert_allclose(through[key], direct[key], atol=1e-9, rtol=0, err_msg=key)
+
+
+def test_flat_mirror_ground_truth_is_that_of_the_mirrored_camera():
+    """A camera looking back at a plane mirror 0.05 behind it sees what a camera 0.1
+    further back, looking forward, sees (its virtual camera)."""
+    scene = make_scene("tabletop", height=H, width=W, frames=T)
+    cam = scene.camera
+    f = cam.R[2]
+    flip = np.eye(3) - 2 * np.outer(f, f)
+    real = PinholeCamera(cam.K, cam.R @ flip, cam.center, W, H)
+    virtual = PinholeCamera(cam.K, cam.R, cam.center - 0.1 * f, W, H)
+    mirror = PlaneMirror(cam.center - 0.05 * f, f)
+    seen, expected = _gt(scene, real, (mirror,)), _gt(scene, virtual)
+    assert expected["hit"].mean() > 0.9 and expected["lit"].mean() > 0.5
+    for key in GT_KEYS:
+        np.testing.assert_allclose(seen[key], expected[key], atol=1e-6, rtol=0, err_msg=key)
+
+
+def _edge_straightness(optics, size):
+    scene = make_scene("tabletop_squares", height=size, width=size, frames=T, optics=optics)
+    edges = square_edge_points(scene)
+    ok = edges.lit & np.all((edges.dual_uv >= 0) & (edges.dual_uv <= T - 1), axis=1)
+    if optics is not None:
+        ok &= edges.through_optics
+    primal = edge_straightness(edges.camera_xy[ok], labels=edges.label[ok], min_points=5)
+    dual = edge_straightness(edges.dual_uv[ok], labels=edges.label[ok], min_points=5)
+    return primal, dual
+
+
+def test_edges_are_straight_in_both_views_without_optics():
+    primal, dual = _edge_straightness(None, 64)
+    assert np.isfinite(primal.rms).sum() >= 10
+    assert primal.overall_rms < 1e-6 and dual.overall_rms < 1e-6
+
+
+@pytest.mark.parametrize("optics, size, bent_px", [
+    ({"kind": "mirror"}, 256, 1.5),  # measured 2.4 px RMS (max 3.5 px) at 256 px
+    ({"kind": "glass", "shape": "sphere"}, 64, 1.5),  # measured 2.3 px RMS (max 3.9 px)
+])
+def test_optics_bend_edges_in_the_primal_view_but_not_in_the_dual_view(optics, size, bent_px):
+    primal, dual = _edge_straightness(optics, size)
+    assert np.isfinite(primal.rms).sum() >= 8
+    assert primal.overall_rms > bent_px
+    assert dual.overall_rms < 0.05
+
+
+def test_make_scene_selects_optics_and_defaults_to_none():
+    assert make_scene("tabletop", height=8, width=8, frames=4).optics == ()
+    mirror = make_scene("tabletop", height=8, width=8, frames=4, optics={"kind": "mirror"})
+    assert isinstance(mirror.optics[0], SphereMirror)
+    glass = make_scene("tabletop", height=8, width=8, frames=4,
+                       optics={"kind": "glass", "shape": "slab", "index": 1.33})
+    assert isinstance(glass.optics[0], GlassSlab) and glass.optics[0].index == 1.33
+    with pytest.raises(ValueError, match="optics"):
+        make_scene("tabletop", height=8, width=8, frames=4, optics={"kind": "lens"})
+    with pytest.raises(ValueError, match="index"):
+        make_scene("tabletop", height=8, width=8, frames=4, optics={"kind": "glass", "index": 0.5})
+
+
+def test_capture_through_glass_dips_at_the_ground_truth_time():
+    scene = make_scene("tabletop_squares", height=H, width=W, frames=T,
+                       optics={"kind": "glass", "shape": "sphere"})
+    capture = prepare_capture(scene, supersample=1, calibration=False)
+    gt = capture.ground_truth
+    assert capture.homography is None and not gt["dual_cam_visible"].values.any()
+    frames = capture.frames("u").sum(-1)
+    t = gt["t_u"].values
+    good = np.isfinite(t) & (capture.reference.sum(-1) > 1e-3 * capture.reference.sum(-1).max())
+    assert good.sum() > 0.3 * H * W
+    rows, cols = np.nonzero(good)
+    nearest = frames[np.rint(t[good]).astype(int), rows, cols]
+    assert np.all(nearest < 0.5 * capture.reference.sum(-1)[good])
