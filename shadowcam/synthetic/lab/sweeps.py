@@ -335,7 +335,7 @@ def dual_affine(mask, sweep, light=None):
     return np.array([a, b, c])
 
 
-def true_dual_coordinates(points, sweeps, names):
+def true_dual_coordinates(points, sweeps, names, *, light=None):
     """Virtual-image coordinates of points for the sweep pair `names` (Fig. 10, 12).
 
     The virtual camera of two sweeps (a, b) has pixel (row j, col i) centre at
@@ -348,8 +348,9 @@ def true_dual_coordinates(points, sweeps, names):
     ----------
     points : (N, 3) ndarray
     sweeps : dict of str to WireSweep
-        Each sweep carries its light.
     names : (str, str)
+    light : PointLight, AreaLight or DistantLight, optional
+        Light of sweeps that carry none (the scene's light).
 
     Returns
     -------
@@ -359,4 +360,8 @@ def true_dual_coordinates(points, sweeps, names):
     names = tuple(names)
     if len(names) != 2 or any(n not in sweeps for n in names):
         raise ValueError(f"names: expected two of {sorted(sweeps)}, got {names!r}")
-    return np.stack([wire_shadow_time(points, sweeps[n]) for n in names], axis=-1)
+    lights = [light if sweeps[n].light is None else sweeps[n].light for n in names]
+    if any(lt is None for lt in lights):
+        raise ValueError("light: a sweep carries no light; pass the scene's light")
+    return np.stack([wire_shadow_time(points, sweeps[n], lt) for n, lt in zip(names, lights)],
+                    axis=-1)
