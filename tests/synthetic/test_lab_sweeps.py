@@ -218,3 +218,42 @@ def test_distant_light_times_reproject(angle, log_speed):
     assert np.all(np.abs(miss) <= 1e-9 * (1 + np.abs(t) * np.linalg.norm(sweep.velocity)))
     coef = dual_affine(sc.mask, sweep)
     assert np.all(np.isfinite(coef))
+
+
+def test_scene_from_description_selects_the_variants():
+    from shadowcam.synthetic.lab.scene import OrthographicCamera, scene_from_description
+
+    plain = scene_from_description({"scene": "tabletop", "seed": 3, "height": H, "width": W,
+                                    "frames": T, "format": "tiff", "noise": False})
+    default = make_scene("tabletop", seed=3, height=H, width=W, frames=T)
+    assert plain.dual_sweeps is None and plain.sweeps.keys() == default.sweeps.keys()
+    for name in "uv":
+        assert np.array_equal(plain.sweeps[name].p0, default.sweeps[name].p0)
+    varied = scene_from_description({
+        "scene": "tabletop", "seed": 3, "height": H, "width": W, "frames": T,
+        "light": "distant", "camera": "orthographic",
+        "sweeps": [{"name": "u"}, {"name": "v", "angle_deg": 90, "speed": 0.5},
+                   {"name": "w", "angle_deg": 30}],
+        "dual_sweeps": ["u", "w"]})
+    assert isinstance(varied.camera, OrthographicCamera)
+    assert varied.dual_sweeps == ("u", "w")
+    assert varied.sweeps["v"].frames == 2 * T  # half speed: twice the frames
+    assert all(s.light is varied.light for s in varied.sweeps.values())
+    with pytest.raises(ValueError, match="dual_sweeps"):
+        make_scene("tabletop", height=8, width=8, sweeps=[{"name": "u"}], dual_sweeps=("u", "x"))
+    with pytest.raises(ValueError, match="camera_kind"):
+        scene_from_description({"scene": "tabletop", "camera": "fisheye"})
+
+
+def test_single_sweep_capture_uses_the_standard_dual_camera():
+    """A lone (pushbroom) sweep under its own light renders and is timed under that light."""
+    sc = make_scene("tabletop", seed=3, height=16, width=16, frames=T,
+                    sweeps=[{"name": "p", "angle_deg": 10, "light_offset": [0.005, 0, 0]}])
+    assert sc.dual_sweeps is None
+    cap = prepare_capture(sc, supersample=1, calibration=False)
+    assert cap.sweep_names == ("p",)
+    gt = cap.ground_truth
+    lit = gt["lit_p"].values
+    t = wire_shadow_time(gt["P"].values[lit].astype(np.float64), sc.sweeps["p"])
+    np.testing.assert_allclose(gt["t_p_all"].values[lit], t, rtol=1e-6, atol=1e-4)
+    assert cap.frames("p").shape == (sc.sweeps["p"].frames, 16, 16, 3)

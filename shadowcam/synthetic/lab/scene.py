@@ -19,6 +19,8 @@ make_mask_plane, make_wire_sweeps, dual_camera : build them from a light and an 
 wire_shadow_time : analytic time at which a sweep's wire centre line shadows points.
 CAMERA_KINDS : primal camera kinds of the presets (perspective, orthographic).
 Scene, make_scene, calibration_scene, SCENES : a whole scene; presets by name.
+scene_from_description, DESCRIPTION_KEYS : a scene from a capture description (the scene
+    keys of a manifest's ``synthetic:`` block: light, camera, sweeps, ...).
 texture_albedo : evaluate a texture at 2-D texture coordinates.
 yaw_matrix : rotation about +y (local -> world).
 """
@@ -786,8 +788,8 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
         scene's light as default. None = the standard u/v pair (``make_wire_sweeps``).
     dual_sweeps : (str, str), optional
         Names of the sweeps whose times are the reciprocal view's pixel coordinates
-        (``lab.virtual.SweepPairCamera``). Default: None with the standard pair; the first
-        two sweeps otherwise.
+        (``lab.virtual.SweepPairCamera``). Default: None (the standard dual camera) with the
+        standard pair or a single sweep; the first two sweeps otherwise.
 
     Returns
     -------
@@ -810,7 +812,7 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
         from shadowcam.synthetic.lab.sweeps import make_sweeps  # builds on this module
 
         sweep_set = make_sweeps(mask, sweeps, light=light)
-        if dual_sweeps is None:
+        if dual_sweeps is None and len(sweep_set) >= 2:
             dual_sweeps = tuple(sweep_set)[:2]
     if dual_sweeps is not None:
         dual_sweeps = tuple(dual_sweeps)
@@ -819,3 +821,35 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
                              f"{sorted(sweep_set)}, got {dual_sweeps!r}")
     return Scene(name=name, objects=tuple(objects), light=light, camera=camera, mask=mask,
                  sweeps=sweep_set, seed=int(seed), dual_sweeps=dual_sweeps)
+
+
+#: capture-description key -> make_scene argument (the scene part of a ``synthetic:`` block)
+DESCRIPTION_KEYS = {"scene": "name", "seed": "seed", "height": "height", "width": "width",
+                    "frames": "frames", "light": "light_kind", "camera": "camera_kind",
+                    "sweeps": "sweeps", "dual_sweeps": "dual_sweeps"}
+
+
+def scene_from_description(description):
+    """Build the scene a capture description asks for.
+
+    Parameters
+    ----------
+    description : mapping
+        Like a manifest's ``synthetic:`` block: ``scene`` (preset name, required), ``seed``,
+        ``height``, ``width``, ``frames``, ``light`` ({"point", "area", "distant"}),
+        ``camera`` ({"perspective", "orthographic"}), ``sweeps`` (list of sweep specs of
+        ``sweeps.make_sweeps``, e.g. ``{"name": "w", "angle_deg": 30, "speed": 1.0,
+        "light_offset": [0, 0, -0.02]}``), ``dual_sweeps`` (two sweep names). Other keys
+        (frame format, noise, supersample, ...) describe the rendering, not the scene, and
+        are left to the caller. Missing keys take ``make_scene``'s defaults, so a
+        description without light/camera/sweeps gives exactly today's scene.
+
+    Returns
+    -------
+    Scene
+    """
+    if not hasattr(description, "get") or "scene" not in description:
+        raise ValueError("description: expected a mapping with at least a 'scene' key")
+    options = {arg: description[key] for key, arg in DESCRIPTION_KEYS.items()
+               if key in description and description[key] is not None}
+    return make_scene(options.pop("name"), **options)
