@@ -128,7 +128,8 @@ def make_sweeps(mask, specs, *, light=None, radius=None, length=None):
         plane, shifted by this many scene units along the mask normal;
         ``light`` (a light object), ``light_offset`` ((3,) shift of the default point/area
         light along (e_u, e_v, n), scene units) or ``light_direction`` ((3,) toward a
-        distant light); default: `light`.
+        distant light of the default distant light's irradiance, or (2, 2, 2) as the
+        tabletop preset's); default: `light`.
 
         The sweep's middle frame ``(frames - 1) / 2`` passes through the foot of the mask
         origin on its plane; sweep ``{"name": "u"}`` is ``make_wire_sweeps(mask)["u"]``
