@@ -23,17 +23,21 @@ trace_light_paths : cast primary and shadow rays once for a camera, light and ob
 render_image : (rows, cols, 3) image of a view from its light paths.
 sweep_frames : (T, rows, cols, 3) frames of one wire sweep from the light paths
     (optionally with the wire pushed off its plane per frame: non-planar motion).
-pixel_centre_ground_truth : exact per-pixel GT (P, lit, shadow times, cosines, distances).
-plane_homography : camera (col, row) pixel-centre index -> back-plane (x, y) homography.
-render_reciprocal : the reciprocal render (pinhole at the light, point light at the camera).
-CaptureRenderer, prepare_capture : a whole capture (u, v, cal_u, cal_v sweeps, reference,
-    ground-truth xarray Dataset) with sweeps rendered on demand.
+pixel_centre_ground_truth : exact per-pixel GT (P, lit, shadow times, cosines, distances);
+    each sweep's time under the sweep's own light.
+plane_homography : camera (col, row) pixel-centre index -> back-plane (x, y) homography
+    (projective for a pinhole, affine for an orthographic camera).
+render_reciprocal : the reciprocal render (the dual or a virtual sweep-pair camera at the
+    light, the primal camera as a point light, or as a distant light when orthographic).
+CaptureRenderer, prepare_capture : a whole capture (every sweep of the scene, each under its
+    own light, plus cal_<sweep> calibration sweeps, reference, ground-truth xarray Dataset)
+    with sweeps rendered on demand.
 SWEEP_INDEX : sweep name -> index used to seed sensor noise.
 """
 
 import json
 import logging
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import xarray as xr
@@ -96,6 +100,8 @@ def _subpixel_grid(rows, cols, supersample):
 def _view_dirs(camera, points):
     if isinstance(camera, OrthographicCamera):
         return np.broadcast_to(-camera.R[2], points.shape)
+    if callable(getattr(camera, "view_dirs", None)):  # virtual cameras (lab.virtual)
+        return camera.view_dirs(points)
     rel = camera.center - points
     return rel / np.linalg.norm(rel, axis=1, keepdims=True)
 
@@ -230,6 +236,14 @@ def _offset_rate(paths, sweep, mask):
         return (w @ mask.normal) / (w @ sweep.velocity)
 
 
+def _sweep_mask(mask, sweep):
+    """`mask` moved onto the plane the sweep's wire moves in (when it is a parallel plane)."""
+    height = (sweep.p0 - mask.origin) @ mask.normal
+    if abs(height) <= 1e-12 * max(mask.n_u, mask.n_v) * mask.delta:
+        return mask
+    return replace(mask, origin=sweep.p0)
+
+
 def sweep_frames(paths, sweep, mask, *, path_offsets=None):
     """Frames of one wire sweep.
 
@@ -239,8 +253,10 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None):
     Parameters
     ----------
     paths : LightPaths
+        Traced under the sweep's light.
     sweep : WireSweep
     mask : MaskPlane
+        (a sweep moving in a parallel plane uses that plane.)
     path_offsets : (T,) array_like, optional
         Non-planar mask motion: in frame k the wire is displaced by ``path_offsets[k]``
         (scene units) along the mask normal ``n`` (the light's aim direction), i.e. it
@@ -254,6 +270,7 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None):
     """
     n_frames = sweep.frames
     n_pix = paths.shape[0] * paths.shape[1]
+    mask = _sweep_mask(mask, sweep)
     t_c, half = wire_occlusion_interval(paths.points, paths.light, sweep, mask,
                                         distant=paths.distant)
     reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
@@ -318,9 +335,9 @@ def _surface_terms(objects, points, normal, hit, eye_camera, light, to_view=None
         to_light = rel / dist_l[:, None]
     if to_view is None:
         to_view = _view_dirs(eye_camera, points)
-    if dist_c is None:
-        dist_c = (np.full(n, np.inf) if isinstance(eye_camera, OrthographicCamera)
-                  else np.linalg.norm(eye_camera.center - points, axis=1))
+    if dist_c is None:  # infinite for orthographic and virtual (non-pinhole) eye cameras
+        dist_c = (np.linalg.norm(eye_camera.center - points, axis=1)
+                  if isinstance(eye_camera, PinholeCamera) else np.full(n, np.inf))
     with np.errstate(invalid="ignore"):
         cos_l = (normal * to_light).sum(axis=1)
         cos_c = (normal * to_view).sum(axis=1)
@@ -344,10 +361,12 @@ def pixel_centre_ground_truth(objects, camera, light, mask, sweeps, *, optics=()
     Parameters
     ----------
     objects : sequence of scene objects
-    camera : PinholeCamera
+    camera : PinholeCamera or OrthographicCamera
     light : PointLight, AreaLight or DistantLight (area lights use their centre)
     mask : MaskPlane
     sweeps : dict of str to WireSweep
+    sweeps : dict of str to WireSweep
+        A sweep carrying its own light (``WireSweep.light``) is timed under that light.
     optics : sequence of optical elements
         Mirrors / thick glass that bend the primary rays; empty = direct view.
 
@@ -357,8 +376,9 @@ def pixel_centre_ground_truth(objects, camera, light, mask, sweeps, *, optics=()
         ``P``, ``N`` (rows, cols, 3); ``hit``, ``lit`` (rows, cols) bool (lit: faces light and
         camera, light centre visible, wire excluded); ``cos_L``, ``cos_C``, ``dist_L``,
         ``dist_C``, ``depth``; ``object_id``; and for every sweep name s: ``t_<s>``
-        (fractional frame, NaN where not lit, not covered by the finite wire or outside
-        [0, T-1]) and ``t_<s>_all`` (unrestricted).
+        (fractional frame, NaN where not lit by the sweep's light, not covered by the finite
+        wire or outside [0, T-1]) and ``t_<s>_all`` (unrestricted); for a sweep with its own
+        light also ``lit_<s>`` (lit by that light).
     """
     rows, cols = camera.height, camera.width
     x, y = _pixel_centres(camera)
@@ -373,14 +393,20 @@ def pixel_centre_ground_truth(objects, camera, light, mask, sweeps, *, optics=()
     out = {"P": hits.point, "N": hits.normal, "hit": hits.hit, "lit": lit, "cos_L": cos_l,
            "cos_C": cos_c, "dist_L": dist_l, "dist_C": dist_c, "depth": depth,
            "object_id": hits.object_id}
-    distant = isinstance(light, DistantLight)
-    centre = light.direction if distant else light.center
-    light_pts = np.broadcast_to(centre, hits.point.shape)
     for name, sweep in sweeps.items():
-        t_all = wire_shadow_time(hits.point, sweep, light)
-        t_cov, _ = wire_occlusion_interval(np.nan_to_num(hits.point), light_pts, sweep, mask,
-                                           distant=distant)
-        ok = lit & np.isfinite(t_cov) & (t_all >= 0) & (t_all <= sweep.frames - 1)
+        sweep_light, sweep_lit = light, lit
+        if sweep.light is not None and sweep.light is not light:
+            sweep_light = sweep.light
+            sweep_lit = _surface_terms(objects, hits.point, hits.normal, hits.hit, camera,
+                                       sweep_light)[4]
+            out[f"lit_{name}"] = sweep_lit
+        distant = isinstance(sweep_light, DistantLight)
+        centre = sweep_light.direction if distant else sweep_light.center
+        light_pts = np.broadcast_to(centre, hits.point.shape)
+        t_all = wire_shadow_time(hits.point, sweep, sweep_light)
+        t_cov, _ = wire_occlusion_interval(np.nan_to_num(hits.point), light_pts, sweep,
+                                           _sweep_mask(mask, sweep), distant=distant)
+        ok = sweep_lit & np.isfinite(t_cov) & (t_all >= 0) & (t_all <= sweep.frames - 1)
         out[f"t_{name}_all"] = t_all
         out[f"t_{name}"] = np.where(ok, t_all, np.nan)
     return {k: np.asarray(v).reshape(rows, cols, *np.shape(v)[1:]) for k, v in out.items()}
@@ -391,16 +417,19 @@ def plane_homography(camera, plane):
 
     Parameters
     ----------
-    camera : PinholeCamera
+    camera : PinholeCamera or OrthographicCamera
     plane : BackPlane
 
     Returns
     -------
     (3, 3) float64 ndarray
-        ``H`` with ``[x, y, 1] ~ H [col, row, 1]``, normalised so ``H[2, 2] = 1``.
+        ``H`` with ``[x, y, 1] ~ H [col, row, 1]``, normalised so ``H[2, 2] = 1`` (affine, last
+        row (0, 0, 1), for an orthographic camera).
     """
+    if isinstance(camera, OrthographicCamera):
+        return _orthographic_plane_map(camera, plane)
     if not isinstance(camera, PinholeCamera):
-        raise ValueError("camera: the plane homography needs a PinholeCamera")
+        raise ValueError("camera: the plane homography needs a pinhole or orthographic camera")
     shift = np.array([[1.0, 0.0, 0.5], [0.0, 1.0, 0.5], [0.0, 0.0, 1.0]])  # index -> edge
     A = camera.R.T @ np.linalg.inv(camera.K) @ shift  # pixel index -> ray direction
     n, p0, c = plane.normal, plane.center, camera.center
@@ -410,15 +439,56 @@ def plane_homography(camera, plane):
     return H / H[2, 2]
 
 
-def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=()):
+def _orthographic_plane_map(camera, plane):
+    """Affine map camera (col, row) pixel-centre index -> plane (x, y) of an orthographic camera:
+    the ray origin is affine in (col, row) and moves onto the plane along the fixed direction."""
+    d, n, s = camera.R[2], plane.normal, camera.pixel_size
+    if abs(n @ d) < 1e-12:
+        raise ValueError("plane: parallel to the orthographic camera's viewing direction")
+
+    def onto_plane(vector):  # oblique projection along d onto the plane's directions
+        return vector - d * (n @ vector) / (n @ d)
+
+    o0 = (camera.center + (0.5 - camera.width / 2.0) * s * camera.R[0]
+          + (0.5 - camera.height / 2.0) * s * camera.R[1])
+    cols = [onto_plane(s * camera.R[0]), onto_plane(s * camera.R[1]),
+            onto_plane(o0 - plane.center)]
+    return np.array([[plane.axis_x @ c for c in cols], [plane.axis_y @ c for c in cols],
+                     [0.0, 0.0, 1.0]])
+
+
+def _reciprocal_light(camera, strength):
+    """The primal camera as a light: a point light at a pinhole's centre, a distant light
+    toward an orthographic camera."""
+    if isinstance(camera, OrthographicCamera):
+        return DistantLight(-camera.R[2], strength)
+    return PointLight(camera.center, strength)
+
+
+def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(), dual=None):
     """The reciprocal render and the dual-pixel geometry.
 
     The view from the dual camera (``scene.dual_camera``: pinhole at the light centre, or
-    orthographic for a distant light) lit by a point light at the camera centre with the
-    light's intensity (irradiance for a distant light); its pixel grid is the dual grid.
-    The camera's optical elements play no part in it; with `optics` the camera pixel of a
-    dual point has no closed form, so ``dual_cam_visible`` is False and ``dual_cam_xy``
-    NaN everywhere.
+    orthographic for a distant light; or the given virtual camera, e.g.
+    ``lab.virtual.SweepPairCamera`` for skewed or cross-slit views) lit by the primal camera
+    as a light with the light's intensity (irradiance for a distant light): a point light at
+    a pinhole camera's centre, a distant light toward an orthographic camera (Fig. 8). Its
+    pixel grid is the dual grid. The camera's optical elements play no part in it; with
+    `optics` the camera pixel of a dual point has no closed form, so ``dual_cam_visible`` is
+    False and ``dual_cam_xy`` NaN everywhere.
+
+    Parameters
+    ----------
+    objects : sequence of scene objects
+    camera : PinholeCamera or OrthographicCamera
+        The primal camera.
+    light : PointLight, AreaLight or DistantLight
+    mask : MaskPlane
+    supersample : int
+    optics : sequence of optical elements
+        Mirrors / thick glass that bend the primal camera's rays (see above).
+    dual : camera, optional
+        The reciprocal view's camera; default ``dual_camera(mask, light)``.
 
     Returns
     -------
@@ -428,9 +498,9 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=())
         camera centre and projects inside the image); ``dual_cam_xy`` (n_v, n_u, 2) camera
         (col, row) pixel-centre index of dual_P (NaN where not visible).
     """
-    dual = dual_camera(mask, light)
+    dual = dual_camera(mask, light) if dual is None else dual
     strength = light.irradiance if isinstance(light, DistantLight) else light.intensity
-    swapped = PointLight(camera.center, strength)
+    swapped = _reciprocal_light(camera, strength)
     paths = trace_light_paths(objects, dual, swapped, supersample=supersample)
     reciprocal = render_image(paths)
     x, y = _pixel_centres(dual)
@@ -449,45 +519,74 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=())
             "dual_cam_xy": cam_xy.reshape(*shape, 2)}
 
 
-def _geometry_attrs(scene):
-    """JSON description of camera, light, mask plane and sweeps (like meta.json)."""
-    cam, light, mask = scene.camera, scene.light, scene.mask
+def _light_attrs(light):
     light_d = {"type": type(light).__name__}
     for key in ("position", "direction", "intensity", "irradiance", "normal", "size", "shape"):
         if hasattr(light, key):
             value = getattr(light, key)
             light_d[key] = value.tolist() if isinstance(value, np.ndarray) else value
-    return json.dumps({
-        "camera": {"K": cam.K.tolist(), "R_world_to_cam": cam.R.tolist(),
-                   "center": cam.center.tolist(), "width": cam.width, "height": cam.height,
-                   "convention": "X_cam = R (X - center); pixel (row r, col c) centre at "
-                                 "pixel-edge (c + 0.5, r + 0.5)"},
-        "light": light_d,
+    return light_d
+
+
+def _camera_attrs(cam):
+    if isinstance(cam, OrthographicCamera):
+        return {"type": "orthographic", "R_world_to_cam": cam.R.tolist(),
+                "center": cam.center.tolist(), "pixel_size": cam.pixel_size,
+                "width": cam.width, "height": cam.height,
+                "convention": "pixel-edge (x, y) -> ray origin center + (x - width/2) "
+                              "pixel_size R[0] + (y - height/2) pixel_size R[1], direction "
+                              "R[2]; pixel (row r, col c) centre at pixel-edge (c + 0.5, r + 0.5)"}
+    return {"K": cam.K.tolist(), "R_world_to_cam": cam.R.tolist(),
+            "center": cam.center.tolist(), "width": cam.width, "height": cam.height,
+            "convention": "X_cam = R (X - center); pixel (row r, col c) centre at "
+                          "pixel-edge (c + 0.5, r + 0.5)"}
+
+
+def _sweep_attrs(sweep):
+    attrs = {"p0": sweep.p0.tolist(), "v": sweep.velocity.tolist(),
+             "d": sweep.direction.tolist(), "frames": sweep.frames, "radius": sweep.radius,
+             "length": sweep.length}
+    if sweep.light is not None:
+        attrs["light"] = _light_attrs(sweep.light)
+    return attrs
+
+
+def _geometry_attrs(scene):
+    """JSON description of camera, light, mask plane and sweeps (like meta.json)."""
+    mask = scene.mask
+    geometry = {
+        "camera": _camera_attrs(scene.camera),
+        "light": _light_attrs(scene.light),
         "mask_plane": {"M0": mask.origin.tolist(), "n": mask.normal.tolist(),
                        "e_u": mask.e_u.tolist(), "e_v": mask.e_v.tolist(),
                        "delta": mask.delta, "N_u": mask.n_u, "N_v": mask.n_v,
                        "f_light_to_mask_plane": mask.focal},
-        "sweeps": {k: {"p0": s.p0.tolist(), "v": s.velocity.tolist(),
-                       "d": s.direction.tolist(), "frames": s.frames, "radius": s.radius,
-                       "length": s.length} for k, s in scene.sweeps.items()},
-    })
+        "sweeps": {k: _sweep_attrs(s) for k, s in scene.sweeps.items()},
+    }
+    if scene.dual_sweeps is not None:
+        geometry["dual_sweeps"] = list(scene.dual_sweeps)
+    return json.dumps(geometry)
+
+
+def _sweep_light(scene, name):
+    sweep = scene.sweeps[name]
+    return scene.light if sweep.light is None else sweep.light
 
 
 class CaptureRenderer:
     """A rendered capture: reference, ground truth, and sweeps rendered on demand.
 
     Build it with ``prepare_capture``. ``frames(name)`` returns the (T, rows, cols, 3)
-    float32 linear frames of sweep ``u``, ``v``, ``cal_u`` or ``cal_v``.
+    float32 linear frames of sweep `name` (every sweep of the scene, e.g. ``u``, ``v``, and
+    the calibration sweeps ``cal_<sweep>``), each under the sweep's own light.
     """
 
-    def __init__(self, scene, paths, cal_paths, reference, ground_truth, homography):
+    def __init__(self, scene, sweep_paths, reference, ground_truth, homography):
         self.scene = scene
         self.reference = reference
         self.ground_truth = ground_truth
         self.homography = homography
-        self._paths = {"u": paths, "v": paths}
-        if cal_paths is not None:
-            self._paths.update(cal_u=cal_paths, cal_v=cal_paths)
+        self._paths = dict(sweep_paths)
 
     @property
     def sweep_names(self):
@@ -504,42 +603,81 @@ class CaptureRenderer:
                             path_offsets=path_offsets)
 
 
+def _trace_per_light(objects, camera, scene, names, supersample, prefix=""):
+    """LightPaths of each sweep, traced once per distinct light (sweep name -> paths);
+    the camera rays are bent by the scene's optics."""
+    by_light = {}
+    out = {}
+    for name in names:
+        light = _sweep_light(scene, name)
+        if id(light) not in by_light:
+            by_light[id(light)] = trace_light_paths(objects, camera, light,
+                                                    supersample=supersample,
+                                                    optics=scene.optics)
+        out[prefix + name] = by_light[id(light)]
+    return out
+
+
 def prepare_capture(scene, *, supersample=4, calibration=True):
     """Cast the static rays of a capture and compute its exact ground truth.
 
     Parameters
     ----------
     scene : Scene
+        Its camera may be a pinhole or orthographic; each sweep is rendered and timed under
+        its own light (``WireSweep.light``, default the scene's light).
     supersample : int
         Sub-samples per pixel side for the camera and the reciprocal renders.
     calibration : bool
-        Also prepare the calibration sweeps ``cal_u``, ``cal_v`` over the scene's back
-        plane alone.
+        Also prepare the calibration sweeps ``cal_<sweep>`` over the scene's back plane alone.
 
     Returns
     -------
     CaptureRenderer
-        With ``reference`` (rows, cols, 3) float32, ``ground_truth`` (xarray.Dataset, the
-        standard GT names of docs/contracts.md plus P, N, cosines, distances, calibration
-        GT) and ``homography`` ((3, 3), or None without calibration or when the scene's
-        optics bend the camera rays, which leaves no plane homography).
+        With ``reference`` (rows, cols, 3) float32 (under the scene's light),
+        ``ground_truth`` (xarray.Dataset, the standard GT names of docs/contracts.md plus
+        P, N, cosines, distances, calibration GT; ``t_<sweep>`` for every sweep, ``lit_<sweep>``
+        for a sweep with its own light; the reciprocal render on the (u, v) grid of the dual
+        camera, or of ``lab.virtual.SweepPairCamera`` of ``scene.dual_sweeps`` with
+        u = t_a, v = t_b) and ``homography`` ((3, 3), or None without calibration or when
+        the scene's optics bend the camera rays, which leaves no plane homography).
     """
     cam, light, mask, optics = scene.camera, scene.light, scene.mask, scene.optics
-    paths = trace_light_paths(scene.objects, cam, light, supersample=supersample,
-                              optics=optics)
-    reference = render_image(paths)
-    log.info("traced %d light paths for %dx%d pixels", len(paths.pixel), cam.height, cam.width)
+    names = tuple(scene.sweeps)
+    sweep_paths = _trace_per_light(scene.objects, cam, scene, names, supersample)
+    scene_paths = next((p for n, p in sweep_paths.items() if _sweep_light(scene, n) is light),
+                       None)
+    if scene_paths is None:
+        scene_paths = trace_light_paths(scene.objects, cam, light, supersample=supersample,
+                                        optics=optics)
+    reference = render_image(scene_paths)
+    log.info("traced %d light paths for %dx%d pixels", len(scene_paths.pixel), cam.height,
+             cam.width)
     gt = pixel_centre_ground_truth(scene.objects, cam, light, mask, scene.sweeps,
                                    optics=optics)
+    dual = None
+    recip_name = "reciprocal render: pinhole at the light, point light at the camera"
+    if scene.dual_sweeps is not None:
+        from shadowcam.synthetic.lab.virtual import sweep_pair_camera  # builds on scene, sweeps
+
+        dual = sweep_pair_camera(scene.sweeps, scene.dual_sweeps, light=light)
+        recip_name = ("reciprocal render: virtual camera of sweeps {} (u) and {} (v), the "
+                      "camera as a light").format(*scene.dual_sweeps)
     recip = render_reciprocal(scene.objects, cam, light, mask, supersample=supersample,
-                              optics=optics)
+                              optics=optics, dual=dual)
+    n_v, n_u = recip["dual_hit"].shape
     f32 = np.float32
     rc, vu = ("row", "col"), ("v", "u")
-    data = {
-        "t_u": (rc, gt["t_u"].astype(f32), "frame", "analytic shadow time of sweep u (dual u)"),
-        "t_v": (rc, gt["t_v"].astype(f32), "frame", "analytic shadow time of sweep v (dual v)"),
-        "t_u_all": (rc, gt["t_u_all"].astype(f32), "frame", "t_u without lit/range limits"),
-        "t_v_all": (rc, gt["t_v_all"].astype(f32), "frame", "t_v without lit/range limits"),
+
+    def time_long_name(name):
+        dual_axis = f" (dual {name})" if name in ("u", "v") else ""
+        return f"analytic shadow time of sweep {name}{dual_axis}"
+
+    data = {f"t_{n}": (rc, gt[f"t_{n}"].astype(f32), "frame", time_long_name(n))
+            for n in names}
+    data.update({f"t_{n}_all": (rc, gt[f"t_{n}_all"].astype(f32), "frame",
+                                f"t_{n} without lit/range limits") for n in names})
+    data.update({
         "lit": (rc, gt["lit"], "1", "pixel-centre point faces light and camera, light visible"),
         "hit": (rc, gt["hit"], "1", "pixel-centre ray hits geometry"),
         "P": (rc + ("xyz",), gt["P"].astype(f32), "scene_unit", "world point at pixel centre"),
@@ -551,31 +689,31 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
         "dist_C": (rc, gt["dist_C"].astype(f32), "scene_unit", "distance P to camera centre"),
         "reference_linear": (rc + ("channel",), reference, "radiance",
                              "linear render without the wire"),
-        "reciprocal": (vu + ("channel",), recip["reciprocal"], "radiance",
-                       "reciprocal render: pinhole at the light, point light at the camera"),
+        "reciprocal": (vu + ("channel",), recip["reciprocal"], "radiance", recip_name),
         "dual_P": (vu + ("xyz",), recip["dual_P"].astype(f32), "scene_unit",
                    "world point at dual pixel centre"),
         "dual_cam_visible": (vu, recip["dual_cam_visible"], "1",
                              "dual_P visible from the camera centre and inside the image"),
         "dual_cam_xy": (vu + ("cam_xy",), recip["dual_cam_xy"].astype(f32), "pixel",
                         "camera (col, row) pixel-centre index of dual_P"),
-    }
+    })
+    data.update({f"lit_{n}": (rc, gt[f"lit_{n}"], "1",
+                              f"pixel-centre point faces the light of sweep {n}, light visible")
+                 for n in names if f"lit_{n}" in gt})
     homography = None
-    cal_paths = None
     if calibration:
         cal = calibration_scene(scene)
-        cal_paths = trace_light_paths(cal.objects, cam, light, supersample=supersample,
-                                      optics=optics)
+        sweep_paths.update(_trace_per_light(cal.objects, cam, scene, names, supersample,
+                                            prefix="cal_"))
         cgt = pixel_centre_ground_truth(cal.objects, cam, light, mask, scene.sweeps,
                                         optics=optics)
         plane = cal.back_plane
         homography = None if optics else plane_homography(cam, plane)
         xy = plane.plane_coords(cgt["P"].reshape(-1, 3)).reshape(cam.height, cam.width, 2)
+        data.update({f"t_cal_{n}": (rc, cgt[f"t_{n}"].astype(f32), "frame",
+                                    f"analytic shadow time of calibration sweep cal_{n}")
+                     for n in names})
         data.update({
-            "t_cal_u": (rc, cgt["t_u"].astype(f32), "frame",
-                        "analytic shadow time of calibration sweep cal_u"),
-            "t_cal_v": (rc, cgt["t_v"].astype(f32), "frame",
-                        "analytic shadow time of calibration sweep cal_v"),
             "plane_xy": (rc + ("plane_axis",), xy.astype(f32), "scene_unit",
                          "back-plane coordinates (x, y) at pixel centre (calibration scene)"),
         })
@@ -583,18 +721,22 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
             data["calibration_homography"] = (
                 ("h_row", "h_col"), homography, "1",
                 "camera (col, row) pixel-centre index -> plane (x, y)")
+    attrs = {"scene": scene.name, "seed": scene.seed, "supersample": int(supersample),
+             "geometry": _geometry_attrs(scene),
+             "convention": "arrays indexed [row, col] at pixel centres; dual pixel "
+                           "(row j, col i) centre <-> u = i, v = j"}
+    if scene.dual_sweeps is not None:
+        attrs["dual_sweeps"] = "u = t_{}, v = t_{}".format(*scene.dual_sweeps)
     ds = xr.Dataset(
         {k: (dims, val, {"units": units, "long_name": name})
          for k, (dims, val, units, name) in data.items()},
         coords={"row": np.arange(cam.height), "col": np.arange(cam.width),
-                "u": np.arange(mask.n_u, dtype=np.float64),
-                "v": np.arange(mask.n_v, dtype=np.float64),
+                "u": np.arange(n_u, dtype=np.float64),
+                "v": np.arange(n_v, dtype=np.float64),
                 "channel": ["R", "G", "B"], "xyz": ["x", "y", "z"]},
-        attrs={"scene": scene.name, "seed": scene.seed, "supersample": int(supersample),
-               "geometry": _geometry_attrs(scene),
-               "convention": "arrays indexed [row, col] at pixel centres; dual pixel "
-                             "(row j, col i) centre <-> u = i, v = j"},
+        attrs=attrs,
     )
-    ds["u"].attrs.update(units="dual_pixel", long_name="dual column (u = t_u)")
-    ds["v"].attrs.update(units="dual_pixel", long_name="dual row (v = t_v)")
-    return CaptureRenderer(scene, paths, cal_paths, reference, ds, homography)
+    dual_names = scene.dual_sweeps or ("u", "v")
+    ds["u"].attrs.update(units="dual_pixel", long_name=f"dual column (u = t_{dual_names[0]})")
+    ds["v"].attrs.update(units="dual_pixel", long_name=f"dual row (v = t_{dual_names[1]})")
+    return CaptureRenderer(scene, sweep_paths, reference, ds, homography)

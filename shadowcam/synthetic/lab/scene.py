@@ -14,10 +14,14 @@ Sphere, Box, GroundPlane, BackPlane : scene objects (box yawed about +y; ground 
 PointLight, DistantLight, AreaLight : lights; ``light_samples`` gives their stratified samples.
 PinholeCamera, OrthographicCamera : cameras; ``look_at_camera`` builds a pinhole.
 camera_rays, project : pixel-edge coordinates <-> world rays / points.
-MaskPlane, WireSweep : the mask plane and the wire sweeps u, v (README 1.3).
+MaskPlane, WireSweep : the mask plane and the wire sweeps u, v (README 1.3); a sweep may
+    carry its own light (general sweeps: ``shadowcam.synthetic.lab.sweeps``).
 make_mask_plane, make_wire_sweeps, dual_camera : build them from a light and an aim point.
 wire_shadow_time : analytic time at which a sweep's wire centre line shadows points.
+CAMERA_KINDS : primal camera kinds of the presets (perspective, orthographic).
 Scene, make_scene, calibration_scene, SCENES : a whole scene; presets by name.
+scene_from_description, DESCRIPTION_KEYS : a scene from a capture description (the scene
+    keys of a manifest's ``synthetic:`` block: light, camera, sweeps, ...).
 texture_albedo : evaluate a texture at 2-D texture coordinates.
 yaw_matrix : rotation about +y (local -> world).
 """
@@ -475,6 +479,8 @@ def camera_rays(camera, x, y):
         o = (camera.center + ((x - camera.width / 2.0) * s)[:, None] * camera.R[0]
              + ((y - camera.height / 2.0) * s)[:, None] * camera.R[1])
         return o, np.broadcast_to(camera.R[2], o.shape).copy()
+    if callable(getattr(camera, "rays", None)):  # virtual cameras (lab.virtual)
+        return camera.rays(x, y)
     raise ValueError(f"camera: unsupported camera type {type(camera).__name__}")
 
 
@@ -491,6 +497,8 @@ def project(camera, points):
         cam = (points - camera.center) @ camera.R.T
         xy = cam[:, :2] / camera.pixel_size + np.array([camera.width, camera.height]) / 2.0
         return xy, cam[:, 2]
+    if callable(getattr(camera, "project", None)):  # virtual cameras (lab.virtual)
+        return camera.project(points)
     raise ValueError(f"camera: unsupported camera type {type(camera).__name__}")
 
 
@@ -523,7 +531,12 @@ class MaskPlane:
 
 @dataclass(frozen=True, eq=False)
 class WireSweep:
-    """One wire sweep: centre line ``p(t) = p0 + t velocity``, axis `direction`, t = 0..frames-1."""
+    """One wire sweep: centre line ``p(t) = p0 + t velocity``, axis `direction`, t = 0..frames-1.
+
+    `velocity` is perpendicular to `direction`; both lie in the plane the wire moves in
+    (normal = the mask normal). `light` is the light the sweep is captured under (None = the
+    scene's light).
+    """
 
     axis: str
     p0: np.ndarray
@@ -532,6 +545,7 @@ class WireSweep:
     frames: int
     radius: float
     length: float
+    light: object = None
 
 
 def make_mask_plane(light, *, target, frames, f=0.045, fov_deg=44.0, extent=None, up=UP):
@@ -629,7 +643,7 @@ def dual_camera(mask, light):
     return PinholeCamera(K=K, R=R, center=light.center, width=mask.n_u, height=mask.n_v)
 
 
-def wire_shadow_time(points, sweep, light):
+def wire_shadow_time(points, sweep, light=None):
     """Analytic time at which the wire centre line shadows each point (README 1.3).
 
     ``t = -(P - L).(d x (p0 - L)) / ((P - L).(d x v))`` for a light centre L; for a
@@ -639,14 +653,17 @@ def wire_shadow_time(points, sweep, light):
     ----------
     points : (N, 3) ndarray
     sweep : WireSweep
-    light : PointLight, AreaLight or DistantLight
-        Area lights use their centre.
+    light : PointLight, AreaLight or DistantLight, optional
+        Area lights use their centre. Default: the sweep's own light (``sweep.light``).
 
     Returns
     -------
     (N,) float64 ndarray
         Fractional frame (not restricted to [0, frames-1]; NaN where undefined).
     """
+    light = sweep.light if light is None else light
+    if light is None:
+        raise ValueError("light: the sweep carries no light; pass one")
     points = np.asarray(points, dtype=np.float64)
     d, v = sweep.direction, sweep.velocity
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -666,6 +683,9 @@ class Scene:
 
     `optics` holds optical elements (``optics.OPTICAL_ELEMENTS``: mirrors, thick glass) that
     bend the camera's primary rays only; empty = the camera sees the scene directly.
+    `dual_sweeps` names the two sweeps whose shadow times are the pixel coordinates of the
+    reciprocal (virtual) view (``lab.virtual.SweepPairCamera``); None = the standard dual
+    camera of the mask plane (``dual_camera``).
     """
 
     name: str
@@ -676,6 +696,7 @@ class Scene:
     sweeps: dict
     seed: int = 0
     optics: tuple = ()
+    dual_sweeps: tuple = None
 
     @property
     def back_plane(self):
@@ -691,7 +712,19 @@ def calibration_scene(scene):
     return replace(scene, name=f"{scene.name}_calibration", objects=(plane,))
 
 
-def _tabletop(*, seed, height, width, frames, light_kind, back_texture="discs"):
+#: primal camera kinds of the presets
+CAMERA_KINDS = ("perspective", "orthographic")
+
+
+def _orthographic_like(camera, distance):
+    """Orthographic camera with the pinhole's pose whose field matches it at `distance`."""
+    pixel_size = distance / camera.K[0, 0]
+    return OrthographicCamera(R=camera.R, center=camera.center, pixel_size=pixel_size,
+                              width=camera.width, height=camera.height)
+
+
+def _tabletop(*, seed, height, width, frames, light_kind, camera_kind="perspective",
+              back_texture="discs"):
     rng = np.random.default_rng([seed, 1234])
     jit = lambda s: rng.uniform(-s, s)  # noqa: E731
     ground_y = -0.05
@@ -716,6 +749,10 @@ def _tabletop(*, seed, height, width, frames, light_kind, back_texture="discs"):
                              Material(texture=tex_back)))
     camera = look_at_camera((0.03, 0.085, 0.3), (0.0, -0.02, -0.03), fov_x_deg=42.0,
                             width=width, height=height)
+    if camera_kind == "orthographic":
+        camera = _orthographic_like(camera, distance=0.33)
+    elif camera_kind != "perspective":
+        raise ValueError(f"camera_kind: must be one of {CAMERA_KINDS}, got {camera_kind!r}")
     aim = np.array([-0.005, -0.02, -0.02])
     light_pos = camera.center + np.array([-0.09, -0.045, 0.035])
     intensity = (0.02, 0.02, 0.02)
@@ -738,12 +775,12 @@ def _tabletop_squares(**options):
     return _tabletop(**options, back_texture="squares")
 
 
-#: preset scene name -> builder(seed, height, width, frames, light_kind)
+#: preset scene name -> builder(seed, height, width, frames, light_kind, camera_kind)
 SCENES = {"tabletop": _tabletop, "tabletop_squares": _tabletop_squares}
 
 
 def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="point",
-               optics=None):
+               camera_kind="perspective", sweeps=None, dual_sweeps=None, optics=None):
     """Build a preset scene.
 
     Parameters
@@ -758,13 +795,25 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     height, width : int
         Camera image size (rows, cols).
     frames : int
-        Frames per sweep (= dual grid size).
+        Frames per sweep of the standard pair (= dual grid size).
     light_kind : {"point", "area", "distant"}
+    camera_kind : {"perspective", "orthographic"}
+        Primal camera: the preset's pinhole, or an orthographic camera with its pose
+        (Fig. 8: orthographic primal view, perspective dual view).
+    sweeps : sequence of dict, optional
+        Sweep specifications for ``sweeps.make_sweeps`` (wire angle, motion, speed, frames,
+        plane offset, own light or light offset), built on the scene's mask plane with the
+        scene's light as default. None = the standard u/v pair (``make_wire_sweeps``).
+    dual_sweeps : (str, str), optional
+        Names of the sweeps whose times are the reciprocal view's pixel coordinates
+        (``lab.virtual.SweepPairCamera``). Default: None (the standard dual camera) with the
+        standard pair or a single sweep; the first two sweeps otherwise.
     optics : dict, optional
         Optical elements on the camera side (paper section V), e.g. ``{"kind": "mirror"}``
         (the camera looks at the scene in a convex spherical mirror) or
         ``{"kind": "glass", "shape": "slab", "index": 1.5}``; the other keys are the options
-        of ``optics.mirror_setup`` / ``optics.glass_setup``. None = direct view.
+        of ``optics.mirror_setup`` / ``optics.glass_setup`` (which need the perspective
+        camera). None = direct view.
 
     Returns
     -------
@@ -774,13 +823,64 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     for key, value in (("height", height), ("width", width)):
         if int(value) < 2 or int(value) % 2:
             raise ValueError(f"{key}: must be an even number >= 2, got {value}")
+    if camera_kind not in CAMERA_KINDS:
+        raise ValueError(f"camera_kind: must be one of {CAMERA_KINDS}, got {camera_kind!r}")
+    builder_options = {} if camera_kind == "perspective" else {"camera_kind": camera_kind}
     objects, light, camera, mask = SCENES[name](seed=int(seed), height=int(height),
                                                 width=int(width), frames=int(frames),
-                                                light_kind=light_kind)
+                                                light_kind=light_kind, **builder_options)
+    if sweeps is None:
+        sweep_set = make_wire_sweeps(mask)
+    else:
+        from shadowcam.synthetic.lab.sweeps import make_sweeps  # builds on this module
+
+        sweep_set = make_sweeps(mask, sweeps, light=light)
+        if dual_sweeps is None and len(sweep_set) >= 2:
+            dual_sweeps = tuple(sweep_set)[:2]
+    if dual_sweeps is not None:
+        dual_sweeps = tuple(dual_sweeps)
+        if len(dual_sweeps) != 2 or any(k not in sweep_set for k in dual_sweeps):
+            raise ValueError(f"dual_sweeps: expected two of the sweep names "
+                             f"{sorted(sweep_set)}, got {dual_sweeps!r}")
     elements = ()
     if optics is not None:
         from shadowcam.synthetic.lab.optics import optics_setup  # optics builds on scene
 
         camera, elements = optics_setup(optics, camera)
     return Scene(name=name, objects=tuple(objects), light=light, camera=camera, mask=mask,
-                 sweeps=make_wire_sweeps(mask), seed=int(seed), optics=tuple(elements))
+                 sweeps=sweep_set, seed=int(seed), optics=tuple(elements),
+                 dual_sweeps=dual_sweeps)
+
+
+#: capture-description key -> make_scene argument (the scene part of a ``synthetic:`` block)
+DESCRIPTION_KEYS = {"scene": "name", "seed": "seed", "height": "height", "width": "width",
+                    "frames": "frames", "light": "light_kind", "camera": "camera_kind",
+                    "sweeps": "sweeps", "dual_sweeps": "dual_sweeps", "optics": "optics"}
+
+
+def scene_from_description(description):
+    """Build the scene a capture description asks for.
+
+    Parameters
+    ----------
+    description : mapping
+        Like a manifest's ``synthetic:`` block: ``scene`` (preset name, required), ``seed``,
+        ``height``, ``width``, ``frames``, ``light`` ({"point", "area", "distant"}),
+        ``camera`` ({"perspective", "orthographic"}), ``sweeps`` (list of sweep specs of
+        ``sweeps.make_sweeps``, e.g. ``{"name": "w", "angle_deg": 30, "speed": 1.0,
+        "light_offset": [0, 0, -0.02]}``), ``dual_sweeps`` (two sweep names), ``optics``
+        (optical elements, e.g. ``{"kind": "glass", "shape": "slab", "index": 1.5}``; see
+        ``make_scene``). Other keys
+        (frame format, noise, supersample, ...) describe the rendering, not the scene, and
+        are left to the caller. Missing keys take ``make_scene``'s defaults, so a
+        description without light/camera/sweeps gives exactly today's scene.
+
+    Returns
+    -------
+    Scene
+    """
+    if not hasattr(description, "get") or "scene" not in description:
+        raise ValueError("description: expected a mapping with at least a 'scene' key")
+    options = {arg: description[key] for key, arg in DESCRIPTION_KEYS.items()
+               if key in description and description[key] is not None}
+    return make_scene(options.pop("name"), **options)
