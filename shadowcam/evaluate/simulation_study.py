@@ -43,7 +43,8 @@ from shadowcam.lab.accuracy import dual_coord_errors, dual_image_errors, shadow_
 from shadowcam.cameras.dual_coords import dual_coords_uniform
 from shadowcam.cameras.dual_view import resample_dual_view
 from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
-from shadowcam.synthetic.lab.scene import AreaLight, make_scene, make_wire_sweeps
+from shadowcam.synthetic.lab.scene import AreaLight, make_wire_sweeps
+from shadowcam.synthetic.lab.scenes import make_scene
 from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
 from shadowcam.lab.shadow_time import sweep_shadow_times
 
@@ -160,7 +161,7 @@ def simulate_setting(setting, *, scene="tabletop", size=64, supersample=2, seed=
     ----------
     setting : StudySetting
     scene : str, keyword-only
-        Preset of :data:`shadowcam.synthetic.lab.scene.SCENES`.
+        Preset of :data:`shadowcam.synthetic.lab.scenes.SCENES`.
     size : int
         Camera rows = cols (even).
     supersample : int

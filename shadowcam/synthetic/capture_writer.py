@@ -131,7 +131,7 @@ def write_capture(options, out_dir):
 def write_lab_capture(options, out_dir):
     """Render the lab capture described by `options` into `out_dir` (see :func:`write_capture`)."""
     from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
-    from shadowcam.synthetic.lab.scene import make_scene
+    from shadowcam.synthetic.lab.scenes import make_scene
     from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     started = time.perf_counter()

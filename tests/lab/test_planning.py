@@ -19,8 +19,10 @@ import pytest
 from shadowcam.cli import main
 from shadowcam.synthetic.lab.render import prepare_capture
 from shadowcam.lab.planning import dual_resolution_ratio, mask_speed_for_ratio, plan_capture
-from shadowcam.synthetic.lab.scene import (BackPlane, Material, PointLight, Scene, look_at_camera,
-                             make_mask_plane, make_wire_sweeps)
+from shadowcam.synthetic.lab.scene import (
+    BackPlane, Material, PointLight, look_at_camera, make_mask_plane, make_wire_sweeps,
+)
+from shadowcam.synthetic.lab.scenes import Scene
 from shadowcam.lab.shadow_time import sweep_shadow_times
 
 SIZE = 64

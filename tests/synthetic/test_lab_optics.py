@@ -18,7 +18,8 @@ from shadowcam.synthetic.lab.optics import (
     trace_through_optics,
 )
 from shadowcam.synthetic.lab.render import pixel_centre_ground_truth, prepare_capture
-from shadowcam.synthetic.lab.scene import PinholeCamera, make_scene
+from shadowcam.synthetic.lab.scene import PinholeCamera
+from shadowcam.synthetic.lab.scenes import make_scene
 
 H = W = 32
 T = 24

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from shadowcam.synthetic.lab.render import pixel_centre_ground_truth, prepare_capture
-from shadowcam.synthetic.lab.scene import make_scene
+from shadowcam.synthetic.lab.scenes import make_scene
 from shadowcam.synthetic.lab.sweeps import dual_affine
 
 H = W = 32

@@ -11,7 +11,8 @@ import xarray as xr
 
 from shadowcam.synthetic.lab.render import prepare_capture, render_image, trace_light_paths
 from shadowcam.synthetic.lab.raycast import intersect_scene
-from shadowcam.synthetic.lab.scene import camera_rays, make_scene
+from shadowcam.synthetic.lab.scene import camera_rays
+from shadowcam.synthetic.lab.scenes import make_scene
 
 H = W = 64
 T = 32

@@ -4,22 +4,15 @@ import numpy as np
 import pytest
 
 from shadowcam.synthetic.lab.scene import (
-    AreaLight,
-    BackPlane,
-    DistantLight,
-    PointLight,
-    camera_rays,
-    dual_camera,
-    look_at_camera,
-    make_mask_plane,
-    make_scene,
-    make_wire_sweeps,
-    project,
-    light_samples,
-    wire_shadow_time,
-    texture_albedo,
-    Texture,
+
+    AreaLight, BackPlane, DistantLight, PointLight, camera_rays, dual_camera, look_at_camera,
+
+    make_mask_plane, make_wire_sweeps, project, light_samples, wire_shadow_time,
+
+    texture_albedo, Texture,
+
 )
+from shadowcam.synthetic.lab.scenes import make_scene
 
 
 def test_camera_rays_reproject_to_their_pixel():

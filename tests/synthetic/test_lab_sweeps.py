@@ -13,7 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from shadowcam.synthetic.lab.render import pixel_centre_ground_truth, prepare_capture
-from shadowcam.synthetic.lab.scene import make_scene, make_wire_sweeps, wire_shadow_time
+from shadowcam.synthetic.lab.scene import make_wire_sweeps, wire_shadow_time
+from shadowcam.synthetic.lab.scenes import make_scene
 from shadowcam.synthetic.lab.sweeps import (
     dual_affine,
     make_sweeps,
@@ -221,7 +222,8 @@ def test_distant_light_times_reproject(angle, log_speed):
 
 
 def test_scene_from_description_selects_the_variants():
-    from shadowcam.synthetic.lab.scene import OrthographicCamera, scene_from_description
+    from shadowcam.synthetic.lab.scene import OrthographicCamera
+    from shadowcam.synthetic.lab.scenes import scene_from_description
 
     plain = scene_from_description({"scene": "tabletop", "seed": 3, "height": H, "width": W,
                                     "frames": T, "format": "tiff", "noise": False})

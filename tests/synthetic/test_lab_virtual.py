@@ -15,14 +15,9 @@ from shadowcam.synthetic.lab.render import (
     render_reciprocal,
 )
 from shadowcam.synthetic.lab.scene import (
-    Box,
-    OrthographicCamera,
-    PinholeCamera,
-    Sphere,
-    camera_rays,
-    dual_camera,
-    make_scene,
+    Box, OrthographicCamera, PinholeCamera, Sphere, camera_rays, dual_camera,
 )
+from shadowcam.synthetic.lab.scenes import make_scene
 from shadowcam.synthetic.lab.sweeps import make_sweeps, true_dual_coordinates
 from shadowcam.synthetic.lab.virtual import sweep_pair_camera
 

@@ -125,7 +125,7 @@ def square_edge_points(scene, *, step=0.25, iterations=48):
 
     Parameters
     ----------
-    scene : scene.Scene
+    scene : scenes.Scene
         Its back plane must carry a ``squares`` texture (e.g. preset ``tabletop_squares``);
         its optics (if any) bend the camera rays.
     step : float

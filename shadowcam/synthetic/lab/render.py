@@ -45,17 +45,10 @@ import xarray as xr
 from shadowcam.synthetic.lab.optics import intersect_through_optics
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_scene, occluded, wire_occlusion_interval
 from shadowcam.synthetic.lab.scene import (
-    DistantLight,
-    OrthographicCamera,
-    PinholeCamera,
-    PointLight,
-    calibration_scene,
-    camera_rays,
-    dual_camera,
-    light_samples,
-    project,
-    wire_shadow_time,
+    DistantLight, OrthographicCamera, PinholeCamera, PointLight, camera_rays, dual_camera,
+    light_samples, project, wire_shadow_time,
 )
+from shadowcam.synthetic.lab.scenes import calibration_scene
 
 log = logging.getLogger(__name__)
 
