@@ -153,8 +153,9 @@ def format_ldt(table, *, name="shadowcam light field"):
     check_positive(flux, "table flux")
     header = ["shadowcam", "1", "0", str(c.size), f"{dc:g}", str(gamma.size), f"{dg:g}",
               "shadowcam light field", name, "1", "source.ldt", "shadowcam",
-              "0", "0", "0", "0", "0", "0", "0", "0", "0", "0",
-              "100", "100", "1", "0", "1", "1", "light-field capture", f"{flux:.6g}", "0", "0", "0"]
+              "0", "0", "0", "0", "0", "0", "0", "0", "0",  # dimensions and luminous-area heights, mm
+              "100", "100", "1", "0", "1", "1",  # DFF %, LORL %, conversion factor, tilt, lamp sets, lamps
+              "light-field capture", f"{flux:.6g}", "0", "0", "0"]  # lamp type, flux lm, CCT, CRI, W
     header += ["0"] * 10
     body = [f"{v:g}" for v in c] + [f"{v:g}" for v in gamma]
     body += [f"{v:.6g}" for v in (values * 1000.0 / flux).ravel()]

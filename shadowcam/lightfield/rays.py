@@ -24,6 +24,7 @@ write_rays : the rays dataset as a netCDF file (h5netcdf), atomically.
 import numpy as np
 import xarray as xr
 from scipy.interpolate import LinearNDInterpolator
+from scipy.ndimage import distance_transform_edt
 
 from shadowcam._shared.atomic import atomic_path
 from shadowcam._shared.validation import check_positive, check_same_shape
@@ -125,8 +126,9 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
         On the near screen's pixel grid ``(row, col)``: ``origin`` and ``direction``
         ``(row, col, axis)`` (mm; direction with unit z), ``irradiance`` (lux at the near
         screen), ``flux`` (lm through the pixel), ``mask`` ``(row, col, mask_axis)`` mm,
-        ``confidence`` in [0, 1] and ``flag`` (:data:`REASONS`). Rays that are not
-        found are NaN.
+        ``confidence`` in [0, 1] and ``flag`` (:data:`REASONS`). A pixel whose ray is not
+        found (flag > 0, confidence 0) keeps its flux and takes the direction of the
+        nearest found ray; its ``mask`` is NaN.
     """
     z1, z2 = near["position_mm"], far["position_mm"]
     if not z2 > z1:
@@ -150,9 +152,12 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
     x1 = near["xy"]
     origin = np.concatenate([x1, np.full(shape + (1,), z1)], -1)
     direction = np.concatenate([(matched[..., :2] - x1) / (z2 - z1), np.ones(shape + (1,))], -1)
-    origin[~good] = np.nan
-    direction[~good] = np.nan
-    irradiance = np.where(good, near["irradiance"], np.nan)
+    if good.any():
+        # a pixel without its own correspondence (beam edge, dark, a fold) keeps its flux and
+        # takes the direction of the nearest found ray, so no ray tube is dropped
+        _, (ri, ci) = distance_transform_edt(~good, return_indices=True)
+        direction = direction[ri, ci]
+    irradiance = np.where(np.isfinite(near["irradiance"]), near["irradiance"], np.nan)
     flux = irradiance * near["area"] * 1e-6
     std = np.hypot(near["mask_std"], matched[..., 2])
     confidence = np.where(good, np.exp(-0.5 * (std / mask_std_scale) ** 2), 0.0)
