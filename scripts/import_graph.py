@@ -24,7 +24,7 @@ from collections import Counter
 from pathlib import Path
 
 PACKAGE = "shadowcam"
-PRODUCT_WINGS = {"io", "lab", "cameras", "outdoor", "report", "_shared"}
+PRODUCT_WINGS = {"io", "lab", "cameras", "outdoor", "report", "lightfield", "_shared"}
 DEVELOPMENT_WINGS = {"synthetic", "evaluate"}
 
 

@@ -1,0 +1,187 @@
+"""Ray correspondence of a light-field capture and the rays dataset.
+
+Each screen position has a horizontal sweep (a vertical wire moving along the mask's
+x) and a vertical one (a horizontal wire moving along y). Their shadow times at a
+camera pixel, turned into mask positions ``x_mask = start + step * time``, name the
+mask point the pixel's light passed through (paper VI, Fig. 17). A ray is the line
+through the near screen's point and the far screen's point with the same mask
+coordinates: its origin is on the near screen, its direction goes to the far one. Its
+flux is the near screen's irradiance times the pixel's screen area.
+
+The shadow times come from the lab wing's streaming dip tracker
+(:func:`shadowcam.lab.shadow_time.track_sweep`, memory independent of the number of
+frames) fed HDR-merged frames (:func:`shadowcam.lightfield.hdr.merge_stream`).
+
+Offers
+------
+REASONS : ray flag code -> meaning.
+sweep_mask_positions : frames of one sweep (streamed) -> mask position per pixel, its std, flags, lit level.
+screen_mask_map : the two sweeps of one screen + its geometry -> the screen's mask-coordinate map.
+rays_dataset : near and far screen maps -> the rays dataset (row, col, axis).
+write_rays : the rays dataset as a netCDF file (h5netcdf), atomically.
+"""
+
+import numpy as np
+import xarray as xr
+from scipy.interpolate import LinearNDInterpolator
+from scipy.ndimage import distance_transform_edt
+
+from shadowcam._shared.atomic import atomic_path
+from shadowcam._shared.validation import check_positive, check_same_shape
+from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
+
+#: ray flag code -> meaning (0 = a ray)
+REASONS = {
+    0: "ok",
+    1: "no_shadow_near",      # no reliable dip in one of the near screen's sweeps
+    2: "no_match_far",        # the mask point is not seen reliably on the far screen
+    3: "saturated",           # every bracket saturated: no irradiance
+}
+OK, NO_SHADOW_NEAR, NO_MATCH_FAR, SATURATED = range(4)
+
+
+def sweep_mask_positions(blocks, shape, *, mask_start, mask_step, half_window=4, method="edge_fit",
+                         progress=None):
+    """Mask position whose shadow crosses each pixel, from one sweep's frames.
+
+    Parameters
+    ----------
+    blocks : iterable of (T, H, W, 1) float ndarray
+        Linear HDR frames in time order (e.g. :func:`shadowcam.lightfield.hdr.merge_stream`);
+        NaN samples take no part.
+    shape : (H, W)
+    mask_start : float, keyword-only
+        Mask position (mm, in the mask plane) of the wire's centre at frame 0.
+    mask_step : float, keyword-only
+        Wire motion per frame, mm (non-zero).
+    half_window, method
+        As :func:`shadowcam.lab.shadow_time.sweep_shadow_times`.
+    progress : callable, optional
+
+    Returns
+    -------
+    dict of (H, W) ndarrays
+        ``position`` mm (NaN where flagged), ``position_std`` mm, ``flags``
+        (:data:`shadowcam.lab.shadow_time.REASONS`), ``lit_level`` and ``n_frames``.
+    """
+    if not (np.isfinite(mask_step) and mask_step != 0):
+        raise ValueError(f"mask_step must be a finite non-zero number; got {mask_step!r}")
+    if not np.isfinite(mask_start):
+        raise ValueError(f"mask_start must be finite; got {mask_start!r}")
+    summary, _, _ = track_sweep(blocks, shape, half_window=half_window, saturation_level=np.inf,
+                                progress=progress)
+    result = summary_shadow_times(summary, method=method)
+    ok = result["reason"] == 0
+    position = np.where(ok, mask_start + mask_step * result["shadow_time"], np.nan)
+    return {"position": position, "position_std": np.abs(mask_step) * result["time_std"],
+            "flags": result["reason"], "lit_level": summary.lit_level, "n_frames": result["n_frames"]}
+
+
+def screen_mask_map(horizontal, vertical, *, xy, area, position_mm):
+    """One screen's map from camera pixels to mask coordinates and screen points.
+
+    Parameters
+    ----------
+    horizontal, vertical : dict
+        :func:`sweep_mask_positions` of the sweep along the mask's x and along its y.
+    xy : (H, W, 2) ndarray
+        Screen ``x, y`` mm of each pixel (:func:`shadowcam.lightfield.screen.screen_coordinates`).
+    area : (H, W) ndarray
+        Screen mm^2 per pixel.
+    position_mm : float
+        The screen's z.
+
+    Returns
+    -------
+    dict
+        ``mask`` (H, W, 2) mask ``x, y`` (NaN where either sweep is flagged), ``mask_std``
+        (H, W), ``xy``, ``area``, ``irradiance`` (H, W, NaN where saturated), ``ok`` (H, W) bool,
+        ``position_mm``.
+    """
+    check_positive(position_mm, "position_mm", finite=True)
+    check_same_shape({"horizontal position": horizontal["position"], "vertical position": vertical["position"],
+                      "xy[..., 0]": xy[..., 0], "area": area})
+    mask = np.stack([horizontal["position"], vertical["position"]], -1)
+    irradiance = 0.5 * (horizontal["lit_level"] + vertical["lit_level"])
+    ok = np.all(np.isfinite(mask), axis=-1)
+    std = np.hypot(horizontal["position_std"], vertical["position_std"])
+    return {"mask": mask, "mask_std": np.where(ok, std, np.nan), "xy": np.asarray(xy, np.float64),
+            "area": np.asarray(area, np.float64), "irradiance": irradiance, "ok": ok,
+            "position_mm": float(position_mm)}
+
+
+def rays_dataset(near, far, *, mask_std_scale=0.05):
+    """The rays through the near and the far screens' points of equal mask coordinates.
+
+    Parameters
+    ----------
+    near, far : dict
+        :func:`screen_mask_map` of the near and the far screen.
+    mask_std_scale : float, keyword-only
+        Mask-coordinate standard deviation (mm) at which the confidence is ``exp(-1/2)``.
+
+    Returns
+    -------
+    xarray.Dataset
+        On the near screen's pixel grid ``(row, col)``: ``origin`` and ``direction``
+        ``(row, col, axis)`` (mm; direction with unit z), ``irradiance`` (lux at the near
+        screen), ``flux`` (lm through the pixel), ``mask`` ``(row, col, mask_axis)`` mm,
+        ``confidence`` in [0, 1] and ``flag`` (:data:`REASONS`). A pixel whose ray is not
+        found (flag > 0, confidence 0) keeps its flux and takes the direction of the
+        nearest found ray; its ``mask`` is NaN.
+    """
+    z1, z2 = near["position_mm"], far["position_mm"]
+    if not z2 > z1:
+        raise ValueError(f"far position_mm must be > near position_mm ({z1}); got {z2}")
+    check_positive(mask_std_scale, "mask_std_scale", finite=True)
+    shape = near["ok"].shape
+    flag = np.zeros(shape, np.uint8)
+    flag[~near["ok"]] = NO_SHADOW_NEAR
+    far_ok = far["ok"]
+    if far_ok.sum() < 3:
+        raise ValueError(f"far screen must have at least 3 pixels with shadow times of both sweeps; got "
+                         f"{int(far_ok.sum())}: check the far screen's sweeps")
+    interpolate = LinearNDInterpolator(far["mask"][far_ok], np.c_[far["xy"][far_ok], far["mask_std"][far_ok]])
+    matched = np.full(shape + (3,), np.nan)
+    matched[near["ok"]] = interpolate(near["mask"][near["ok"]])
+    no_match = near["ok"] & ~np.all(np.isfinite(matched), axis=-1)
+    flag[no_match] = NO_MATCH_FAR
+    saturated = (flag == OK) & ~np.isfinite(near["irradiance"])
+    flag[saturated] = SATURATED
+    good = flag == OK
+    x1 = near["xy"]
+    origin = np.concatenate([x1, np.full(shape + (1,), z1)], -1)
+    direction = np.concatenate([(matched[..., :2] - x1) / (z2 - z1), np.ones(shape + (1,))], -1)
+    if good.any():
+        # a pixel without its own correspondence (beam edge, dark, a fold) keeps its flux and
+        # takes the direction of the nearest found ray, so no ray tube is dropped
+        _, (ri, ci) = distance_transform_edt(~good, return_indices=True)
+        direction = direction[ri, ci]
+    irradiance = np.where(np.isfinite(near["irradiance"]), near["irradiance"], np.nan)
+    flux = irradiance * near["area"] * 1e-6
+    std = np.hypot(near["mask_std"], matched[..., 2])
+    confidence = np.where(good, np.exp(-0.5 * (std / mask_std_scale) ** 2), 0.0)
+    mask = np.where(good[..., None], near["mask"], np.nan)
+    dims2, dims3 = ("row", "col"), ("row", "col", "axis")
+    return xr.Dataset(
+        {
+            "origin": (dims3, origin, {"units": "mm", "long_name": "ray origin on the near screen"}),
+            "direction": (dims3, direction, {"units": "1", "long_name": "ray direction (dz = 1)"}),
+            "irradiance": (dims2, irradiance, {"units": "lx", "long_name": "near-screen irradiance"}),
+            "flux": (dims2, flux, {"units": "lm", "long_name": "flux of the ray tube through the pixel"}),
+            "mask": (("row", "col", "mask_axis"), mask, {"units": "mm", "long_name": "mask point of the ray"}),
+            "confidence": (dims2, confidence, {"units": "1", "long_name": "ray confidence from the shadow-time noise"}),
+            "flag": (dims2, flag, {"long_name": "ray reason code",
+                                   "flag_values": list(REASONS), "flag_meanings": " ".join(REASONS.values())}),
+        },
+        coords={"row": np.arange(shape[0]), "col": np.arange(shape[1]), "axis": ["x", "y", "z"],
+                "mask_axis": ["x", "y"]},
+        attrs={"near_position_mm": z1, "far_position_mm": z2, "convention": "lengths in mm; +z from the source"},
+    )
+
+
+def write_rays(path, rays):
+    """Write a rays dataset as netCDF-4 (h5netcdf engine), atomically; return the path."""
+    with atomic_path(path) as tmp:
+        rays.to_netcdf(tmp, engine="h5netcdf")
+    return path
