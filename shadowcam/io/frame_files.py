@@ -6,8 +6,8 @@ is decided by the file's content (its magic bytes; a TIFF with a DNGVersion
 tag is DNG), never by its name: a file whose content and name disagree (a DNG
 renamed ``.png``) is an error, because the name picks the decoder
 (:func:`shadowcam.io.raw_mosaic.is_raw`). The frame size comes from the header
-(OpenImageIO's spec; for camera RAW, LibRaw's size fields, read without
-unpacking the data).
+(a PNG's IHDR chunk; OpenImageIO's spec for other images; for camera RAW,
+LibRaw's size fields, read without unpacking the data).
 
 These checks read a few bytes and one header per file, and are run where the
 files are read anyway: :func:`check_capture_frames` (the first file of each
@@ -115,6 +115,11 @@ def header_size(path):
                 return int(raw.sizes.height), int(raw.sizes.width)
         except (rawpy.LibRawError, OSError) as exc:
             raise ValueError(f"cannot read camera RAW file {path}: {exc}") from None
+    with open(path, "rb") as handle:
+        head = handle.read(24)
+    if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":  # width, height: big-endian uint32
+        width, height = struct.unpack(">II", head[16:24])
+        return int(height), int(width)
     import OpenImageIO as oiio
 
     inp = oiio.ImageInput.open(str(path))
