@@ -286,8 +286,13 @@ def _numbering_gaps(rels):
     if min(steps) <= 0:
         return []
     step = math.gcd(*steps)
-    return [(rels[k], rels[k + 1], list(range(numbered[k][1] + step, numbered[k + 1][1], step)))
+    return [(rels[k], rels[k + 1], range(numbered[k][1] + step, numbered[k + 1][1], step))
             for k, diff in enumerate(steps) if diff > step]
+
+
+def _gap_text(before, after, missing):
+    numbers = ", ".join(map(str, missing[:3])) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
+    return f"{before} is followed by {after} (missing: frame number{'s' if len(missing) > 1 else ''} {numbers})"
 
 
 def _check_contents(manifest, files, root):
@@ -326,9 +331,7 @@ def _check_contents(manifest, files, root):
             )
         gaps = _numbering_gaps(rels)
         if gaps:
-            text = "; ".join(f"{a} is followed by {b} (missing: frame number{'s' if len(missing) > 1 else ''} "
-                             f"{_shown(map(str, missing), 3)})"
-                             for a, b, missing in gaps[:3])
+            text = "; ".join(_gap_text(*gap) for gap in gaps[:3])
             raise ValueError(
                 f"{where}: gap in the frame numbers: {text}{' and more' if len(gaps) > 3 else ''}; "
                 "a missing frame shifts the time of every later frame. Restore the missing file(s), "
