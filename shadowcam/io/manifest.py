@@ -304,7 +304,8 @@ def _check_contents(manifest, files, root):
     """
     path = manifest["manifest_path"]
     listed = manifest.get("checksums", {})
-    gone = [rel for rel in listed if root is not None and not (Path(root) / rel).is_file()]
+    found = {rel for group in files.values() for rel in group}  # the globs saw these files: they exist
+    gone = [rel for rel in listed if rel not in found and root is not None and not (Path(root) / rel).is_file()]
     if gone:
         raise ValueError(
             f"manifest {path}: file(s) listed in checksums are missing: {_shown(gone)} (under root {root}); "
@@ -319,7 +320,7 @@ def _check_contents(manifest, files, root):
     for name, sweep in manifest["sweeps"].items():
         rels = files[name]
         where = f"manifest {path}, sweep {name!r} (files {sweep['files']!r})"
-        suffixes = [Path(rel).suffix.lower() for rel in rels]
+        suffixes = [os.path.splitext(rel)[1].lower() for rel in rels]
         counts = {s: suffixes.count(s) for s in dict.fromkeys(suffixes)}
         if len(counts) > 1:
             usual = max(counts, key=counts.get)
