@@ -183,7 +183,7 @@ def _rewrite(path, doc):
     return path
 
 
-def _make_capture(tmp_path, *, names=("f1.png", "f2.png", "f10.png"), with_checksums=True, **overrides):
+def _make_capture(tmp_path, *, names=("f8.png", "f9.png", "f10.png"), with_checksums=True, **overrides):
     """A capture folder data/ and a manifest manifests/cap.yaml with root ../data; return (path, doc)."""
     from shadowcam.io.manifest import checksums_for
 

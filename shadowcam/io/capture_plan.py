@@ -33,6 +33,7 @@ from types import MappingProxyType
 import numpy as np
 
 from shadowcam.cameras.dual_coords import choose_dual_model
+from shadowcam.io.frame_files import check_capture_frames
 from shadowcam.io.manifest import load_manifest
 
 #: scene sweeps of a lab capture (perpendicular, measuring dual u and v)
@@ -217,8 +218,9 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         schema, a file or glob it references is missing, its checksums block
         does not list a file, frame times cannot be resolved, a lab capture lacks
         the scene sweeps ``u``, ``v``, an outdoor capture has several sweeps and
-        none named ``timelapse``, or `dual_model` is ``calibration`` without
-        calibration sweeps.
+        none named ``timelapse``, `dual_model` is ``calibration`` without
+        calibration sweeps, or the first frames of the sweeps and the reference
+        differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`).
     """
     manifest = load_manifest(manifest_path)
     path = manifest["manifest_path"]
@@ -257,10 +259,7 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
     if rendered:
         shape = (int(manifest["synthetic"]["height"]), int(manifest["synthetic"]["width"]))
     else:
-        from shadowcam.io.decode import frame_info
-
-        info = frame_info(sweeps[first].files[0])
-        shape = (int(info["height"]), int(info["width"]))
+        shape = check_capture_frames(manifest)
     return CapturePlan(
         name=manifest["name"],
         manifest_path=path,

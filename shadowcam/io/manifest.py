@@ -32,6 +32,7 @@ import datetime as _dt
 import glob
 import json
 import logging
+import math
 import os
 import re
 from pathlib import Path
@@ -120,8 +121,34 @@ def _epoch_seconds(iso_text):
     return _dt.datetime.fromisoformat(iso_text).replace(tzinfo=_dt.timezone.utc).timestamp()
 
 
+def _seconds(value):
+    return format(value, ".10g")
+
+
+def _check_time_order(paths, times, *, root, source):
+    """Raise ValueError naming the first two files whose times do not increase in file order."""
+    for k in range(1, len(times)):
+        if times[k] > times[k - 1]:
+            continue
+        a, b = _rel(root, paths[k - 1]), _rel(root, paths[k])
+        if times[k] == times[k - 1]:
+            problem = f"frame {b} ({_seconds(times[k])} s) has the same time as {a}"
+        else:
+            problem = (f"frame {b} ({_seconds(times[k])} s) comes after {a} ({_seconds(times[k - 1])} s) "
+                       "in file-name order but is earlier")
+        raise ValueError(
+            f"{problem} (timing source {source}); frame times must increase in file-name order: "
+            "check the timing source, and rename or remove the files so that name order is time order"
+        )
+
+
 def frame_times(paths, timing, *, root, sweep, sidecar=None):
-    """Return frame times in seconds for the files of one sweep.
+    """Return frame times in seconds for the files of one sweep, checked to increase.
+
+    Frames are ordered by file name; times that do not increase in that order
+    (out of order or duplicated) are an error, not sorted: which file is frame
+    ``k`` stays what the names say, and the message names the two files, their
+    times and the timing source.
 
     Parameters
     ----------
@@ -145,22 +172,39 @@ def frame_times(paths, timing, *, root, sweep, sidecar=None):
         ``time_s`` group, or the ``index`` group / ``rate_hz`` (default 1);
         for ``metadata`` seconds since the sweep's first frame (EXIF
         DateTimeOriginal + SubsecTimeOriginal); for ``sidecar`` the listed values.
-    """
-    source = timing["source"]
-    if source == "auto":
-        from shadowcam.io.frame_times import auto_candidates
 
-        problems = []
-        for candidate in auto_candidates(timing):
-            try:
-                times = frame_times(paths, candidate, root=root, sweep=sweep, sidecar=sidecar)
-            except ValueError as exc:
-                problems.append(f"{candidate['source']}: {exc}")
-                continue
-            log.info("sweep %s: frame times from %s (timing source auto)", sweep, candidate["source"])
-            return times
-        raise ValueError("timing.source auto found no source with a time for every file ("
-                         + "; ".join(problems) + "); add timing.regex or timing.file/key")
+    Raises
+    ------
+    ValueError
+        If a source gives no time for a file, or the times do not increase
+        strictly in file order (``auto`` then tries its next source).
+    """
+    if timing["source"] == "auto":
+        return _auto_times(paths, timing, root=root, sweep=sweep, sidecar=sidecar)
+    times = _source_times(paths, timing, root=root, sweep=sweep, sidecar=sidecar)
+    _check_time_order(paths, times, root=root, source=timing["source"])
+    return times
+
+
+def _auto_times(paths, timing, *, root, sweep, sidecar):
+    from shadowcam.io.frame_times import auto_candidates
+
+    problems = []
+    for candidate in auto_candidates(timing):
+        try:
+            times = frame_times(paths, candidate, root=root, sweep=sweep, sidecar=sidecar)
+        except ValueError as exc:
+            problems.append(f"{candidate['source']}: {exc}")
+            continue
+        log.info("sweep %s: frame times from %s (timing source auto)", sweep, candidate["source"])
+        return times
+    raise ValueError("timing.source auto found no source with increasing times for every file ("
+                     + "; ".join(problems) + "); add timing.regex or timing.file/key")
+
+
+def _source_times(paths, timing, *, root, sweep, sidecar):
+    """Frame times of one concrete timing source (see :func:`frame_times`), unchecked."""
+    source = timing["source"]
     if source == "rate":
         start, rate = float(timing.get("start_s", 0.0)), float(timing["rate_hz"])
         return [start + k / rate for k in range(len(paths))]
@@ -217,6 +261,86 @@ def frame_times(paths, timing, *, root, sweep, sidecar=None):
     raise ValueError(f"timing.source {source!r} is not one of rate, filename, metadata, sidecar")
 
 
+def _shown(names, limit=5):
+    names = list(names)
+    return ", ".join(names[:limit]) + (f" and {len(names) - limit} more" if len(names) > limit else "")
+
+
+def _numbering_gaps(rels):
+    """Gaps in the frame numbers of a sweep's files: a list of (file before, file after, missing numbers).
+
+    The frame number is the last digit run of the path; files whose paths
+    differ elsewhere too (another folder, a time in the name) are no numbered
+    sequence and have no gaps. The step is the greatest common divisor of the
+    number differences, so keeping every other frame is no gap.
+    """
+    numbered = []
+    for rel in rels:
+        match = re.search(r"(\d+)(\D*)$", rel)
+        if match is None:
+            return []
+        numbered.append((rel[:match.start()] + "#" + match.group(2), int(match.group(1))))
+    if len(numbered) < 3 or len({template for template, _ in numbered}) != 1:
+        return []
+    steps = [b[1] - a[1] for a, b in zip(numbered, numbered[1:])]
+    if min(steps) <= 0:
+        return []
+    step = math.gcd(*steps)
+    return [(rels[k], rels[k + 1], range(numbered[k][1] + step, numbered[k + 1][1], step))
+            for k, diff in enumerate(steps) if diff > step]
+
+
+def _gap_text(before, after, missing):
+    numbers = ", ".join(map(str, missing[:3])) + (f" and {len(missing) - 3} more" if len(missing) > 3 else "")
+    return f"{before} is followed by {after} (missing: frame number{'s' if len(missing) > 1 else ''} {numbers})"
+
+
+def _check_contents(manifest, files, root):
+    """The checksums block states what the capture contains: compare it with the files found.
+
+    Raises ValueError naming the files when a listed file is missing, a found
+    file is not listed, a sweep's files are of several file types, or a
+    sweep's frame numbers have a gap. Costs no read of a frame file.
+    """
+    path = manifest["manifest_path"]
+    listed = manifest.get("checksums", {})
+    found = {rel for group in files.values() for rel in group}  # the globs saw these files: they exist
+    gone = [rel for rel in listed if rel not in found and root is not None and not (Path(root) / rel).is_file()]
+    if gone:
+        raise ValueError(
+            f"manifest {path}: file(s) listed in checksums are missing: {_shown(gone)} (under root {root}); "
+            "the checksums block states what the capture contains: restore the file(s), or if they were "
+            "removed on purpose " + _FIX_CHECKSUMS.format(m=path)
+        )
+    unlisted = [rel for group in files.values() for rel in group if rel not in listed]
+    if unlisted:
+        raise ValueError(
+            f"manifest {path}: file(s) not listed in checksums: {_shown(unlisted)}; " + _FIX_CHECKSUMS.format(m=path)
+        )
+    for name, sweep in manifest["sweeps"].items():
+        rels = files[name]
+        where = f"manifest {path}, sweep {name!r} (files {sweep['files']!r})"
+        suffixes = [os.path.splitext(rel)[1].lower() for rel in rels]
+        counts = {s: suffixes.count(s) for s in dict.fromkeys(suffixes)}
+        if len(counts) > 1:
+            usual = max(counts, key=counts.get)
+            odd = [rel for rel, s in zip(rels, suffixes) if s != usual]
+            raise ValueError(
+                f"{where}: a sweep's files must be of one file type; found "
+                + ", ".join(f"{s or '(no suffix)'} ({n})" for s, n in counts.items())
+                + f"; odd file(s): {_shown(odd)}. Remove or convert them, or narrow the glob"
+            )
+        gaps = _numbering_gaps(rels)
+        if gaps:
+            text = "; ".join(_gap_text(*gap) for gap in gaps[:3])
+            raise ValueError(
+                f"{where}: gap in the frame numbers: {text}{' and more' if len(gaps) > 3 else ''}; "
+                "a missing frame shifts the time of every later frame. Restore the missing file(s), "
+                "or if frames were removed on purpose renumber the files without gaps and "
+                + _FIX_CHECKSUMS.format(m=path)
+            )
+
+
 def _resolve(path, *, strict):
     """Load + validate; with `strict`, also require checksums and resolve times."""
     path = Path(path).resolve()
@@ -270,13 +394,7 @@ def _resolve(path, *, strict):
     manifest["files"] = files
     if not strict:
         return manifest
-    listed = manifest.get("checksums", {})
-    missing = [rel for group in files.values() for rel in group if rel not in listed]
-    if missing:
-        shown = ", ".join(missing[:5]) + (f" and {len(missing) - 5} more" if len(missing) > 5 else "")
-        raise ValueError(
-            f"manifest {path}: file(s) not listed in checksums: {shown}; " + _FIX_CHECKSUMS.format(m=path)
-        )
+    _check_contents(manifest, files, root)
     sidecar = None
     if "timing" in files:
         side_path = Path(root) / files["timing"][0]

@@ -7,6 +7,7 @@ decode_sweep : verify the sha256 of a sweep's files and stream them into a frame
 
 import xarray as xr
 
+from shadowcam.io.frame_files import check_capture_frames, check_frame_files
 from shadowcam.io.frame_store import write_frames, write_reference
 from shadowcam.io.manifest import manifest_files, verify_checksums
 from shadowcam.io.provenance import attach_provenance
@@ -22,7 +23,11 @@ def _only_files(manifest, group, paths):
 def decode_sweep(manifest, sweep, out, *, frames=None, chunk_frames=None):
     """Decode `sweep` of `manifest` into the frame store `out`.
 
-    Verifies the sha256 of the files it decodes first (only those of the part).
+    Checks first, before anything is written, that the capture's sweeps and
+    reference share one frame size and that the files it decodes share their
+    sweep's first file's format, decode path and size
+    (:mod:`shadowcam.io.frame_files`), then verifies their sha256 (only those
+    of the part).
 
     Parameters
     ----------
@@ -41,6 +46,12 @@ def decode_sweep(manifest, sweep, out, *, frames=None, chunk_frames=None):
     -------
     dict
         The provenance attrs of the store.
+
+    Raises
+    ------
+    ValueError
+        Naming the odd file and the expected format or size, or the file whose
+        checksum differs.
     """
     available = sorted(manifest["sweeps"]) + (["reference"] if manifest["reference_paths"] else [])
     if sweep != "reference" and sweep not in manifest["sweeps"]:
@@ -49,11 +60,15 @@ def decode_sweep(manifest, sweep, out, *, frames=None, chunk_frames=None):
         raise ValueError(f"manifest {manifest['name']} has no reference frame (key reference)")
     if sweep == "reference" and frames:
         raise ValueError("frames: a frame range applies to sweeps, not to the reference")
+    check_capture_frames(manifest)
+    what = f"manifest {manifest['manifest_path']}, {'reference' if sweep == 'reference' else f'sweep {sweep!r}'}"
     if sweep == "reference":
+        check_frame_files(manifest["reference_paths"], what=what)
         checksums = verify_checksums(manifest, [sweep])
     else:
         entry = manifest["sweeps"][sweep]
         start, stop = frames or (0, len(entry["paths"]))
+        check_frame_files(entry["paths"][start:stop], what=what, first=entry["paths"][0])
         checksums = verify_checksums(_only_files(manifest, sweep, entry["paths"][start:stop]), [sweep])
     config = {"manifest": manifest["name"], "sweep": sweep, "chunk_frames": chunk_frames}
     attrs = dict(attach_provenance(xr.Dataset(), config=config, input_checksums=checksums, step="decode").attrs)

@@ -63,7 +63,7 @@ def lab_doc(**overrides):
 @pytest.fixture
 def lab(tmp_path, write_frames):
     data = tmp_path / "data"
-    write_frames(data / "u", [f"f{i}.png" for i in (1, 2, 10)], seed=1)
+    write_frames(data / "u", [f"f{i}.png" for i in (8, 9, 10)], seed=1)
     write_frames(data / "v", [f"f{i}.png" for i in range(1, 5)], seed=2)
     write_frames(data, ["ref.png"], seed=3)
     return tmp_path
@@ -76,8 +76,8 @@ def test_lab_capture_facts(lab):
     assert list(plan.sweeps) == ["u", "v"]
     assert (plan.n_frames("u"), plan.n_frames("v")) == (3, 4)
     root = (lab / "data").resolve()
-    # natural order: f2 before f10
-    assert plan.sweep("u").files == tuple(str(root / "u" / f"f{i}.png") for i in (1, 2, 10))
+    # natural order: f9 before f10
+    assert plan.sweep("u").files == tuple(str(root / "u" / f"f{i}.png") for i in (8, 9, 10))
     assert plan.sweep("u").times_s == (0.0, 0.25, 0.5)
     assert plan.sweep("u").axis == "u"
     assert plan.frame_shape == (ROWS, COLS)

@@ -29,10 +29,10 @@ def test_load_resolves_root_paths_times(tmp_path, make_capture):
     manifest = load_manifest(path)
     root = (tmp_path / "data").resolve()
     assert manifest["root"] == str(root)
-    assert manifest["sweeps"]["u"]["paths"] == [str(root / "u" / n) for n in ("f1.png", "f2.png", "f10.png")]
+    assert manifest["sweeps"]["u"]["paths"] == [str(root / "u" / n) for n in ("f8.png", "f9.png", "f10.png")]
     assert manifest["sweeps"]["u"]["times_s"] == [0.0, 0.5, 1.0]  # 2 Hz
     assert manifest["reference_paths"] == [str(root / "ref.png")]
-    assert set(manifest_files(manifest)) == {"u/f1.png", "u/f2.png", "u/f10.png", "ref.png"}
+    assert set(manifest_files(manifest)) == {"u/f8.png", "u/f9.png", "u/f10.png", "ref.png"}
     assert len(verify_checksums(manifest)) == 4
 
 
@@ -87,8 +87,8 @@ def test_missing_reference_file_named(tmp_path, make_capture):
 
 def test_file_not_in_checksums_named(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path)
-    del doc["checksums"]["u/f2.png"]
-    with pytest.raises(ValueError, match=r"not listed in checksums: u/f2\.png.*shadowcam checksum"):
+    del doc["checksums"]["u/f9.png"]
+    with pytest.raises(ValueError, match=r"not listed in checksums: u/f9\.png.*shadowcam checksum"):
         load_manifest(rewrite(path, doc))
 
 
@@ -111,8 +111,8 @@ def test_bad_checksum_names_file_expected_actual(tmp_path, make_capture):
 def test_file_removed_after_load_named(tmp_path, make_capture):
     path, _ = make_capture(tmp_path)
     manifest = load_manifest(path)
-    (tmp_path / "data" / "u" / "f1.png").unlink()
-    with pytest.raises(ValueError, match=r"f1\.png.*does not exist"):
+    (tmp_path / "data" / "u" / "f8.png").unlink()
+    with pytest.raises(ValueError, match=r"f8\.png.*does not exist"):
         verify_checksums(manifest)
 
 
@@ -123,9 +123,9 @@ def test_timing_from_filename(tmp_path, make_capture, rewrite):
     )
     assert load_manifest(path)["sweeps"]["u"]["times_s"] == [0.0, 0.25, 1.5]
     path, doc = make_capture(tmp_path / "b", timing={"source": "filename", "regex": r"f(?P<index>\d+)", "rate_hz": 4.0})
-    assert load_manifest(path)["sweeps"]["u"]["times_s"] == [0.25, 0.5, 2.5]
+    assert load_manifest(path)["sweeps"]["u"]["times_s"] == [2.0, 2.25, 2.5]
     doc["timing"]["regex"] = r"g(?P<index>\d+)"
-    with pytest.raises(ValueError, match="f1.png.*does not match timing.regex"):
+    with pytest.raises(ValueError, match="f8.png.*does not match timing.regex"):
         load_manifest(rewrite(path, doc))
 
 
@@ -153,7 +153,7 @@ def test_timing_from_sidecar(tmp_path, make_capture, rewrite):
     doc["checksums"] = checksums_for(path)
     assert "stamps.json" in doc["checksums"]  # the sidecar is a referenced file too
     assert load_manifest(rewrite(path, doc))["sweeps"]["u"]["times_s"] == [0.0, 0.9, 2.1]
-    side.write_text(json.dumps({"times_s": {"u/f1.png": 1.0, "f2.png": 2.0, "u/f10.png": 3.0}}))
+    side.write_text(json.dumps({"times_s": {"u/f8.png": 1.0, "f9.png": 2.0, "u/f10.png": 3.0}}))
     doc["checksums"] = checksums_for(path)
     assert load_manifest(rewrite(path, doc))["sweeps"]["u"]["times_s"] == [1.0, 2.0, 3.0]
     side.write_text(json.dumps({"times_s": [0.0, 1.0]}))
@@ -187,3 +187,67 @@ def test_shared_dev_manifests(name, suffix):
     noise = "raw12" if suffix == ".dng" else "noise_free"
     assert manifest["ground_truth"] == {"format": "mitsuba_lab_npz", "file": "gt.npz", "noise": noise}
     assert len(verify_checksums(manifest)) == 2 * 96 + 2
+
+
+# --------------------------------------------------------------------------- what the capture contains
+
+
+def test_listed_file_missing_is_named_before_any_work(tmp_path, make_capture):
+    path, _ = make_capture(tmp_path, names=("f1.png", "f2.png", "f3.png"))
+    (tmp_path / "data" / "u" / "f2.png").unlink()
+    with pytest.raises(ValueError, match=r"listed in checksums.*missing.*u/f2\.png"):
+        load_manifest(path)
+
+
+def test_unlisted_file_matching_the_glob_is_named(tmp_path, make_capture, write_image):
+    path, _ = make_capture(tmp_path, names=("f1.png", "f2.png", "f3.png"))
+    write_image(tmp_path / "data" / "u" / "f4.png", np.zeros((6, 8, 3), np.uint16))
+    with pytest.raises(ValueError, match=r"not listed in checksums: u/f4\.png"):
+        load_manifest(path)
+
+
+def test_gap_in_frame_numbers_is_named(tmp_path, make_capture):
+    path, _ = make_capture(tmp_path, names=("f000.png", "f001.png", "f003.png", "f004.png"))
+    with pytest.raises(ValueError, match=r"sweep 'u'.*gap.*u/f001\.png.*u/f003\.png.*frame number 2"):
+        load_manifest(path)
+    # a constant step other than 1 (every other frame kept) is a sequence, not a gap
+    path, _ = make_capture(tmp_path / "b", names=("f0.png", "f2.png", "f4.png"))
+    assert len(load_manifest(path)["sweeps"]["u"]["paths"]) == 3
+
+
+def test_mixed_file_types_in_a_sweep_are_named(tmp_path, make_capture, rewrite):
+    path, doc = make_capture(tmp_path, names=("f1.png", "f2.png", "f3.png"), with_checksums=False)
+    (tmp_path / "data" / "u" / "f2.tif").write_bytes((tmp_path / "data" / "u" / "f2.png").read_bytes())
+    (tmp_path / "data" / "u" / "f2.png").unlink()
+    doc["sweeps"]["u"]["files"] = "u/*"
+    rewrite(path, doc)
+    doc["checksums"] = checksums_for(path)
+    with pytest.raises(ValueError, match=r"sweep 'u'.*one file type.*\.png.*u/f2\.tif"):
+        load_manifest(rewrite(path, doc))
+
+
+@pytest.mark.parametrize("stamps, problem", [
+    ({"u/f1.png": 0.0, "u/f2.png": 2.0, "u/f3.png": 1.0}, r"u/f3\.png \(1 s\).*after u/f2\.png \(2 s\)"),
+    ({"u/f1.png": 0.0, "u/f2.png": 1.0, "u/f3.png": 1.0}, r"u/f3\.png \(1 s\).*same time.*u/f2\.png"),
+])
+def test_times_out_of_order_or_duplicated_are_named(tmp_path, make_capture, rewrite, stamps, problem):
+    path, doc = make_capture(tmp_path, names=("f1.png", "f2.png", "f3.png"), with_checksums=False)
+    (tmp_path / "data" / "stamps.json").write_text(json.dumps({"times_s": stamps}))
+    doc["timing"] = {"source": "sidecar", "file": "stamps.json", "key": "times_s"}
+    rewrite(path, doc)
+    doc["checksums"] = checksums_for(path)
+    with pytest.raises(ValueError, match=problem + r".*timing source sidecar"):
+        load_manifest(rewrite(path, doc))
+
+
+def test_duplicated_exif_times_are_named(tmp_path, write_image, rewrite):
+    data = tmp_path / "data" / "t"
+    data.mkdir(parents=True)
+    for k, stamp in enumerate(["2024:05:01 19:00:00", "2024:05:01 19:00:01", "2024:05:01 19:00:01"]):
+        write_image(data / f"{k}.tif", np.zeros((4, 4, 3), np.uint16), **{"Exif:DateTimeOriginal": stamp})
+    doc = {"name": "m", "kind": "outdoor", "light": "distant", "root": "data",
+           "sweeps": {"t": {"files": "t/*.tif"}}, "timing": {"source": "metadata"}}
+    path = rewrite(tmp_path / "m.yaml", doc)
+    doc["checksums"] = checksums_for(path)
+    with pytest.raises(ValueError, match=r"t/2\.tif \(1 s\).*same time.*t/1\.tif.*timing source metadata"):
+        load_manifest(rewrite(path, doc))

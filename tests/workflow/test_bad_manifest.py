@@ -74,3 +74,27 @@ def test_unknown_dataset_names_the_config_key(tmp_path, workflow_copy, dry_run):
         dry_run(workdir, "nosuch"),
         "error: dataset 'nosuch' (config key 'datasets'): data_manifest/nosuch.yaml does not exist",
     )
+
+
+def _lab_capture(workdir, write_image, write_manifest, *, v_shape=(6, 8)):
+    rng = np.random.default_rng(12)
+    for sweep, shape in (("u", (6, 8)), ("v", v_shape)):
+        for index in range(4):
+            path = workdir / "data" / sweep / f"f{index:03d}.png"
+            path.parent.mkdir(parents=True, exist_ok=True)
+            write_image(path, rng.integers(0, 65536, shape + (3,)).astype(np.uint16))
+    doc = {"name": "cap", "kind": "lab", "light": "point", "root": "../data",
+           "sweeps": {"u": {"files": "u/*.png"}, "v": {"files": "v/*.png"}},
+           "timing": {"source": "rate", "rate_hz": 1.0}}
+    return write_manifest(workdir / "data_manifest" / "cap.yaml", doc)
+
+
+def test_deleted_frame_and_odd_sweep_size_stop_the_dry_run(tmp_path, workflow_copy, write_image, write_manifest,
+                                                           dry_run):
+    workdir = workflow_copy(tmp_path / "wf")
+    _lab_capture(workdir, write_image, write_manifest)
+    (workdir / "data" / "u" / "f002.png").unlink()
+    assert_stops_with(dry_run(workdir, "cap"), "file(s) listed in checksums are missing: u/f002.png")
+    workdir = workflow_copy(tmp_path / "wf2")
+    _lab_capture(workdir, write_image, write_manifest, v_shape=(6, 10))
+    assert_stops_with(dry_run(workdir, "cap"), "v/f000.png is 6x10", "u/f000.png is 6x8")
