@@ -57,7 +57,6 @@ REASON_FLAGS = {
     1: "no_time",
     2: "outside_calibration",
     3: "ill_conditioned",
-    4: "inconsistent",
 }
 
 

@@ -35,6 +35,7 @@ from the same capture description).
 Offers
 ------
 SWEEP_KEYS : keys of a sweep declaration.
+REASON_FLAGS : reason code -> meaning (those of ``dual_coords`` and ``inconsistent``).
 CAMERA_MODELS : model name -> function ``(times, sweeps, **options) -> (u, v, valid, reason, info)``.
 declared_sweeps : normalised sweep declarations of a capture description.
 choose_camera_model : the camera a capture description needs (``auto``) or a checked request.
@@ -50,6 +51,7 @@ import math
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in, check_positive
+from shadowcam.cameras.dual_coords import REASON_FLAGS as DUAL_REASON_FLAGS
 from shadowcam.cameras.dual_coords import dual_coords_dataset, dual_coords_uniform
 
 #: keys of a sweep declaration (a subset of the renderer's sweep specification keys)
@@ -63,6 +65,9 @@ LIGHT_KINDS = ("point", "area", "distant")
 STANDARD_SWEEPS = ({"name": "u", "angle_deg": 0.0}, {"name": "v", "angle_deg": 90.0})
 
 _NO_TIME, _ILL, _INCONSISTENT = 1, 3, 4
+
+#: reason codes of the camera models: those of ``dual_coords`` plus ``inconsistent``
+REASON_FLAGS = {**DUAL_REASON_FLAGS, _INCONSISTENT: "inconsistent"}
 
 
 def _cos_sin(angle_deg):
@@ -321,7 +326,7 @@ def camera_perspective(times, sweeps, *, light="point", dual_shape=None):
     u, v : (rows, cols) float32 ndarray
     valid : (rows, cols) bool ndarray
     reason : (rows, cols) uint8 ndarray
-        Codes of ``dual_coords.REASON_FLAGS``.
+        Codes of :data:`REASON_FLAGS`.
     info : dict
         ``model``, ``projection``, ``dual_width``, ``dual_height``, ...
     """
@@ -621,5 +626,8 @@ def camera_coords_from_shadow_time(shadow_time, description, *, model="auto", du
         maps("shadow_time"), sweeps, light=description.get("light", "point"),
         dual_shape=dual_shape, **options)
     info = {k: val for k, val in info.items() if k != "sweeps"} | {"sweeps": " ".join(info["sweeps"])}
-    return dual_coords_dataset(u, v, valid, info=info, method=chosen, reason=reason)
+    ds = dual_coords_dataset(u, v, valid, info=info, method=chosen, reason=reason)
+    ds["reason"].attrs.update(flag_values=np.array(sorted(REASON_FLAGS), dtype=np.uint8),
+                              flag_meanings=" ".join(REASON_FLAGS[k] for k in sorted(REASON_FLAGS)))
+    return ds
 

@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from shadowcam.cameras.dual_coords import REASON_FLAGS
 from shadowcam.cameras.models import (
     CAMERA_MODELS,
+    REASON_FLAGS,
     camera_coords_from_shadow_time,
     camera_linear,
     choose_camera_model,
@@ -75,6 +75,14 @@ def test_inconsistent_descriptions_are_refused(description, model, message):
 def test_entries_and_reason_codes():
     assert set(CAMERA_MODELS) == {"perspective", "orthographic", "linear", "cross_slit", "pushbroom"}
     assert REASON_FLAGS[ILL] == "ill_conditioned" and REASON_FLAGS[INCONSISTENT] == "inconsistent"
+
+
+def test_dataset_names_every_reason_code(timed_capture):
+    description = {**SIZE, "sweeps": SLANTED}
+    _, _, shadow_time, _ = timed_capture(description)
+    coords = camera_coords_from_shadow_time(shadow_time, description)
+    assert list(coords["reason"].attrs["flag_values"]) == sorted(REASON_FLAGS)
+    assert coords["reason"].attrs["flag_meanings"].split()[-1] == "inconsistent"
 
 
 @pytest.mark.parametrize("extra, projection", [({}, "perspective"),
