@@ -1,4 +1,11 @@
-"""Ridge pushbroom (paper section VII, Fig. 18): the image along the moving shadow edge.
+"""Shadow pushbroom: the image along the moving shadow edge, for the outdoor ridge (paper
+section VII, Fig. 18) and the lab's single sweep (Fig. 10 IV-V, Fig. 11) alike.
+
+Outdoor: the edge row per (frame, column) comes from edge tracking. Lab: for a wire whose
+shadow runs along the camera's columns (a vertical wire), the edge column per (frame, row)
+is where the shadow-time map ``t(row, col)`` crosses the frame, found sub-pixel by
+:func:`edge_from_time_map` (``along="row"``); for a horizontal wire the roles of rows and
+columns swap. Both then read the colours along the edge with the same functions.
 
 For each frame, the intensities along the tracked edge curve are read out and
 stacked over time: output row ``k`` is frame ``k`` (time ``time_s[k]``), output
@@ -15,8 +22,11 @@ gaps in the capture would otherwise distort the time axis).
 Offers
 ------
 sample_along_edge : the colours at one edge curve.
-assemble_pushbroom : the (time, col, channel) pushbroom from all edge curves.
+assemble_pushbroom : the (time, col, channel) pushbroom from all edge curves (or (time, row,
+    channel) with ``along="row"``).
 resample_uniform_time : rows resampled to evenly spaced times.
+edge_from_time_map : the lab's edge per (frame, row) from a shadow-time map.
+pushbroom_from_shadow_time : the lab pushbroom dataset of one sweep (front function).
 """
 
 import numpy as np
@@ -54,23 +64,31 @@ def sample_along_edge(image, edge_row):
     return out
 
 
-def assemble_pushbroom(reference, edge_row):
-    """Return the ridge pushbroom.
+def assemble_pushbroom(reference, edge_row, *, along="col"):
+    """Return the pushbroom.
 
     Parameters
     ----------
     reference : (H, W, C) ndarray
         The registered first frame (colour source; see the module docstring).
     edge_row : (T, W) ndarray
-        Edge rows per frame.
+        Edge rows per frame (pixel-edge coordinates); with ``along="row"`` a (T, H) array
+        of edge columns per row.
+    along : {"col", "row"}, keyword-only
+        The camera axis the edge runs along: ``col`` (the outdoor ridge: one edge row per
+        column) or ``row`` (a vertical wire's shadow: one edge column per row).
 
     Returns
     -------
-    (T, W, C) ndarray
+    (T, W, C) ndarray, or (T, H, C) with ``along="row"``
         Row k = colours along the edge of frame k.
     """
     edge = np.asarray(edge_row)
     check_array(edge, "edge_row", ndim=2)
+    if along not in ("col", "row"):
+        raise ValueError(f"along must be one of 'col', 'row'; got {along!r}")
+    if along == "row":
+        reference = np.asarray(reference).transpose(1, 0, 2)
     return np.stack([sample_along_edge(reference, row) for row in edge])
 
 
@@ -102,3 +120,101 @@ def resample_uniform_time(pushbroom, time_s, *, step_s):
     frac = ((grid - times[before]) / (times[after] - times[before]))[:, None, None]
     out = (1 - frac) * data[before] + frac * data[after]
     return grid, out.astype(np.asarray(pushbroom).dtype)
+
+
+def edge_from_time_map(shadow_time, frames, *, along="row"):
+    """Where the shadow edge is in each frame: the crossing of the shadow-time map.
+
+    Along each camera row (``along="row"``: the edge runs along the rows' direction, one
+    edge column per row) the edge at frame k lies between the first pair of neighbouring
+    pixels whose times bracket k, linearly interpolated between their centres.
+
+    Parameters
+    ----------
+    shadow_time : (H, W) ndarray
+        Shadow times (frames); NaN = none (no crossing through a NaN pixel).
+    frames : (T,) array_like
+        Frame indices (fractional allowed).
+    along : {"row", "col"}, keyword-only
+        ``row``: edge column per (frame, row); ``col``: edge row per (frame, column).
+
+    Returns
+    -------
+    (T, H) float64 ndarray, or (T, W) with ``along="col"``
+        Edge positions in pixel-edge coordinates (pixel i has its centre at i + 0.5), NaN
+        where the frame crosses no pair of timed neighbours.
+    """
+    t = check_array(np.asarray(shadow_time, dtype=np.float64), "shadow_time", ndim=2)
+    if along not in ("col", "row"):
+        raise ValueError(f"along must be one of 'col', 'row'; got {along!r}")
+    frames = check_array(np.asarray(frames, dtype=np.float64), "frames", ndim=1)
+    if along == "col":
+        t = t.T
+    left, right = t[:, :-1], t[:, 1:]
+    out = np.full((frames.size, t.shape[0]), np.nan)
+    cols = np.arange(left.shape[1])
+    for k, frame in enumerate(frames):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            lo, hi = np.minimum(left, right), np.maximum(left, right)
+            bracket = (lo <= frame) & (frame <= hi) & (hi > lo)
+            frac = (frame - left) / (right - left)
+        first = np.where(bracket.any(axis=1), np.argmax(bracket, axis=1), -1)
+        has = first >= 0
+        rows = np.nonzero(has)[0]
+        out[k, rows] = cols[first[has]] + 0.5 + frac[rows, first[has]]
+    return out
+
+
+def pushbroom_from_shadow_time(shadow_time, *, sweep, reference=None):
+    """The lab shadow pushbroom of one sweep (Fig. 10 IV-V): shadow time x position along
+    the shadow line.
+
+    The colours come from the sweep's lit image (the scene lit by the light and seen by the
+    camera, the paper's Fig. 10(V) look) or `reference`, read at the edge of each frame.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``shadow_time (sweep, row, col)``, ``lit_image (sweep, row, col, channel)``; attrs
+        ``n_frames_<sweep>``.
+    sweep : str, keyword-only
+        The sweep's name.
+    reference : (H, W, C) ndarray, optional
+        Colour source instead of the lit image.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``pushbroom (time, position, channel)`` float32 and ``edge (time, position)``
+        (pixel-edge coordinates across the shadow line); attrs ``along`` (``row``: position
+        is the camera row, ``col``: the column) and ``sweep``.
+    """
+    import xarray as xr
+
+    names = [str(s) for s in shadow_time["sweep"].values]
+    if sweep not in names:
+        raise ValueError(f"sweep must be one of {names}; got {sweep!r}")
+    t = shadow_time["shadow_time"].sel(sweep=sweep).transpose("row", "col").values
+    n_frames = int(shadow_time.attrs.get(f"n_frames_{sweep}", 0))
+    if n_frames < 2:
+        raise ValueError(f"shadow_time: attr n_frames_{sweep} missing or < 2")
+    if reference is None:
+        reference = shadow_time["lit_image"].sel(sweep=sweep).transpose("row", "col", "channel").values
+    reference = np.asarray(reference)
+    if reference.ndim != 3 or reference.shape[:2] != t.shape:
+        raise ValueError(f"reference must be {t.shape + ('C',)}; got shape {reference.shape}")
+    with np.errstate(invalid="ignore"):
+        d_col = np.nanmedian(np.abs(np.diff(t, axis=1)))
+        d_row = np.nanmedian(np.abs(np.diff(t, axis=0)))
+    along = "col" if d_row > d_col else "row"
+    edge = edge_from_time_map(t, np.arange(n_frames), along=along)
+    image = assemble_pushbroom(reference, edge, along=along)
+    channels = shadow_time["channel"].values if "channel" in shadow_time.coords else None
+    return xr.Dataset(
+        {"pushbroom": (("time", "position", "channel"), image.astype(np.float32),
+                       {"long_name": f"colours along the shadow edge of sweep {sweep}"}),
+         "edge": (("time", "position"), edge.astype(np.float32),
+                  {"units": "pixel", "long_name": "edge across the shadow line (pixel-edge coordinates)"})},
+        coords={"time": np.arange(n_frames), "position": np.arange(edge.shape[1]),
+                **({"channel": channels} if channels is not None else {})},
+        attrs={"sweep": sweep, "along": along, "projection": "pushbroom"})
