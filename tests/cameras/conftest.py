@@ -16,7 +16,7 @@ import pytest
 
 from shadowcam.lab.shadow_time import shadow_time_dataset, sweep_shadow_times
 from shadowcam.synthetic.lab.render import prepare_capture
-from shadowcam.synthetic.lab.scene import scene_from_description
+from shadowcam.synthetic.lab.scenes import scene_from_description
 
 
 @pytest.fixture(scope="session")

@@ -14,7 +14,7 @@ from shadowcam.cameras.accuracy import (
 from shadowcam.cameras.models import camera_coords_from_shadow_time
 from shadowcam.lab.accuracy import dual_coord_errors
 from shadowcam.synthetic.lab.edges import square_edge_points
-from shadowcam.synthetic.lab.scene import scene_from_description
+from shadowcam.synthetic.lab.scenes import scene_from_description
 
 SWEEPS = [{"name": "u"}, {"name": "v", "angle_deg": 90},
           {"name": "w", "angle_deg": 45, "speed": 1.0}]
