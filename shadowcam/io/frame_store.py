@@ -31,6 +31,7 @@ import json
 import logging
 import os
 import shutil
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -373,7 +374,10 @@ def open_frames(path):
         tmp = path.with_name(path.name + ".tmp")
         hint = " (an unfinished write left it as .tmp; rerun the decode step)" if tmp.exists() else ""
         raise ValueError(f"frame store {path} does not exist{hint}")
-    return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
+    with warnings.catch_warnings():
+        # Snakemake marks directory outputs with a .snakemake_timestamp file, which zarr warns about
+        warnings.filterwarnings("ignore", message=r"Object at \.snakemake_timestamp is not recognized")
+        return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
 
 
 def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
