@@ -139,6 +139,7 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
     """Decode frames one at a time into a time-chunked zarr v3 store.
 
     Memory stays bounded by one time chunk whatever the number of frames.
+    Progress (frames done, rate, time left) is logged about every 5 s.
 
     Parameters
     ----------
