@@ -5,6 +5,8 @@
 # `make bench-outdoor-size` the same stages at a camera's size (24 MP by default), extrapolated.
 # `make bench` prints the speed benchmark (not part of the tests; ~10 min per compression,
 # renders its DNG input once into results/bench/dng-<compression> and reuses it).
+# `make shell` opens a shell inside .venv (`shadowcam`, `snakemake` on PATH; `exit` leaves it);
+# `make shell CMD='...'` runs one command in it.
 # Every target installs the package (editable, with test and SLURM-executor extras) into .venv first.
 
 PYTHON ?= python3
@@ -31,7 +33,9 @@ BENCH_CHUNK ?= 1
 # registration's factor 4): mask margin around it 6 + 8 reduced pixels (outdoor.normalise.registration_margin)
 BENCH_MARGIN ?= 14
 
-.PHONY: demo test lint install clean bench bench-outdoor bench-outdoor-size
+CMD ?=
+
+.PHONY: demo test lint install shell clean bench bench-outdoor bench-outdoor-size
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -42,6 +46,14 @@ $(STAMP): pyproject.toml | $(BIN)/python
 	touch $(STAMP)
 
 install: $(STAMP)
+
+shell: $(STAMP)
+ifeq ($(strip $(CMD)),)
+	@echo "In the shadowcam environment ($(CURDIR)/$(VENV)); 'exit' leaves it."
+	@PATH="$(CURDIR)/$(BIN):$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" $${SHELL:-/bin/sh} -i
+else
+	@PATH="$(CURDIR)/$(BIN):$$PATH" VIRTUAL_ENV="$(CURDIR)/$(VENV)" /bin/sh -c '$(CMD)'
+endif
 
 demo: $(STAMP)
 	PATH="$(CURDIR)/$(BIN):$$PATH" $(SNAKEMAKE) --profile profiles/local --config datasets=[$(DATASET)]

@@ -4,6 +4,10 @@ Offers
 ------
 atomic_path : context manager yielding a temporary file path that replaces the target on success.
 atomic_directory : context manager yielding a temporary directory that replaces the target on success.
+umask : the process's file-creation mask.
+
+Outputs get the modes of a plain ``open``/``mkdir`` (``0o666`` / ``0o777``
+less the umask), so a group that shares the results can read them.
 """
 
 import contextlib
@@ -24,6 +28,7 @@ def atomic_path(path):
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
     os.close(fd)
+    os.chmod(tmp, 0o666 & ~umask())  # mkstemp creates 0o600
     try:
         yield Path(tmp)
         os.replace(tmp, path)
@@ -58,3 +63,14 @@ def atomic_directory(path):
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+
+
+def umask():
+    """Return the process's umask (read without changing it where the system allows)."""
+    with contextlib.suppress(OSError, ValueError), open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask

@@ -1,8 +1,9 @@
 """Command line interface: ``shadowcam <step> ...``.
 
 Each step lives in its own module of this package and exposes
-``add_parser(subparsers)`` (which registers the step and its options) and
-``run(args)``. Snakemake rules call exactly one step each.
+``add_parser(subparsers, name)`` (which registers the step and its options) and
+``run(args)``; its ``--help`` text and example come from the module docstring
+(:mod:`shadowcam.cli.help_text`). Snakemake rules call exactly one step each.
 """
 
 import argparse
@@ -11,6 +12,7 @@ import logging
 import sys
 
 from shadowcam import __version__
+from shadowcam.cli.help_text import DESCRIPTION, step_texts
 
 #: step name -> module (inside ``shadowcam.cli``) that implements it
 STEPS = {
@@ -47,7 +49,8 @@ def build_parser(steps=None):
     A job runs one step, so :func:`main` registers only that one: importing every
     step's libraries (plotting, compiled kernels, ...) would add seconds to each job.
     """
-    parser = argparse.ArgumentParser(prog="shadowcam", description=__doc__)
+    parser = argparse.ArgumentParser(prog="shadowcam", description=DESCRIPTION,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=__version__)
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     subparsers = parser.add_subparsers(dest="step", required=True, metavar="STEP")
@@ -61,6 +64,8 @@ def build_parser(steps=None):
                 continue  # step not part of this installation
             raise
         sub = module.add_parser(subparsers, name)
+        sub.description, sub.epilog = step_texts(module.__doc__)
+        sub.formatter_class = argparse.RawDescriptionHelpFormatter
         sub.set_defaults(run=module.run)
     return parser
 

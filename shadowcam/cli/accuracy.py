@@ -6,6 +6,13 @@ noise condition that selects the shadow-time target comes from ``--params
 or ``synthetic.noise``,
 else ``noise_free``.
 
+Example::
+
+    shadowcam accuracy --manifest data_manifest/synthetic_lab.yaml \\
+        --shadow-time results/synthetic_lab/shadow_time.nc --dual-coords results/synthetic_lab/dual_coords.nc \\
+        --dual-view results/synthetic_lab/dual_view.nc \\
+        --out-json results/synthetic_lab/accuracy.json --out-csv results/synthetic_lab/accuracy.csv
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -23,8 +30,7 @@ log = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register ``accuracy`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="accuracy against ground truth (synthetic data)",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="accuracy against ground truth (synthetic data)")
     parser.add_argument("--manifest", required=True, help="capture description with a ground_truth entry")
     parser.add_argument("--shadow-time", required=True, help="results/<ds>/shadow_time.nc")
     parser.add_argument("--dual-coords", default=None, help="results/<ds>/dual_coords.nc")

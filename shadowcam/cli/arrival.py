@@ -3,6 +3,11 @@
 Edge crossing of the tracked edges, checked against the pixel's own coverage
 crossing (:mod:`shadowcam.outdoor.arrival`). Writes ``results/<ds>/outdoor/arrival.nc``.
 
+Example::
+
+    shadowcam arrival --photometry results/dev_ridge/outdoor/photometry.nc \\
+        --edges results/dev_ridge/outdoor/edges.nc --out results/dev_ridge/outdoor/arrival.nc
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -16,8 +21,7 @@ from shadowcam.outdoor.arrival import arrival_map
 
 def add_parser(subparsers, name):
     """Register ``arrival`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="per-pixel shadow-arrival time map from the tracked edges",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="per-pixel shadow-arrival time map from the tracked edges")
     parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
     parser.add_argument("--edges", required=True, help="results/<ds>/outdoor/edges.nc")
     parser.add_argument("--params", default="{}",

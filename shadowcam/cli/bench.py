@@ -5,6 +5,10 @@ throughput against the decode floor, the shadow-time stage against one numpy
 pass, peak memory for a short and a long sequence, and the default
 configuration's accuracy. Not part of the test suite.
 
+Example::
+
+    shadowcam bench --compression none --frames 96 --json results/bench/figures-none.json
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -19,15 +23,14 @@ from shadowcam.evaluate.speed_benchmark import WireScene, format_report, run_ben
 
 def add_parser(subparsers, name):
     """Register ``bench`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="speed benchmark (make bench)",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="speed benchmark (make bench)")
     parser.add_argument("--dir", help="where the DNG sweep is rendered (default results/bench/dng-<compression>)")
     parser.add_argument("--compression", choices=("ljpeg", "none"), default="ljpeg",
                         help="DNG compression: lossless JPEG as cameras write (default), or none")
     parser.add_argument("--frames", type=int, default=1000, help="frames of the long sequence")
     parser.add_argument("--short", type=int, default=100, help="frames of the short sequence")
-    parser.add_argument("--height", type=int, default=1200)
-    parser.add_argument("--width", type=int, default=1600)
+    parser.add_argument("--height", type=int, default=1200, help="frame rows, pixels")
+    parser.add_argument("--width", type=int, default=1600, help="frame cols, pixels")
     parser.add_argument("--workers", type=int, default=2, help="processes (cores)")
     parser.add_argument("--json", help="also write the figures to this JSON file")
     return parser

@@ -12,6 +12,11 @@ once. Disk: the decoded frame store per frame. With ``--photometry`` and ``--sha
 (a sample's sidecar, ``shadowcam outdoor-sample``) it also prints the registration
 error at that size against the applied shake.
 
+Example::
+
+    shadowcam bench-report --benchmarks benchmarks/dev_ridge \\
+        --frames results/dev_ridge/frames/timelapse.zarr --extrapolate 1000
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -28,8 +33,7 @@ from shadowcam.io.frame_store import open_frames
 
 def add_parser(subparsers, name):
     """Register ``bench-report`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="per-stage throughput / memory of a run, extrapolated",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="per-stage throughput / memory of a run, extrapolated")
     parser.add_argument("--benchmarks", required=True, help="benchmarks/<ds> directory of a finished run")
     parser.add_argument("--frames", required=True, help="the run's frame store (results/<ds>/frames/<sweep>.zarr)")
     parser.add_argument("--compare", default=None, help="benchmarks/<ds> of a run with fewer frames (memory growth)")

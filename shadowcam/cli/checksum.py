@@ -4,6 +4,10 @@ Declaring a capture: write ``data_manifest/<name>.yaml`` without (or with a
 stale) ``checksums`` block, run ``shadowcam checksum --manifest <it>``, paste
 the printed block into the file.
 
+Example::
+
+    shadowcam checksum --manifest data_manifest/my_capture.yaml
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -18,7 +22,6 @@ def add_parser(subparsers, name):
     parser = subparsers.add_parser(
         name,
         help="print the sha256 checksums block for a manifest",
-        description=__doc__.split("\n\n")[1],
     )
     parser.add_argument("--manifest", required=True, help="data_manifest/<name>.yaml (or capture.json)")
     return parser

@@ -5,6 +5,11 @@ into ``results/<ds>/frames/<sweep>.zarr`` (:func:`shadowcam.io.sweep_store.decod
 With ``--frames START:STOP`` it decodes only that range into a *part* store
 (one job of a long sweep; ``shadowcam merge-frames`` joins the parts).
 
+Example::
+
+    shadowcam decode --manifest data_manifest/dev_spheres.yaml --sweep u \\
+        --out results/dev_spheres/frames/u.zarr
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -21,7 +26,6 @@ def add_parser(subparsers, name):
     parser = subparsers.add_parser(
         name,
         help="decode a sweep (or the reference frame) into a zarr frame store",
-        description=__doc__.split("\n\n")[0].strip("`"),
     )
     parser.add_argument("--manifest", required=True, help="data_manifest/<name>.yaml or capture.json")
     parser.add_argument("--sweep", required=True, help="sweep name (u, v, cal_u, cal_v, ...) or 'reference'")

@@ -6,6 +6,11 @@ manifest's ``calibration_plane`` homography and optional mask) and writes
 ``--model auto`` uses the calibration plane when the manifest has one and the
 calibration sweeps ``cal_u``, ``cal_v`` were timed, else uniform motion.
 
+Example::
+
+    shadowcam dual-coords --shadow-time results/dev_spheres/shadow_time.nc \\
+        --manifest data_manifest/dev_spheres.yaml --model auto --out results/dev_spheres/dual_coords.nc
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -32,11 +37,11 @@ _GRID_KEYS = ("dual_width", "dual_height", "min_confidence")
 
 def add_parser(subparsers, name):
     """Register ``dual-coords`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="shadow times -> dual coordinates",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="shadow times -> dual coordinates")
     parser.add_argument("--shadow-time", required=True, help="results/<ds>/shadow_time.nc")
     parser.add_argument("--manifest", required=True, help="data_manifest/<ds>.yaml or capture.json")
-    parser.add_argument("--model", default="auto", choices=["auto", *DUAL_COORD_METHODS])
+    parser.add_argument("--model", default="auto", choices=["auto", *DUAL_COORD_METHODS],
+                        help="mapping from shadow times to u, v (default auto: the simplest the data support)")
     parser.add_argument("--params", default="{}", help="JSON: dual_width, dual_height, min_confidence, "
                         f"uniform: {', '.join(UNIFORM_OPTIONS)}; calibration: {', '.join(CALIBRATION_OPTIONS)}")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/dual_coords.nc")

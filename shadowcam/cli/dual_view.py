@@ -5,6 +5,12 @@ Reads ``dual_coords.nc`` and ``shadow_time.nc`` (for the mean lit image, or
 linear float EXR and an 8-bit sRGB PNG preview (holes in grey)
 (:func:`shadowcam.cameras.dual_view.dual_view_from_coords`).
 
+Example::
+
+    shadowcam dual-view --dual-coords results/dev_spheres/dual_coords.nc \\
+        --shadow-time results/dev_spheres/shadow_time.nc --out results/dev_spheres/dual_view.nc \\
+        --png results/dev_spheres/dual_view.png
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -25,12 +31,12 @@ log = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register ``dual-view`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="resample camera colours into the dual view",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="resample camera colours into the dual view")
     parser.add_argument("--dual-coords", required=True, help="results/<ds>/dual_coords.nc")
     parser.add_argument("--shadow-time", required=True, help="results/<ds>/shadow_time.nc (lit_image)")
     parser.add_argument("--reference", default=None, help="reference frame store (results/<ds>/frames/reference.zarr)")
-    parser.add_argument("--method", default="mesh", choices=sorted(DUAL_VIEW_METHODS))
+    parser.add_argument("--method", default="mesh", choices=sorted(DUAL_VIEW_METHODS),
+                        help="resampling onto the dual grid (default mesh)")
     parser.add_argument("--params", default="{}",
                         help="JSON method options: mesh: max_edge; idw: k, radius, power")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/dual_view.nc")

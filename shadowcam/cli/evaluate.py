@@ -1,6 +1,6 @@
 """``shadowcam evaluate``: the simulation study (paper II-C, Fig. 5), reproduced and extended.
 
-Usage::
+Example::
 
     shadowcam evaluate --params '{"levels": {"frames": [96, 48, 12]}, "size": 64}' \\
         --out results/evaluate/study.nc --figures results/evaluate/figures
@@ -25,8 +25,7 @@ from shadowcam.io.datasets import write_dataset
 
 def add_parser(subparsers, name):
     """Register ``evaluate`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="simulation study of the dual pipeline (Fig. 5)",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="simulation study of the dual pipeline (Fig. 5)")
     parser.add_argument("--params", default="{}",
                         help="JSON: levels, baseline, scene, size, supersample, seed, method, "
                              "half_window, dual_view_method")

@@ -5,6 +5,11 @@ their chunk files are hard-linked, not copied (``shadowcam.io.frame_store``), an
 the provenance lists the checksums of every part's input files, so the store
 equals a single-job decode of the whole sweep.
 
+Example::
+
+    shadowcam merge-frames --parts results/dev_spheres/frames/u.part0.zarr \\
+        results/dev_spheres/frames/u.part1.zarr --out results/dev_spheres/frames/u.zarr
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -22,8 +27,7 @@ from shadowcam.io.provenance import attach_provenance
 
 def add_parser(subparsers, name):
     """Register ``merge-frames`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="join part stores of a sweep into one frame store",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="join part stores of a sweep into one frame store")
     parser.add_argument("--parts", nargs="+", required=True, help="part stores in time order")
     parser.add_argument("--out", required=True, help="output store, e.g. results/<ds>/frames/u.zarr")
     return parser

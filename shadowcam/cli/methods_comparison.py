@@ -6,6 +6,14 @@ throughput, peak memory and error against the ground truth
 (:func:`shadowcam.evaluate.methods_comparison.compare_methods`), and writes the
 table (netCDF and CSV) and the speed-versus-error chart with the Pareto front.
 
+Example::
+
+    shadowcam methods-comparison --manifest data_manifest/synthetic_lab.yaml \\
+        --frames results/synthetic_lab/frames/u.zarr results/synthetic_lab/frames/v.zarr --sweeps u v \\
+        --shadow-time results/synthetic_lab/shadow_time.nc --dual-coords results/synthetic_lab/dual_coords.nc \\
+        --out results/synthetic_lab/methods/methods.nc --csv results/synthetic_lab/methods/methods.csv \\
+        --figure results/synthetic_lab/methods/speed_vs_error.png
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -23,8 +31,7 @@ log = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register ``methods-comparison`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="speed against error of every method",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="speed against error of every method")
     parser.add_argument("--manifest", required=True, help="capture description with ground truth")
     parser.add_argument("--frames", nargs="+", required=True, help="frame stores of the scene sweeps")
     parser.add_argument("--sweeps", nargs="+", required=True, help="their sweep names (u v)")

@@ -82,3 +82,4 @@ def parse_strip(text, *, option="--strip"):
     if not 0 <= index < count:
         raise ValueError(f"{option} {text}: I must be in [0, N)")
     return index, count
+

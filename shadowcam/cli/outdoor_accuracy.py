@@ -8,6 +8,14 @@ issue's targets for the capture's condition (``--params '{"condition":
 one of these, else ``nuisances``), and writes JSON plus a flat CSV
 (:func:`shadowcam.outdoor.accuracy.outdoor_accuracy`).
 
+Example::
+
+    shadowcam outdoor-accuracy --manifest data_manifest/dev_ridge.yaml \\
+        --frames results/dev_ridge/frames/timelapse.zarr --photometry results/dev_ridge/outdoor/photometry.nc \\
+        --edges results/dev_ridge/outdoor/edges.nc --arrival results/dev_ridge/outdoor/arrival.nc \\
+        --pushbroom results/dev_ridge/outdoor/pushbroom.nc \\
+        --out-json results/dev_ridge/outdoor/accuracy.json --out-csv results/dev_ridge/outdoor/accuracy.csv
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -30,8 +38,7 @@ log = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register ``outdoor-accuracy`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="outdoor accuracy against ground truth, with the naive baseline",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="outdoor accuracy against ground truth, with the naive baseline")
     parser.add_argument("--manifest", required=True, help="capture description with a ground_truth entry")
     parser.add_argument("--frames", required=True, help="frame store (for the naive baseline)")
     parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
@@ -39,8 +46,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--arrival", required=True, help="results/<ds>/outdoor/arrival.nc")
     parser.add_argument("--pushbroom", required=True, help="results/<ds>/outdoor/pushbroom.nc")
     parser.add_argument("--params", default="{}", help='JSON: {"condition": "clean" | "nuisances"}')
-    parser.add_argument("--out-json", required=True)
-    parser.add_argument("--out-csv", required=True)
+    parser.add_argument("--out-json", required=True, help="results/<ds>/outdoor/accuracy.json")
+    parser.add_argument("--out-csv", required=True, help="results/<ds>/outdoor/accuracy.csv")
     return parser
 
 

@@ -5,6 +5,13 @@ pushbroom beside the real view (sky masked), and with an accuracy report the
 error histogram and an HTML table of the figures against the targets
 (:func:`shadowcam.report.outdoor_report.write_outdoor_figures`).
 
+Example::
+
+    shadowcam outdoor-figures --frames results/dev_ridge/frames/timelapse.zarr \\
+        --photometry results/dev_ridge/outdoor/photometry.nc --edges results/dev_ridge/outdoor/edges.nc \\
+        --arrival results/dev_ridge/outdoor/arrival.nc --pushbroom results/dev_ridge/outdoor/pushbroom.nc \\
+        --outdir results/dev_ridge/outdoor/figures
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -21,15 +28,14 @@ from shadowcam.report.outdoor_report import write_outdoor_figures
 
 def add_parser(subparsers, name):
     """Register ``outdoor-figures`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="report figures of an outdoor time-lapse",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
-    parser.add_argument("--frames", required=True)
-    parser.add_argument("--photometry", required=True)
-    parser.add_argument("--edges", required=True)
-    parser.add_argument("--arrival", required=True)
-    parser.add_argument("--pushbroom", required=True)
+    parser = subparsers.add_parser(name, help="report figures of an outdoor time-lapse")
+    parser.add_argument("--frames", required=True, help="frame store of the time-lapse sweep")
+    parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
+    parser.add_argument("--edges", required=True, help="results/<ds>/outdoor/edges.nc")
+    parser.add_argument("--arrival", required=True, help="results/<ds>/outdoor/arrival.nc")
+    parser.add_argument("--pushbroom", required=True, help="results/<ds>/outdoor/pushbroom.nc")
     parser.add_argument("--accuracy", default=None, help="outdoor accuracy JSON (optional)")
-    parser.add_argument("--outdir", required=True)
+    parser.add_argument("--outdir", required=True, help="output directory of the PNG figures (created)")
     return parser
 
 

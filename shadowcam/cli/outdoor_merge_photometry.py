@@ -7,6 +7,11 @@ shadow levels as the single job does. Parts are read one at a time (ordered by
 their ``first_frame`` attribute, read without loading the data), so memory does
 not grow with their number. Writes ``results/<ds>/outdoor/photometry.nc``.
 
+Example::
+
+    shadowcam outdoor-merge-photometry --parts results/dev_ridge/outdoor/photometry.part0.nc \\
+        results/dev_ridge/outdoor/photometry.part1.nc --out results/dev_ridge/outdoor/photometry.nc
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -19,8 +24,7 @@ from shadowcam.outdoor.photometry import merge_photometry_parts
 
 def add_parser(subparsers, name):
     """Register ``outdoor-merge-photometry`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="merge the time parts of the first outdoor pass",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="merge the time parts of the first outdoor pass")
     parser.add_argument("--parts", nargs="+", required=True, help="part datasets (any order)")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/outdoor/photometry.nc")
     return parser

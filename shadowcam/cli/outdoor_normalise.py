@@ -7,6 +7,11 @@ shadow levels. Writes ``results/<ds>/outdoor/photometry.nc``; with
 ``--part START:STOP`` only that time part (after its warm-up frames), to be
 merged by ``shadowcam outdoor-merge-photometry``.
 
+Example::
+
+    shadowcam outdoor-normalise --manifest data_manifest/dev_ridge.yaml \\
+        --frames results/dev_ridge/frames/timelapse.zarr --out results/dev_ridge/outdoor/photometry.nc
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -22,8 +27,7 @@ from shadowcam.outdoor.photometry import PHOTOMETRY_OPTIONS, photometry_from_fra
 
 def add_parser(subparsers, name):
     """Register ``outdoor-normalise`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="register an outdoor time-lapse; gains, sky mask, levels",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="register an outdoor time-lapse; gains, sky mask, levels")
     parser.add_argument("--manifest", required=True, help="capture description (sky_mask, exposure keys)")
     parser.add_argument("--frames", required=True, help="frame store of the time-lapse sweep")
     parser.add_argument("--params", default="{}",

@@ -10,6 +10,11 @@ the frame times and the applied shake (``timestamps.json``: ``times_s``,
 benchmark (``make bench-outdoor-size``), which also measures the registration against
 the recorded shake. No arrival-time ground truth at that size.
 
+Example::
+
+    shadowcam outdoor-sample --source data_manifest/dev_ridge.yaml --size 6000x4000 --frames 16 \\
+        --name bench16 --outdir /tmp/bench/data/bench16 --manifest-out /tmp/bench/data_manifest/bench16.yaml
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -24,13 +29,12 @@ from shadowcam.synthetic.outdoor.sample import write_sample
 
 def add_parser(subparsers, name):
     """Register ``outdoor-sample`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="write a real-size DNG time-lapse sample (benchmarks)",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="write a real-size DNG time-lapse sample (benchmarks)")
     parser.add_argument("--source", required=True, help="manifest of a small outdoor capture (data_manifest/dev_ridge.yaml)")
     parser.add_argument("--size", default="6000x4000", help="COLSxROWS of the sample (default 6000x4000 = 24 MP)")
     parser.add_argument("--frames", type=int, default=16, help="number of frames")
     parser.add_argument("--first", type=int, default=40, help="first source frame used")
-    parser.add_argument("--bit-depth", type=int, default=14, help="sensor bit depth")
+    parser.add_argument("--bit-depth", type=int, default=14, help="sensor bit depth, bits")
     parser.add_argument("--seed", type=int, default=0, help="noise and shake seed")
     parser.add_argument("--shake-px", type=float, default=2.0,
                         help="largest camera shake of the sample, pixels (0: none; default 2)")

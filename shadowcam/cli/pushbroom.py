@@ -4,6 +4,12 @@ Colours of the registered first frame along each frame's edge, stacked over
 time (:mod:`shadowcam.cameras.pushbroom`). Writes ``results/<ds>/outdoor/pushbroom.nc``
 and a PNG preview resampled to evenly spaced times (time upward).
 
+Example::
+
+    shadowcam pushbroom --photometry results/dev_ridge/outdoor/photometry.nc \\
+        --edges results/dev_ridge/outdoor/edges.nc --out results/dev_ridge/outdoor/pushbroom.nc \\
+        --png results/dev_ridge/outdoor/pushbroom.png
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -20,8 +26,7 @@ from shadowcam.cameras.pushbroom import assemble_pushbroom, resample_uniform_tim
 
 def add_parser(subparsers, name):
     """Register ``pushbroom`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="ridge pushbroom from the tracked edges",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="ridge pushbroom from the tracked edges")
     parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
     parser.add_argument("--edges", required=True, help="results/<ds>/outdoor/edges.nc")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/outdoor/pushbroom.nc")

@@ -6,6 +6,12 @@ Writes into ``--outdir`` (:func:`shadowcam.report.dataset_report.write_report_fi
 when the capture has ground truth), ``error_histogram.png`` (ground truth only) and
 ``accuracy.html`` (the ``--accuracy`` CSV as a table, when given).
 
+Example::
+
+    shadowcam report-figures --manifest data_manifest/dev_spheres.yaml \\
+        --shadow-time results/dev_spheres/shadow_time.nc --dual-view results/dev_spheres/dual_view.nc \\
+        --outdir results/dev_spheres/figures
+
 Offers ``add_parser(subparsers, name)`` and ``run(args)``.
 """
 
@@ -21,8 +27,7 @@ LOG = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register the step `name` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="write the report figures of one dataset",
-                                   description=__doc__)
+    parser = subparsers.add_parser(name, help="write the report figures of one dataset")
     parser.add_argument("--manifest", required=True,
                         help="capture description (data_manifest/X.yaml or capture.json)")
     parser.add_argument("--shadow-time", required=True, help="shadow_time.nc")

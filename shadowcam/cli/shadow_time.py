@@ -7,6 +7,11 @@ shadow-time method and writes ``results/<ds>/shadow_time.nc``
 by ``shadowcam shadow-time-chunk`` jobs: their partials are merged instead
 (the result is the same bit for bit).
 
+Example::
+
+    shadowcam shadow-time --frames results/dev_spheres/frames/u.zarr results/dev_spheres/frames/v.zarr \\
+        --sweeps u v --method edge_fit --out results/dev_spheres/shadow_time.nc
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -21,11 +26,11 @@ from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, shadow_time_of_stores
 
 def add_parser(subparsers, name):
     """Register ``shadow-time`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="per-pixel shadow times of the sweeps",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="per-pixel shadow times of the sweeps")
     parser.add_argument("--frames", nargs="+", required=True, help="frame stores, one per sweep")
     parser.add_argument("--sweeps", nargs="+", required=True, help="sweep names, same order")
-    parser.add_argument("--method", default="edge_fit", choices=sorted(SHADOW_TIME_METHODS))
+    parser.add_argument("--method", default="edge_fit", choices=sorted(SHADOW_TIME_METHODS),
+                        help="how each pixel's sub-frame shadow time is found (default edge_fit)")
     parser.add_argument("--params", default="{}", help="JSON: half_window, method_params, classify_params")
     parser.add_argument("--partials", nargs="+", action="append", metavar="SWEEP FILE",
                         help="a sweep name and the partial files of all its time chunks (repeat per sweep); "

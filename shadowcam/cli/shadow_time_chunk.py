@@ -5,6 +5,11 @@ Feeds the frames ``[START - pad, STOP + pad)`` of a frame store to a
 (``.npz``, written atomically). ``shadowcam shadow-time --partials`` merges the
 partials of every chunk into the same result as one streaming pass.
 
+Example::
+
+    shadowcam shadow-time-chunk --frames results/dev_spheres/frames/u.zarr --owned 0:64 \\
+        --out results/dev_spheres/shadow_time/u.part0.npz
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -24,8 +29,7 @@ log = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register ``shadow-time-chunk`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="dip tracking of one time chunk of a sweep",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="dip tracking of one time chunk of a sweep")
     parser.add_argument("--frames", required=True, help="frame store of the sweep")
     parser.add_argument("--owned", required=True, metavar="START:STOP",
                         help="frames whose dips and sums this chunk contributes (STOP may exceed the sweep)")

@@ -7,6 +7,11 @@ of unreliable frames. Writes ``results/<ds>/outdoor/edges.nc``. With ``--strips`
 pass is not run here: the column strips of ``shadowcam track-edges-strip`` jobs are
 merged (:func:`shadowcam.outdoor.edges.edges_from_strips`, equal to one job bit for bit).
 
+Example::
+
+    shadowcam track-edges --frames results/dev_ridge/frames/timelapse.zarr \\
+        --photometry results/dev_ridge/outdoor/photometry.nc --out results/dev_ridge/outdoor/edges.nc
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -22,8 +27,7 @@ from shadowcam.outdoor.strips import load_strip
 
 def add_parser(subparsers, name):
     """Register ``track-edges`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="track the shadow edge per frame; keyframe interpolation",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="track the shadow edge per frame; keyframe interpolation")
     parser.add_argument("--frames", required=True, help="frame store of the time-lapse sweep")
     parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
     parser.add_argument("--params", default="{}",

@@ -6,6 +6,12 @@ every frame, tracks it (:func:`shadowcam.outdoor.edges.track_column_strip`) and 
 the strip (``.npz``, written atomically). ``shadowcam track-edges --strips`` merges the
 strips of a frame into exactly the single job's edges.
 
+Example::
+
+    shadowcam track-edges-strip --frames results/dev_ridge/frames/timelapse.zarr \\
+        --photometry results/dev_ridge/outdoor/photometry.nc --strip 0/3 \\
+        --out results/dev_ridge/outdoor/edges.strip0.npz
+
 Offers
 ------
 add_parser : register the step and its options.
@@ -26,8 +32,7 @@ log = logging.getLogger(__name__)
 
 def add_parser(subparsers, name):
     """Register ``track-edges-strip`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="edge tracking of one column strip of the frames",
-                                   description=__doc__.split("\n\n")[0].strip("`"))
+    parser = subparsers.add_parser(name, help="edge tracking of one column strip of the frames")
     parser.add_argument("--frames", required=True, help="frame store of the time-lapse sweep")
     parser.add_argument("--photometry", required=True, help="results/<ds>/outdoor/photometry.nc")
     parser.add_argument("--strip", required=True, metavar="I/N", help="strip I (from 0) of N equal column strips")

@@ -31,13 +31,14 @@ import json
 import logging
 import os
 import shutil
-import time as _time
+import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 from zarr.codecs import ZstdCodec
 
+from shadowcam._shared.progress import Progress
 from shadowcam.io.decode import iter_frames
 
 log = logging.getLogger(__name__)
@@ -134,10 +135,11 @@ class _AtomicStore:
 
 
 def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk_frames=None,
-                 first_frame=0, log_every=25):
+                 first_frame=0):
     """Decode frames one at a time into a time-chunked zarr v3 store.
 
     Memory stays bounded by one time chunk whatever the number of frames.
+    Progress (frames done, rate, time left) is logged about every 5 s.
 
     Parameters
     ----------
@@ -161,8 +163,6 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
         Frame index of ``paths[0]`` in the whole sweep (a part store); the
         ``time`` coordinate counts from it. Must be a multiple of
         `chunk_frames` so that the part's chunks are chunks of the sweep.
-    log_every : int, optional
-        Log progress every this many frames.
 
     Returns
     -------
@@ -187,11 +187,9 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
             f"first_frame must be >= 0 and a multiple of chunk_frames (given explicitly); "
             f"got first_frame={first_frame}, chunk_frames={chunk_frames}"
         )
-    if log_every < 1:
-        raise ValueError(f"log_every must be >= 1; got {log_every}")
 
     n = len(paths)
-    started = _time.perf_counter()
+    progress = Progress(n, f"decode {Path(out_path).stem}")
     with _AtomicStore(out_path) as tmp:
         block, start, written = None, 0, 0
         for k, (path, image, info) in enumerate(iter_frames(paths)):
@@ -217,9 +215,7 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
                     ds.to_zarr(tmp, append_dim="time", zarr_format=3, consolidated=False)
                 written = k + 1
                 start = k + 1
-            if (k + 1) % log_every == 0 or k == n - 1:
-                elapsed = _time.perf_counter() - started
-                log.info("decoded %d/%d frames (%.1f frames/s) -> %s", k + 1, n, (k + 1) / max(elapsed, 1e-9), out_path)
+            progress.update(k + 1)
     assert written == n
     return Path(out_path)
 
@@ -379,7 +375,10 @@ def open_frames(path):
         tmp = path.with_name(path.name + ".tmp")
         hint = " (an unfinished write left it as .tmp; rerun the decode step)" if tmp.exists() else ""
         raise ValueError(f"frame store {path} does not exist{hint}")
-    return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
+    with warnings.catch_warnings():
+        # Snakemake marks directory outputs with a .snakemake_timestamp file, which zarr warns about
+        warnings.filterwarnings("ignore", message=r"Object at \.snakemake_timestamp is not recognized")
+        return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
 
 
 def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
@@ -421,18 +420,14 @@ def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):
         yield first, np.asarray(block, dtype=np.float32)
 
 
-def iter_store_frames(dataset, *, progress_every=50):
+def iter_store_frames(dataset, *, what="read frames"):
     """Yield the ``(H, W, C)`` float32 frames of `dataset` one at a time, in time order.
 
-    Reads one chunk at a time (:func:`iter_frame_chunks`) and logs progress every
-    `progress_every` frames.
+    Reads one chunk at a time (:func:`iter_frame_chunks`) and logs the progress
+    of the pass (:class:`shadowcam._shared.progress.Progress`), naming it `what`.
     """
-    if progress_every < 1:
-        raise ValueError(f"progress_every must be >= 1; got {progress_every}")
-    n_frames = dataset.sizes["time"]
+    progress = Progress(max(dataset.sizes["time"], 1), what)
     for start, block in iter_frame_chunks(dataset):
         for offset, frame in enumerate(block):
-            done = start + offset + 1
-            if done % progress_every == 0 or done == n_frames:
-                log.info("frame %d/%d", done, n_frames)
             yield frame
+            progress.update(start + offset + 1)

@@ -29,6 +29,7 @@ import numba as nb
 import numpy as np
 from scipy.special import ndtri
 
+from shadowcam._shared.progress import Progress
 from shadowcam._shared.validation import check_in_interval, check_positive
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
@@ -736,11 +737,8 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
             per_sweep[sweep] = summary_shadow_times(summary, **options)
         else:
             log.info("sweep %s: %d frames of %dx%d", sweep, n_frames, shape[0], shape[1])
-
-            def progress(done, sweep=sweep, n_frames=n_frames):
-                log.info("sweep %s: %d/%d frames", sweep, done, n_frames)
-
+            progress = Progress(max(n_frames, 1), f"shadow times of sweep {sweep}")
             per_sweep[sweep] = sweep_shadow_times(
                 (block for _, block in iter_frame_chunks(frames)), shape,
-                half_window=half_window, progress=progress, **options)
+                half_window=half_window, progress=progress.update, **options)
     return shadow_time_dataset(per_sweep)

@@ -358,7 +358,7 @@ def outdoor_accuracy(truth, frames, photometry, edges, arrival, pushbroom, *, co
     if "times_s" in truth and truth["times_s"].size == time_s.size:
         log.info("frame times vs GT: max |difference| %.3g s", float(np.max(np.abs(truth["times_s"].values - time_s))))
     baseline = NaiveBaseline((frames.sizes["row"], frames.sizes["col"]))
-    for frame, t in zip(iter_store_frames(frames), time_s):
+    for frame, t in zip(iter_store_frames(frames, what="naive baseline"), time_s):
         baseline.update(frame, t)
     # the maps are in the first frame's pixel grid; synthetic GT is in the unshaken camera
     shift = {"shift_row": 0.0, "shift_col": 0.0}

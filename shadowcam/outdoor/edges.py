@@ -69,7 +69,7 @@ def track_edges(frames, photometry, **options):
     _check_options(options, TRACK_OPTIONS | KEYFRAME_OPTIONS, "options")
     arrays = photometry_arrays(photometry)
     time_s = frames["time_s"].values
-    tracked = track_frames(iter_store_frames(frames), arrays, time_s,
+    tracked = track_frames(iter_store_frames(frames, what="edge tracking"), arrays, time_s,
                            **{k: v for k, v in options.items() if k in TRACK_OPTIONS})
     return _edges(tracked, arrays, time_s, options)
 
@@ -132,5 +132,5 @@ def track_column_strip(frames, photometry, *, index, count, **options):
     halo = strip_halo(arrays["shift"], margin=options.get("margin", 2))
     a, b = strip_window(cols, halo, width)
     log.info("strip %d/%d: columns %d:%d, reading %d:%d (halo %d)", index, count, *cols, a, b, halo)
-    return track_strip(iter_store_frames(frames.isel(col=slice(a, b))), arrays, frames["time_s"].values,
-                       cols=cols, halo=halo, **options)
+    stream = iter_store_frames(frames.isel(col=slice(a, b)), what=f"edge tracking, strip {index}/{count}")
+    return track_strip(stream, arrays, frames["time_s"].values, cols=cols, halo=halo, **options)

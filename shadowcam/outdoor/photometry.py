@@ -90,7 +90,7 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
                         registration_margin=options.get("registration_margin", 6))
     time_s = frames["time_s"].values
     if part is None:
-        result = normalise_frames(iter_store_frames(frames), **pass_options)
+        result = normalise_frames(iter_store_frames(frames, what="registration and gains"), **pass_options)
         return photometry_dataset(result, time_s, exposure_gain=exposure, sky_source=sky_source)
     start, stop = part
     if not 0 <= start < stop <= frames.sizes["time"]:
@@ -98,8 +98,8 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
     overlap = int(options.get("overlap", 2))
     first, _ = part_frames(start, stop, overlap=overlap)
     reference = frames["image"].isel(time=0).values
-    result = normalise_part(iter_store_frames(frames.isel(time=slice(first, stop))), start=start, stop=stop,
-                            reference=reference, overlap=overlap, **pass_options)
+    stream = iter_store_frames(frames.isel(time=slice(first, stop)), what=f"registration and gains {start}:{stop}")
+    result = normalise_part(stream, start=start, stop=stop, reference=reference, overlap=overlap, **pass_options)
     return photometry_part_dataset(result, time_s[start:stop], sky_source=sky_source,
                                    exposure_gain=None if exposure is None else exposure[start:stop])
 

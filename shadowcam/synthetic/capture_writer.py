@@ -29,6 +29,7 @@ import numpy as np
 
 from shadowcam import __version__
 from shadowcam._shared.atomic import atomic_directory
+from shadowcam._shared.progress import Progress
 from shadowcam.io.datasets import write_dataset
 from shadowcam.io.provenance import file_sha256
 from shadowcam.synthetic.capture_options import DEFAULTS, accuracy_condition, outdoor_options
@@ -160,13 +161,13 @@ def write_lab_capture(options, out_dir):
             (tmp / folder).mkdir()
             frames = renderer.frames(name)
             n = len(frames)
+            progress = Progress(n, f"render sweep {name}")
             for k in range(n):
                 rel = f"{folder}/{k:06d}.{ext}"
                 write(tmp / rel, frames[k], seed=[seed, SWEEP_INDEX[name], k],
                       when=CAPTURE_START + datetime.timedelta(seconds=k))
                 written.append(rel)
-                if (k + 1) % max(1, n // 4) == 0 or k + 1 == n:
-                    log.info("sweep %s: %d/%d frames written", name, k + 1, n)
+                progress.update(k + 1)
             sweeps[name] = {"files": f"{folder}/*.{ext}", "axis": name.removeprefix("cal_")}
             del frames
         checksums = {rel: file_sha256(tmp / rel) for rel in written}
@@ -251,12 +252,14 @@ def write_outdoor_capture(options, out_dir):
     with atomic_directory(out_dir) as tmp:
         (tmp / "frames").mkdir()
         written = []
+        progress = Progress(len(capture.frames), "write time-lapse frames")
         for k, image in enumerate(capture.frames):
             rel = f"frames/{k:06d}.{ext}"
             when = start + datetime.timedelta(milliseconds=int(round(times[k] * 1000.0)))
             write(tmp / rel, image, seed=[seed, TIMELAPSE_SWEEP_INDEX, k], when=when,
                   exposure_time=float(exposure_s[k]))
             written.append(rel)
+            progress.update(k + 1)
         side = {
             "units": "seconds since the first frame",
             "times_s": [float(t) for t in times],

@@ -86,7 +86,7 @@ def test_input_validation(tmp_path, make_frames):
 def _peak_bytes(paths, out):
     tracemalloc.start()
     try:
-        write_frames(paths, out, times_s=np.arange(len(paths), dtype=float), chunk_frames=10, log_every=1000)
+        write_frames(paths, out, times_s=np.arange(len(paths), dtype=float), chunk_frames=10)
         return tracemalloc.get_traced_memory()[1]
     finally:
         tracemalloc.stop()

@@ -161,6 +161,15 @@ def test_report_shows_every_figure(run, snakemake):
         assert name in page
 
 
+def test_run_and_report_say_only_what_is_the_users_business(run, snakemake):
+    workdir, _ = run
+    for log in (workdir / "logs" / DS).glob("*.log"):
+        assert "Warning" not in log.read_text(), log  # e.g. zarr on Snakemake's .snakemake_timestamp
+    result = snakemake(["--profile", "profiles/local", "--config", DATASETS, "--report", "quiet.html"], workdir)
+    assert result.returncode == 0, result.stdout[-3000:]
+    assert "Warning" not in result.stdout, result.stdout[-3000:]  # e.g. a coroutine never awaited
+
+
 def test_nothing_to_do_after_a_run(run, snakemake):
     workdir, _ = run
     assert planned_jobs(snakemake, workdir) == {}

@@ -2,7 +2,8 @@
 # unshadowed reference frame (when the capture has one) into its own store.
 # A sweep is decoded in time parts, one job each (decode_part: frames START:STOP into
 # a part store); `decode` joins the parts by hard-linking their chunk files, so the
-# sweep store equals a single-job decode bit for bit. Part sizes: parts.smk.
+# sweep store equals a single-job decode bit for bit. Part sizes: parts.smk, which
+# also says why a user capture's frames are a param of `decode`, not inputs.
 
 # reference.zarr is a single image, not a sweep (wildcard `sweep` never matches it):
 # decode_reference makes it.
@@ -45,6 +46,8 @@ rule decode:
     resources:
         mem_mb=1024,
         runtime=10,
+    params:
+        frames_stamp=get_sweep_stamp,
     shell:
         "shadowcam merge-frames --parts {input} --out {output} > {log} 2>&1"
 

@@ -14,6 +14,13 @@
 #
 # Memory of a job is bounded by one time chunk of chunk_frames frames, whatever the
 # frames per job.
+#
+# The frames of a user capture are not inputs of decode_part (a sweep has hundreds and
+# `snakemake -n` would print them all on one line): the manifest is, with their sha256
+# sums, and `decode` has a param digesting every frame's path, size and modification
+# time, so a changed frame decodes its sweep again.
+import hashlib
+
 from shadowcam.io.frame_store import default_chunk_frames
 
 
@@ -62,13 +69,31 @@ def get_decode_parts(wildcards):
 
 
 def get_part_files(wildcards):
-    """Files one decode_part job reads: the rendered capture, or the manifest and its frames."""
+    """Inputs of one decode_part job: the rendered capture, or the manifest (and missing frames).
+
+    A frame missing on disk stays an input, so that the dry run stops naming it.
+    """
     plan = capture(wildcards.ds)
     if plan.rendered:
         return [f"results/{wildcards.ds}/capture"]
     start, stop = part_range(wildcards)
-    files = plan.sweep(wildcards.sweep).files[start:stop]
-    return [manifest_path(wildcards.ds)] + relative(files)
+    files = relative(plan.sweep(wildcards.sweep).files[start:stop])
+    return [manifest_path(wildcards.ds)] + [f for f in files if not os.path.exists(f)]
+
+
+def get_sweep_stamp(wildcards):
+    """Digest of path, size and modification time of every frame of a user sweep ("" if rendered)."""
+    plan = capture(wildcards.ds)
+    if plan.rendered:
+        return ""
+    digest = hashlib.sha256()
+    for path in relative(plan.sweep(wildcards.sweep).files):
+        try:
+            stat = os.stat(path)
+            digest.update(f"{path}\0{stat.st_size}\0{stat.st_mtime_ns}\n".encode())
+        except FileNotFoundError:
+            digest.update(f"{path}\0missing\n".encode())
+    return digest.hexdigest()[:16]
 
 
 def get_part_range(wildcards):

@@ -19,15 +19,19 @@ edge_speed : fraction of vertically adjacent class-3 pixel pairs the edge crosse
 """
 
 import json
+import logging
 from dataclasses import dataclass
 
 import numpy as np
 
+from shadowcam._shared.progress import Progress
 from shadowcam.io.frame_times import time_to_frame
 from shadowcam.synthetic.outdoor import nuisance as nz
 from shadowcam.synthetic.outdoor import truth as gt
 from shadowcam.synthetic.outdoor.render import frame_radiance, sample_grid, sky_colour, trace_samples
 from shadowcam.synthetic.outdoor.sun import elevation_azimuth, sun_colour
+
+log = logging.getLogger(__name__)
 
 #: nuisance switches and their defaults (all on)
 NUISANCES = {"auto_exposure": True, "shake_px": 1.0, "cloud": True, "irregular_timing": True,
@@ -109,10 +113,13 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
     times, nominal, dropped = nz.capture_times(
         scene.duration_s, frames, seed=seed, irregular=bool(opts["irregular_timing"]),
         dropped=int(opts["dropped_frames"]))
+    log.info("outdoor render: tracing the terrain and its horizon for %dx%d pixels x %d samples",
+             rows, cols, s2)
     samples = trace_samples(scene, *sample_grid(rows, cols, s))
     centres = trace_samples(scene, *sample_grid(rows, cols))
 
     # ground truth: pixel centres and sub-pixel samples
+    log.info("outdoor render: ground-truth shadow arrival times over %d frames", len(times))
     t_centre, lit_centre, first = gt.arrival_times(centres, scene.sun, times)
     t_sub, lit_sub, _ = gt.arrival_times(samples, scene.sun, times)
     classes = gt.classify(lit_centre, first, centres.sky)
@@ -126,6 +133,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
     start_xy, velocity_xy = _cloud_path(scene, seed)
     hit = ~samples.sky
     radiance, clean, cloud_att = [], [], []
+    progress = Progress(len(times), "outdoor render: frames")
     for k, t in enumerate(times):
         trans = np.ones(len(samples.sky))
         if cloud_on:
@@ -137,6 +145,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         radiance.append(L)
         clean.append(L_clear)
         cloud_att.append(_pixel_mean(trans, (rows, cols), s2).astype(np.float32))
+        progress.update(k + 1)
+    log.info("outdoor render: exposure, shake and the pushbroom ground truth")
     radiance = np.stack(radiance)
     clean = np.stack(clean)
     levels = np.array([nz.metered_level(L) for L in radiance])
