@@ -116,33 +116,50 @@ def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
     return figure
 
 
-def dual_view_figure(dual_view, *, reciprocal=None, size=None):
+def dual_view_figure(dual_view, *, reciprocal=None, title="dual view (shadow camera)",
+                     reciprocal_title="ground-truth reciprocal view", note=None, size=None):
     """Figure of the dual view, next to the ground-truth reciprocal view if given.
 
-    Each panel is scaled to its own white point: the two views differ photometrically
-    (the camera and light fall-off terms swap), so only geometry is compared.
+    Both panels must be on the same dual grid (pixel (v, u) of one is pixel (v, u)
+    of the other). Each panel is scaled to its own white point: the two views
+    differ photometrically (the camera and light fall-off terms swap), so only
+    geometry is compared.
 
     Parameters
     ----------
     dual_view : (v, u) or (v, u, 1|3) ndarray
         Linear dual view; NaN = hole (drawn grey).
     reciprocal : (v, u) or (v, u, 1|3) ndarray, optional
-        Ground-truth reciprocal view (rendered from the light).
+        Ground-truth reciprocal view (rendered from the light) on the same grid.
+    title, reciprocal_title : str, optional
+        Panel titles.
+    note : str, optional
+        Text under the panels (e.g. which dual model and why), wrapped.
     size : (float, float), optional
-        Figure width, height in inches; default (5, 5) for one panel, (10, 5) for two.
+        Figure width, height in inches; default 5 inches per panel by 5 (5.6 with a `note`).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    panels = [("dual view (shadow camera)", tone_map(dual_view, percentile=WHITE_PERCENTILE))]
+    panels = [(title, tone_map(dual_view, percentile=WHITE_PERCENTILE))]
     if reciprocal is not None:
-        panels.append(("ground-truth reciprocal view", tone_map(reciprocal, percentile=WHITE_PERCENTILE)))
-    figure = _new_figure(size or (5.0 * len(panels), 5.0))
-    for index, (title, rgb) in enumerate(panels, start=1):
-        _show_image(figure.add_subplot(1, len(panels), index), rgb, title,
-                    xlabel="u (dual col)", ylabel="v (dual row)")
-    figure.tight_layout()
+        if np.shape(reciprocal)[:2] != np.shape(dual_view)[:2]:
+            raise ValueError(f"reciprocal must be on the dual grid {np.shape(dual_view)[:2]}; "
+                             f"got shape {np.shape(reciprocal)}")
+        panels.append((reciprocal_title, tone_map(reciprocal, percentile=WHITE_PERCENTILE)))
+    figure = _new_figure(size or (5.0 * len(panels), 5.6 if note else 5.0))
+    for index, (panel_title, rgb) in enumerate(panels, start=1):
+        _show_image(figure.add_subplot(1, len(panels), index), rgb, panel_title,
+                    xlabel="u (dual column, dual px)", ylabel="v (dual row, dual px)")
+    bottom = 0.0
+    if note:
+        import textwrap
+
+        lines = textwrap.wrap(note, width=int(16 * figure.get_figwidth()))
+        figure.text(0.01, 0.01, "\n".join(lines), fontsize="small", va="bottom", ha="left")
+        bottom = min(0.4, 0.03 + 0.032 * len(lines) * 5.6 / figure.get_figheight())
+    figure.tight_layout(rect=(0, bottom, 1, 0.97))
     return figure
 
 
