@@ -7,7 +7,6 @@ outdoor_summary : counts of arrival reasons, keyframes and interpolated edges.
 write_outdoor_figures : write the figures, ``summary.json`` and ``accuracy.html`` into a directory.
 """
 
-import html
 import json
 from pathlib import Path
 
@@ -18,6 +17,7 @@ from shadowcam.cameras.pushbroom import resample_uniform_time
 from shadowcam.io.frame_times import median_interval
 from shadowcam.outdoor.arrival import ARRIVAL_REASONS
 from shadowcam.outdoor.translation import translate
+from shadowcam.report.dataset_report import table_html
 from shadowcam.report.figures import save_png
 from shadowcam.report.outdoor_figures import (
     arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure, pushbroom_figure,
@@ -28,25 +28,16 @@ SHOWN_FRAMES = 6
 
 
 def accuracy_html(report):
-    """Return an HTML page of `report` (:func:`shadowcam.outdoor.accuracy.outdoor_accuracy`)."""
-    rows = []
-    for estimator, by_definition in report["errors"].items():
-        for definition, stats in by_definition.items():
-            rows.append(
-                f"<tr><td>{html.escape(estimator)}</td><td>{html.escape(definition)}</td>"
-                f"<td>{stats['median_abs']:.3f}</td><td>{stats['p95_abs']:.3f}</td>"
-                f"<td>{100 * stats['frac_over_5']:.2f}%</td><td>{100 * stats['frac_within_1']:.2f}%</td>"
-                f"<td>{100 * stats['coverage']:.2f}%</td></tr>")
-    targets = "".join(
-        f"<li>{html.escape(t['target'])} = {t['value']:.4f} (&lt;= {t['threshold']}): {'pass' if t['pass'] else 'FAIL'}</li>"
-        for t in report["targets"])
-    return (
-        "<html><body><h2>Outdoor arrival-time accuracy</h2>"
-        f"<p>Errors in median capture intervals ({report['interval_s']:.1f} s) over the {report['n_class3']} "
-        f"non-sky pixels the shadow reaches; targets ({html.escape(report['condition'])}) checked for "
-        f"{html.escape(report['primary_estimator'])} against {html.escape(report['primary_definition'])}.</p>"
-        f"<ul>{targets}</ul><table border='1'><tr><th>estimator</th><th>GT definition</th><th>median</th>"
-        "<th>p95</th><th>&gt; 5</th><th>within 1</th><th>coverage</th></tr>" + "".join(rows) + "</table></body></html>")
+    """Return an HTML page of `report` (:func:`shadowcam.outdoor.accuracy.outdoor_accuracy`).
+
+    The table is :func:`shadowcam.outdoor.accuracy.accuracy_table` (one row per quantity,
+    with unit, target and pass), under the ground truth's definition.
+    """
+    from shadowcam.outdoor.accuracy import GROUND_TRUTH_DEFINITION, accuracy_table
+
+    rows = accuracy_table(report)
+    return table_html([list(rows[0])] + [list(row.values()) for row in rows],
+                      title="Outdoor arrival-time accuracy", note=GROUND_TRUTH_DEFINITION)
 
 
 def outdoor_summary(edges, arrival, report=None):
