@@ -4,6 +4,7 @@ Offers
 ------
 accuracy_html : an HTML page of an outdoor accuracy report against its targets.
 outdoor_summary : counts of arrival reasons, keyframes and interpolated edges.
+arrival_in_truth_camera : the arrival map and its ground truth on the ground truth's pixel grid.
 write_outdoor_figures : write the figures, ``summary.json`` and ``accuracy.html`` into a directory.
 """
 
@@ -62,7 +63,28 @@ def outdoor_summary(edges, arrival, report=None):
     return summary
 
 
-def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbroom, report=None):
+def arrival_in_truth_camera(arrival_s, truth):
+    """The arrival map, sky and ground-truth arrival on one grid: the ground truth's camera.
+
+    The map is in the first frame's pixel grid; synthetic ground truth is in the unshaken
+    camera, so the map is moved by the first frame's recorded shake, as the accuracy step does.
+
+    Returns
+    -------
+    estimate_s, truth_s : (H, W) ndarray
+    sky : (H, W) bool ndarray
+    """
+    from shadowcam.outdoor.accuracy import map_to_truth_camera
+
+    shift = {"shift_row": 0.0, "shift_col": 0.0}
+    if "shake_dy_px" in truth and truth["shake_dy_px"].size:
+        shift = {"shift_row": float(truth["shake_dy_px"].values[0]),
+                 "shift_col": float(truth["shake_dx_px"].values[0])}
+    sky = truth["sky_mask"].values.astype(bool) if "sky_mask" in truth else np.zeros(np.shape(arrival_s), bool)
+    return map_to_truth_camera(arrival_s, **shift), truth["arrival_time_s"].values, sky
+
+
+def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbroom, report=None, truth=None):
     """Write the outdoor figures, ``summary.json`` and (with `report`) ``accuracy.html``.
 
     Parameters
@@ -75,6 +97,9 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
         The pipeline's outdoor datasets.
     report : dict, optional
         Outdoor accuracy report.
+    truth : xarray.Dataset, optional
+        Outdoor ground truth: the arrival map is drawn beside the GT arrival map and the
+        error map, all in the ground truth's camera (:func:`arrival_in_truth_camera`).
 
     Returns
     -------
@@ -98,7 +123,12 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
     reference = photometry["reference"].values
     save_png(edge_over_time_figure(edges["edge_row"].values, time_s, reference=reference, sky=sky),
              outdir / "edge_over_time.png")
-    save_png(arrival_map_figure(arrival["arrival_time_s"].values, sky=sky), outdir / "arrival_map.png")
+    if truth is not None and "arrival_time_s" in truth:
+        estimate_s, truth_s, truth_sky = arrival_in_truth_camera(arrival["arrival_time_s"].values, truth)
+        figure = arrival_map_figure(estimate_s, sky=truth_sky, truth_s=truth_s, interval_s=median_interval(time_s))
+    else:
+        figure = arrival_map_figure(arrival["arrival_time_s"].values, sky=sky)
+    save_png(figure, outdir / "arrival_map.png")
     uniform_t, uniform = resample_uniform_time(pushbroom["pushbroom"].values, time_s,
                                                step_s=median_interval(time_s))
     save_png(pushbroom_figure(reference, uniform, uniform_t, sky=sky), outdir / "pushbroom.png")

@@ -17,7 +17,7 @@ rule report_figures:
             caption="../report/figures.rst",
             category="{ds}",
             subcategory="figures",
-            labels={"dataset": "{ds}", "figure": "{figure}"},
+            labels=get_figure_labels,
         ),
     log:
         "logs/{ds}/report_figures.log",
