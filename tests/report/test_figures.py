@@ -146,3 +146,19 @@ def test_reciprocal_panel_is_the_truth_resampled_onto_the_dual_grid():
     rows, cols = np.nonzero(shown[..., 0] > 0.9 * shown[..., 0].max())
     assert abs(rows.mean() - 40.5) <= 1 and abs(cols.mean() - 20.5) <= 1
     assert "uniform" in left.get_title() and "coverage" in left.get_title()
+
+
+def test_primal_figure_shows_no_demosaic_colour_fringes_on_a_grey_edge():
+    from shadowcam.io.cfa import demosaic_bilinear
+
+    rows, cols = np.mgrid[0:40, 0:40]
+    grey = np.where(cols + 0.4 * rows > 24, 3000, 300).astype(np.uint16)  # slanted grey edge
+    rgb = demosaic_bilinear(grey, pattern="RGGB", max_value=4095)
+
+    def fringe(image):  # largest departure from grey, relative to white
+        image = np.asarray(image, dtype=np.float64)
+        return np.abs(image - image.mean(-1, keepdims=True)).max() / image.max()
+
+    assert fringe(rgb) > 0.3  # bilinear demosaic colours the edge
+    shown = figures.primal_figure(rgb).axes[0].images[0].get_array()
+    assert fringe(shown) < 0.02
