@@ -369,8 +369,9 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
     Returns
     -------
     dict
-        ``shadow_time`` (per sweep), ``dual_coords``, ``dual_image``,
-        ``targets`` (list), ``all_targets_pass``, ``noise``.
+        ``shadow_time`` (per sweep), ``dual_model`` (``model`` and ``why``, from the dual
+        coordinates' attrs), ``dual_coords``, ``dual_image``, ``targets`` (list),
+        ``all_targets_pass``, ``noise``.
     """
     lit = np.asarray(ground_truth["lit"].values, dtype=bool)
     report = {"noise": noise, "shadow_time": {}}
@@ -384,6 +385,8 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
     # without dual coordinates the dual view is taken to be on the reciprocal grid
     grid_map = np.eye(3) if dual_coords is None else _dual_grid_map(dual_coords, ground_truth)
     if dual_coords is not None:
+        report["dual_model"] = {"model": str(dual_coords.attrs.get("model", "")),
+                                "why": str(dual_coords.attrs.get("model_choice", ""))}
         if grid_map is None:
             report["dual_coords"] = {"skipped": "the ground truth cannot express this dual grid"}
         else:
@@ -523,6 +526,9 @@ def accuracy_table(report):
                 if key in stats:
                     rows.append(quantity_row(quantity + suffix, stats[key], unit, scale=scale,
                                              target=targets.get((key, sweep))))
+    if "dual_model" in report:
+        model = report["dual_model"]
+        rows.append(quantity_row("dual model", model["why"] or model["model"]))  # why starts with the model
     noise = report.get("noise")
     if report.get("noise_source"):
         noise = f"{noise} (from {report['noise_source']})"

@@ -123,8 +123,9 @@ def test_report_end_to_end_and_serialisation(tmp_path):
     assert (p95["target"], p95["pass"]) == ("<= 0.1", "yes")
     coverage = rows["shadow time coverage, sweep u"]
     assert (coverage["value"], coverage["unit"], coverage["target"]) == ("100", "%", ">= 98")
-    assert all(row["unit"] or row["quantity"] in ("noise condition", "all targets pass", "dataset")
+    assert all(row["unit"] or row["quantity"] in ("dual model", "noise condition", "all targets pass", "dataset")
                for row in table)
+    assert rows["dual model"]["value"].startswith("uniform")  # the model the dual view was made with, and why
     mantissas = [row["value"].split("e")[0].replace("-", "").replace(".", "").lstrip("0") for row in table
                  if row["value"][:1].isdigit() and "." in row["value"]]
     assert mantissas and all(len(m) <= 3 for m in mantissas)  # three significant digits at most
