@@ -28,6 +28,7 @@ Offers
 ------
 DUAL_COORD_MODELS : candidate calibration-plane models, name -> ``PlaneModel`` spec.
 DUAL_COORD_METHODS : name -> function, ``uniform`` and ``calibration``.
+PROJECTIVE_MODELS : calibration-plane models exact under uniform mask motion.
 REASON_FLAGS : reason code -> meaning for the ``reason`` output.
 dual_coords_uniform : times -> dual coordinates under uniform motion.
 dual_coords_calibration : times -> dual coordinates through a calibration plane.
@@ -256,8 +257,11 @@ class PlaneFit:
     residual_rms : float
         Cross-validated RMS residual of the chosen model (in `residual_units`).
     candidates : list of dict
-        Per candidate: ``name``, ``n_params``, ``cv_rms``, ``fit_rms``,
-        ``status`` (``ok`` or why it was skipped), ``chosen``.
+        Per candidate: ``name``, ``n_params``, ``cv_rms``, ``cv_se`` (its
+        standard error), ``fit_rms``, ``status`` (``ok`` or why it was
+        skipped), ``within_noise`` (``cv_rms <= limit``), ``chosen``.
+    limit : float
+        Largest CV residual within the noise of the best candidate.
     residual_units : str
     time_range : (2, 2) ndarray
         ``[[t_u_min, t_u_max], [t_v_min, t_v_max]]`` of the calibration points.
@@ -269,6 +273,7 @@ class PlaneFit:
     candidates: list = field(default_factory=list)
     residual_units: str = "plane"
     time_range: np.ndarray = None
+    limit: float = None
 
 
 def _rms(a, b):
@@ -281,8 +286,8 @@ def fit_time_to_plane(
     *,
     models=("affine", "homography", "tps"),
     k_folds=5,
-    rel_tol=0.1,
-    abs_tol=0.02,
+    rel_tol=0.0,
+    abs_tol=0.1,
     unit_scale=1.0,
     min_sweep_angle_deg=15.0,
     min_spread=0.05,
@@ -292,8 +297,11 @@ def fit_time_to_plane(
     """Fit the calibration map ``(t_u, t_v) -> (x, y)`` and choose its model.
 
     Every candidate is scored by k-fold cross-validation; the simplest model
-    (fewest parameters) whose CV residual is at most
-    ``best * (1 + rel_tol) + abs_tol`` is chosen.
+    (fewest parameters) whose CV residual is within the noise of the best one
+    is chosen: at most ``best + max(se, abs_tol) + rel_tol * best``, where
+    ``se`` is the standard error of the best model's CV residual (the
+    one-standard-error rule) and `abs_tol` a floor below which residual
+    differences are shadow-time noise, not model misfit.
 
     Parameters
     ----------
@@ -306,7 +314,9 @@ def fit_time_to_plane(
     k_folds : int
         Folds of the cross-validation (>= 2).
     rel_tol, abs_tol : float
-        Selection tolerance; `abs_tol` is in units of ``plane / unit_scale``.
+        Selection tolerance (see above); `abs_tol` is in reporting units
+        (``plane / unit_scale``, dual pixels in :func:`dual_coords_calibration`):
+        default 0.1, the sub-frame precision of shadow times.
     unit_scale : float
         Plane units per reporting unit (e.g. plane units per dual pixel);
         residuals are reported divided by it.
@@ -366,20 +376,23 @@ def fit_time_to_plane(
     candidates = []
     for name in order:
         spec = DUAL_COORD_MODELS[name]
-        entry = {"name": name, "n_params": spec.n_params, "cv_rms": None, "fit_rms": None}
+        entry = {"name": name, "n_params": spec.n_params, "cv_rms": None, "cv_se": None, "fit_rms": None}
         if n < spec.n_params + 2:
             entry["status"] = f"skipped: {n} points < n_params + 2 = {spec.n_params + 2}"
             candidates.append(entry)
             continue
         opts = {"seed": seed, **options.get(name, {})}
-        sq = 0.0
+        sq = np.empty(n)
         for k in range(k_folds):
             train, test = folds != k, folds == k
             model = spec.fit(times[train], plane_xy[train], **opts)
             pred = model(times[test])
-            sq += float(np.nansum(np.sum((pred - plane_xy[test]) ** 2, axis=1)))
-            sq += float(np.inf if not np.all(np.isfinite(pred)) else 0.0)
-        entry["cv_rms"] = float(np.sqrt(sq / n)) / unit_scale
+            sq[test] = np.sum((pred - plane_xy[test]) ** 2, axis=1)
+        sq = np.where(np.isfinite(sq), sq, np.inf)
+        rms = float(np.sqrt(np.mean(sq)))
+        entry["cv_rms"] = rms / unit_scale
+        # standard error of the RMS from that of the mean square (delta method)
+        entry["cv_se"] = (float(np.std(sq) / np.sqrt(n) / (2 * rms)) if 0 < rms < np.inf else 0.0) / unit_scale
         model = spec.fit(times, plane_xy, **opts)
         entry["fit_rms"] = _rms(model(times), plane_xy) / unit_scale
         entry["status"] = "ok" if np.isfinite(entry["cv_rms"]) else "failed: non-finite residual"
@@ -388,8 +401,9 @@ def fit_time_to_plane(
     scored = [c for c in candidates if c["status"] == "ok"]
     if not scored:
         raise ValueError(f"calibration points: no candidate model could be fitted: {candidates}")
-    best = min(c["cv_rms"] for c in scored)
-    chosen = next(c for c in scored if c["cv_rms"] <= best * (1 + rel_tol) + abs_tol)
+    best = min(scored, key=lambda c: c["cv_rms"])
+    limit = best["cv_rms"] * (1 + rel_tol) + max(best["cv_se"], abs_tol)
+    chosen = next(c for c in scored if c["cv_rms"] <= limit)
     sine = sweep_crossing_sine(chosen["_model"], times)
     angle = float(np.degrees(np.arcsin(np.clip(np.median(sine), 0.0, 1.0))))
     if angle < min_sweep_angle_deg:
@@ -403,12 +417,15 @@ def fit_time_to_plane(
     model = chosen.pop("_model")
     for c in candidates:
         c.pop("_model", None)
+    for c in candidates:
+        c["within_noise"] = c["status"] == "ok" and c["cv_rms"] <= limit
     return PlaneFit(
         name=chosen["name"],
         model=model,
         residual_rms=chosen["cv_rms"],
         candidates=candidates,
         time_range=np.stack([times.min(axis=0), times.max(axis=0)], axis=1),
+        limit=float(limit),
     )
 
 
@@ -616,6 +633,7 @@ def dual_coords_calibration(
         "model": fit.name,
         "model_residual_rms": fit.residual_rms,
         "candidates": fit.candidates,
+        "selection_limit": fit.limit,
         "plane_window": [x0, y0, x1, y1],
         "axes_flipped": [bool(not grows_x), bool(not grows_y)],
         "dual_width": width,
@@ -689,7 +707,46 @@ def dual_coords_dataset(u, v, valid, *, info, method, reason=None):
 
 UNIFORM_OPTIONS = ("scale", "offset", "min_spread")
 CALIBRATION_OPTIONS = ("models", "k_folds", "rel_tol", "abs_tol", "seed", "model_options", "min_spread",
-                       "plane_window", "extrapolation_margin", "min_sweep_angle_deg")
+                       "plane_window", "extrapolation_margin", "min_sweep_angle_deg", "test_uniform")
+
+#: calibration-plane models that are exact under uniform mask motion (time -> plane projective)
+PROJECTIVE_MODELS = ("affine", "homography")
+
+
+def _rms_text(candidate):
+    return f"{candidate['cv_rms']:.3g}" if candidate.get("cv_rms") is not None else "n/a"
+
+
+def _uniform_if_projective(info, uniform_info):
+    """Info of the calibration fit turned into the uniform model's, or None if it is not projective.
+
+    With a point light and a wire moving uniformly in a plane, frame indices are
+    perspective dual coordinates (paper II-A) and the map time -> calibration plane is
+    exactly projective; a projective model within the noise of the best thus confirms
+    uniform motion, the simplest model, on the frame-index grid.
+    """
+    candidates = info["candidates"]
+    best = min((c for c in candidates if c["status"] == "ok"), key=lambda c: c["cv_rms"])
+    projective = [c for c in candidates if c["name"] in PROJECTIVE_MODELS and c["status"] == "ok"]
+    limit = info["selection_limit"]
+    fits = (f"CV residuals {', '.join(c['name'] + ' ' + _rms_text(c) for c in candidates)} dual px; "
+            f"within noise of the best ({best['name']}): <= {limit:.3g}")
+    if info["model"] not in PROJECTIVE_MODELS:
+        tried = " and ".join(c["name"] for c in projective) or "no projective model"
+        info["model_choice"] = (
+            f"calibration ({info['model']}): the sweeps do not move uniformly -- the projective time->plane "
+            f"map ({tried}) misfits beyond noise ({fits})")
+        return None
+    chosen = next(c for c in candidates if c["chosen"])
+    entry = {"name": "uniform", "n_params": uniform_info["candidates"][0]["n_params"],
+             "cv_rms": chosen["cv_rms"], "cv_se": chosen["cv_se"], "fit_rms": chosen["fit_rms"],
+             "status": f"ok: time->plane is {chosen['name']} within noise", "within_noise": True, "chosen": True}
+    for c in candidates:
+        c["chosen"] = False
+    return {**uniform_info, "method": "uniform", "model_residual_rms": chosen["cv_rms"],
+            "candidates": [entry, *candidates], "selection_limit": limit,
+            "model_choice": (f"uniform (frame index = dual coordinate): the calibration sweeps' time->plane map is "
+                             f"{chosen['name']} (projective) within noise ({fits})")}
 
 
 def _sweeps_of(shadow_time):
@@ -702,8 +759,10 @@ def choose_dual_model(model, *, calibration_available, missing="the calibration 
     Parameters
     ----------
     model : {"auto", "uniform", "calibration"}
-        Requested model; ``auto`` is the simplest model the data support: the
-        calibration plane when it is available, else uniform motion.
+        Requested model; ``auto`` is the simplest model the data support: with
+        calibration data, ``calibration``, whose sweeps are timed and test uniform
+        motion first (:func:`dual_coords_from_shadow_time` keeps the frame-index
+        model when the time->plane map is projective within noise), else ``uniform``.
     calibration_available : bool
         The calibration sweeps ``cal_u``, ``cal_v`` and the plane's homography exist.
     missing : str, optional
@@ -769,12 +828,18 @@ def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=No
     plane_mask : (rows, cols) bool ndarray, optional
         Camera pixels on the calibration plane (calibration method).
     **options
-        :data:`UNIFORM_OPTIONS` or :data:`CALIBRATION_OPTIONS` of the method.
+        :data:`UNIFORM_OPTIONS` or :data:`CALIBRATION_OPTIONS` of the method. The
+        calibration method's ``test_uniform`` (default True) first tests uniform
+        motion against the calibration data: if the chosen plane model is one of
+        :data:`PROJECTIVE_MODELS`, the frame indices are the dual coordinates
+        (paper II-A) and the uniform model runs on the frame-index grid.
 
     Returns
     -------
     xarray.Dataset
-        :func:`dual_coords_dataset`.
+        :func:`dual_coords_dataset`; attrs ``method`` (the model family that ran),
+        ``model``, ``candidates`` (with CV residuals) and ``model_choice`` (which
+        model and why, one sentence).
     """
     if method not in DUAL_COORD_METHODS:
         raise ValueError(f"method: must be one of {sorted(DUAL_COORD_METHODS)}; got {method!r}")
@@ -793,12 +858,22 @@ def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=No
     opts = {k: options[k] for k in allowed if k in options}
     if method == "uniform":
         u, v, valid, info = dual_coords_uniform(t_u, t_v, n_frames=n_frames, dual_shape=shape, **opts)
+        info["model_choice"] = ("uniform (frame index = dual coordinate): assumed (no calibration sweeps "
+                                "tested it)")
         reason = None
     else:
         if homography is None:
             raise ValueError("homography: the calibration method needs the camera -> plane homography")
+        test_uniform = bool(opts.pop("test_uniform", True))
         u, v, valid, reason, info = dual_coords_calibration(
             t_u, t_v, cal_t_u=_sweep_times(shadow_time, "cal_u", min_confidence),
             cal_t_v=_sweep_times(shadow_time, "cal_v", min_confidence), homography=homography,
             dual_shape=shape, plane_mask=plane_mask, **opts)
+        uniform = dual_coords_uniform(t_u, t_v, n_frames=n_frames, dual_shape=shape,
+                                      **{k: opts[k] for k in UNIFORM_OPTIONS if k in opts})
+        uniform_info = _uniform_if_projective(info, uniform[3]) if test_uniform else None
+        if uniform_info is not None:
+            (u, v, valid, _), info, reason = uniform, uniform_info, None
+        info.setdefault("model_choice", f"calibration ({info['model']}): requested without the uniform test")
+        method = info.pop("method", method)
     return dual_coords_dataset(u, v, valid, info=info, method=method, reason=reason)

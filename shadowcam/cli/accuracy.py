@@ -1,6 +1,6 @@
 """``shadowcam accuracy``: accuracy of a synthetic dataset's products against its ground truth.
 
-Writes the nested report as JSON and a flat ``metric,value`` CSV table. The
+Writes the nested report as JSON and a CSV table (one row per quantity: value, unit, target, pass). The
 noise condition that selects the shadow-time target comes from ``--params
 '{"noise": "noise_free"|"raw12"}'``, else from the manifest's ``ground_truth.noise``
 or ``synthetic.noise``,

@@ -3,8 +3,8 @@
 Reads ``shadow_time.nc`` (and, for the calibration-plane method, the
 manifest's ``calibration_plane`` homography and optional mask) and writes
 ``results/<ds>/dual_coords.nc`` (:func:`shadowcam.cameras.dual_coords.dual_coords_from_shadow_time`).
-``--model auto`` uses the calibration plane when the manifest has one and the
-calibration sweeps ``cal_u``, ``cal_v`` were timed, else uniform motion.
+``--model auto`` tests uniform motion against the calibration plane when the manifest
+has one and the calibration sweeps ``cal_u``, ``cal_v`` were timed, else assumes it.
 
 Example::
 
@@ -65,7 +65,7 @@ def run(args):
         dual_height=params.get("dual_height", grid.get("height")),
         min_confidence=params.get("min_confidence", 0.0), homography=plane.get("homography"), plane_mask=mask,
         **{k: v for k, v in params.items() if k not in _GRID_KEYS})
-    log.info("dual coordinates: method %s, model %s, residual %.4g, %d of %d pixels valid", model,
+    log.info("dual coordinates: method %s, model %s, residual %.4g, %d of %d pixels valid", dataset.attrs["method"],
              dataset.attrs["model"], dataset.attrs["model_residual_rms"], int(dataset["valid"].sum()),
              dataset["valid"].size)
     dataset.attrs["dataset"] = manifest["name"]

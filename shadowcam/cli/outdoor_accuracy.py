@@ -30,8 +30,8 @@ from shadowcam.io.datasets import open_dataset
 from shadowcam.io.frame_store import open_frames
 from shadowcam.io.ground_truth import load_ground_truth
 from shadowcam.io.manifest import load_manifest
-from shadowcam.lab.accuracy import report_to_csv, report_to_json
-from shadowcam.outdoor.accuracy import accuracy_condition, outdoor_accuracy
+from shadowcam.lab.accuracy import report_to_json
+from shadowcam.outdoor.accuracy import accuracy_condition, outdoor_accuracy, report_to_csv
 
 log = logging.getLogger(__name__)
 

@@ -1,6 +1,7 @@
 """``shadowcam outdoor-figures``: report figures of an outdoor time-lapse (paper Fig. 18).
 
-Keyframes with the tracked edge, the edge over time, the arrival map, the
+Keyframes with the tracked edge, the edge over time, the arrival map (beside its
+ground truth and error when the ``--manifest`` has ground truth), the
 pushbroom beside the real view (sky masked), and with an accuracy report the
 error histogram and an HTML table of the figures against the targets
 (:func:`shadowcam.report.outdoor_report.write_outdoor_figures`).
@@ -23,6 +24,8 @@ from pathlib import Path
 
 from shadowcam.io.datasets import open_dataset
 from shadowcam.io.frame_store import open_frames
+from shadowcam.io.ground_truth import load_ground_truth
+from shadowcam.io.manifest import load_manifest
 from shadowcam.report.outdoor_report import write_outdoor_figures
 
 
@@ -35,6 +38,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--arrival", required=True, help="results/<ds>/outdoor/arrival.nc")
     parser.add_argument("--pushbroom", required=True, help="results/<ds>/outdoor/pushbroom.nc")
     parser.add_argument("--accuracy", default=None, help="outdoor accuracy JSON (optional)")
+    parser.add_argument("--manifest", default=None,
+                        help="capture description; with a ground_truth entry the arrival map is drawn beside it")
     parser.add_argument("--outdir", required=True, help="output directory of the PNG figures (created)")
     return parser
 
@@ -42,6 +47,10 @@ def add_parser(subparsers, name):
 def run(args):
     """Draw the outdoor figures into ``args.outdir``."""
     report = json.loads(Path(args.accuracy).read_text()) if args.accuracy else None
+    truth = None
+    if args.manifest:
+        manifest = load_manifest(args.manifest)
+        truth = load_ground_truth(manifest) if manifest.get("ground_truth") or manifest.get("synthetic") else None
     write_outdoor_figures(args.outdir, frames=open_frames(args.frames), photometry=open_dataset(args.photometry),
                           edges=open_dataset(args.edges), arrival=open_dataset(args.arrival),
-                          pushbroom=open_dataset(args.pushbroom), report=report)
+                          pushbroom=open_dataset(args.pushbroom), report=report, truth=truth)

@@ -32,6 +32,7 @@ def add_parser(subparsers, name):
                         help="capture description (data_manifest/X.yaml or capture.json)")
     parser.add_argument("--shadow-time", required=True, help="shadow_time.nc")
     parser.add_argument("--dual-view", required=True, help="dual_view.nc")
+    parser.add_argument("--dual-coords", help="dual_coords.nc (grid and model choice of the dual view), optional")
     parser.add_argument("--reference", help="reference frame store (reference.zarr), optional")
     parser.add_argument("--accuracy", help="accuracy.csv to show as a table, optional")
     parser.add_argument("--outdir", required=True, help="output directory (created)")
@@ -40,7 +41,7 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Write the figures of one dataset into ``args.outdir`` (all or nothing)."""
-    for option in ("shadow_time", "dual_view", "accuracy", "manifest"):
+    for option in ("shadow_time", "dual_view", "dual_coords", "accuracy", "manifest"):
         value = getattr(args, option)
         if value and not Path(value).exists():
             raise FileNotFoundError(f"--{option.replace('_', '-')} {value}: no such file")
@@ -57,5 +58,6 @@ def run(args):
         reference = open_frames(args.reference)
     written = write_report_figures(args.outdir, shadow_time=open_dataset(args.shadow_time),
                                    dual_view=open_dataset(args.dual_view), truth=truth,
+                                   dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None,
                                    reference=reference, accuracy_csv=args.accuracy)
     LOG.info("wrote %s", ", ".join(written))

@@ -25,18 +25,20 @@ shadow_time_errors : error statistics of one sweep's shadow times.
 dual_coord_errors : error statistics of dual coordinates.
 dual_image_errors : gain-fitted relative RMSE of a dual view, masked and whole image.
 check_targets : pass/fail of every target for a report.
+reciprocal_on_dual_grid : the GT reciprocal render resampled onto a dual grid.
 accuracy_report : the nested report for one dataset's products.
 noise_condition : the noise condition whose targets apply, and where it came from.
 flatten_report : the report as ``(key, value)`` rows.
-report_to_json, report_to_csv : serialise a report to text.
+TABLE_ROWS, TARGET_KEYS, GROUND_TRUTH_DEFINITION : what the accuracy table shows.
+accuracy_table : the report as one row per quantity (value, unit, target, pass).
+report_to_json, report_to_csv : serialise a report to text (JSON whole, CSV as the table).
 """
 
-import csv
-import io
 import json
 
 import numpy as np
 
+from shadowcam._shared.quantity_table import quantity_row, table_to_csv
 from shadowcam._shared.validation import check_in
 
 #: targets of the foundation issue; the shadow-time p95 depends on the noise condition
@@ -315,6 +317,35 @@ def _reciprocal_on_grid(ground_truth, grid_map, shape):
     return resampled, visible_on_grid
 
 
+def reciprocal_on_dual_grid(ground_truth, shape, *, dual_coords=None):
+    """The GT reciprocal render and camera visibility on the dual grid of `dual_coords`.
+
+    The same resampling as the accuracy of the dual image, so that a figure
+    compares the dual view with its ground truth pixel for pixel.
+
+    Parameters
+    ----------
+    ground_truth : xarray.Dataset
+        ``reciprocal (v, u, channel)``, ``dual_cam_visible (v, u)`` on the mask-plane
+        (frame-index) grid; calibration grids also need ``t_cal_u``, ``t_cal_v``, ``plane_xy``.
+    shape : (int, int)
+        ``(height, width)`` of the dual grid.
+    dual_coords : xarray.Dataset, optional
+        Its attrs define the grid (``method``, ``scale``, ``offset`` or ``plane_window``);
+        default: the dual grid is the reciprocal render's.
+
+    Returns
+    -------
+    reciprocal : (height, width, channel) ndarray or None
+        NaN outside the render; None when the ground truth cannot express the grid.
+    visible : (height, width) bool ndarray or None
+    """
+    grid_map = np.eye(3) if dual_coords is None else _dual_grid_map(dual_coords, ground_truth)
+    if grid_map is None:
+        return None, None
+    return _reciprocal_on_grid(ground_truth, grid_map, tuple(int(n) for n in shape))
+
+
 def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=None,
                     noise="noise_free", sweeps=("u", "v")):
     """Accuracy report of one dataset's products against its ground truth.
@@ -338,8 +369,9 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
     Returns
     -------
     dict
-        ``shadow_time`` (per sweep), ``dual_coords``, ``dual_image``,
-        ``targets`` (list), ``all_targets_pass``, ``noise``.
+        ``shadow_time`` (per sweep), ``dual_model`` (``model`` and ``why``, from the dual
+        coordinates' attrs), ``dual_coords``, ``dual_image``, ``targets`` (list),
+        ``all_targets_pass``, ``noise``.
     """
     lit = np.asarray(ground_truth["lit"].values, dtype=bool)
     report = {"noise": noise, "shadow_time": {}}
@@ -353,6 +385,8 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
     # without dual coordinates the dual view is taken to be on the reciprocal grid
     grid_map = np.eye(3) if dual_coords is None else _dual_grid_map(dual_coords, ground_truth)
     if dual_coords is not None:
+        report["dual_model"] = {"model": str(dual_coords.attrs.get("model", "")),
+                                "why": str(dual_coords.attrs.get("model_choice", ""))}
         if grid_map is None:
             report["dual_coords"] = {"skipped": "the ground truth cannot express this dual grid"}
         else:
@@ -418,13 +452,96 @@ def report_to_json(report):
     return json.dumps(_json_safe(report), indent=2, sort_keys=False) + "\n"
 
 
+#: rows of the accuracy table per report section: key -> (quantity, unit, scale)
+TABLE_ROWS = {
+    "shadow_time": {
+        "coverage": ("shadow time coverage", "%", 100.0),
+        "median": ("shadow time |error| median", "frame", 1.0),
+        "p95": ("shadow time |error| p95", "frame", 1.0),
+        "rmse": ("shadow time RMSE", "frame", 1.0),
+        "max": ("shadow time |error| max", "frame", 1.0),
+        "frac_gt_1_frame": ("shadow time |error| > 1 frame", "%", 100.0),
+        "mean_signed": ("shadow time mean signed error", "frame", 1.0),
+        "false_time_rate": ("false times (unlit pixels given a time)", "%", 100.0),
+        "n_evaluated": ("pixels evaluated (lit, timed)", "pixel", 1.0),
+    },
+    "dual_coords": {
+        "coverage": ("dual coordinates coverage", "%", 100.0),
+        "median": ("dual coordinates |error| median", "dual px", 1.0),
+        "p95": ("dual coordinates |error| p95", "dual px", 1.0),
+        "rmse": ("dual coordinates RMSE", "dual px", 1.0),
+        "rmse_u": ("dual coordinates RMSE of u", "dual px", 1.0),
+        "rmse_v": ("dual coordinates RMSE of v", "dual px", 1.0),
+        "max": ("dual coordinates |error| max", "dual px", 1.0),
+        "n_evaluated": ("camera pixels with dual coordinates", "pixel", 1.0),
+    },
+    "dual_image": {
+        "coverage_of_visible": ("dual view coverage of what the camera sees", "%", 100.0),
+        "covered_not_visible": ("dual view covered where the camera sees nothing", "%", 100.0),
+        "rel_rmse_masked": ("dual view relative RMSE, GT valid mask", "%", 100.0),
+        "rel_rmse_whole": ("dual view relative RMSE, whole image", "%", 100.0),
+        "gain": ("dual view gain fitted to the reciprocal render", "1", 1.0),
+        "n_mask": ("dual pixels in the GT valid mask", "dual px", 1.0),
+    },
+}
+#: target name -> the report key it checks (per sweep of ``shadow_time``)
+TARGET_KEYS = {"shadow_time_p95_frames": "p95", "shadow_time_coverage": "coverage",
+               "false_time_rate": "false_time_rate"}
+#: what the ground truth is (shown with the table)
+GROUND_TRUTH_DEFINITION = (
+    "Ground truth: exact per-pixel shadow times t_u, t_v (frame at which the wire's shadow line "
+    "crosses the pixel centre, from ray casting the rendered geometry; NaN where unlit) and the "
+    "reciprocal render from the light (docs/architecture.md, 'Datasets between stages', lab ground "
+    "truth; shared data README section 1)."
+)
+
+
+def accuracy_table(report):
+    """The report as a table a reader scans: one row per quantity, targets on their quantity's row.
+
+    Parameters
+    ----------
+    report : dict
+        From :func:`accuracy_report` (the ``noise_source`` and ``dataset`` keys are optional).
+
+    Returns
+    -------
+    list of dict
+        Rows of :func:`shadowcam._shared.quantity_table.quantity_row` (``quantity``, ``value``,
+        ``unit``, ``target``, ``pass``), values to three significant digits.
+    """
+    targets = {(TARGET_KEYS.get(t["target"]), t["sweep"]): t for t in report.get("targets", [])}
+    rows = []
+    for section, spec in TABLE_ROWS.items():
+        node = report.get(section)
+        if node is None:
+            continue
+        parts = node.items() if section == "shadow_time" else [(None, node)]
+        for sweep, stats in parts:
+            suffix = f", sweep {sweep}" if sweep is not None else ""
+            if "skipped" in stats:
+                rows.append(quantity_row(f"{section.replace('_', ' ')}{suffix}", f"skipped: {stats['skipped']}"))
+                continue
+            for key, (quantity, unit, scale) in spec.items():
+                if key in stats:
+                    rows.append(quantity_row(quantity + suffix, stats[key], unit, scale=scale,
+                                             target=targets.get((key, sweep))))
+    if "dual_model" in report:
+        model = report["dual_model"]
+        rows.append(quantity_row("dual model", model["why"] or model["model"]))  # why starts with the model
+    noise = report.get("noise")
+    if report.get("noise_source"):
+        noise = f"{noise} (from {report['noise_source']})"
+    rows.append(quantity_row("noise condition", noise))
+    rows.append(quantity_row("all targets pass", report.get("all_targets_pass")))
+    if "dataset" in report:
+        rows.append(quantity_row("dataset", report["dataset"]))
+    return rows
+
+
 def report_to_csv(report):
-    """The report as a two-column CSV table ``metric,value``."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(["metric", "value"])
-    writer.writerows(flatten_report(report))
-    return buf.getvalue()
+    """The report's :func:`accuracy_table` as CSV text (``quantity,value,unit,target,pass``)."""
+    return table_to_csv(accuracy_table(report))
 
 
 def noise_condition(manifest, noise=None):

@@ -23,6 +23,9 @@ registration_errors : estimated shifts (relative to frame 0) against the recorde
 pushbroom_errors : relative colour errors of a pushbroom image against the GT pushbroom.
 accuracy_condition : the condition whose targets apply (explicit, else the manifest's GT noise).
 outdoor_accuracy : the whole report of one capture: arrival maps, baseline, edges, pushbroom, registration.
+GROUND_TRUTH_DEFINITION : what the ground truth is (shown with the table).
+accuracy_table : the report as one row per quantity (value, unit, target, pass).
+report_to_csv : the table as CSV text.
 """
 
 import logging
@@ -33,6 +36,7 @@ from shadowcam.io.frame_store import iter_store_frames
 from shadowcam.io.frame_times import median_interval
 
 log = logging.getLogger(__name__)
+from shadowcam._shared.quantity_table import quantity_row, table_to_csv
 from shadowcam._shared.validation import check_array, check_in, check_positive, check_same_shape
 from shadowcam.outdoor.translation import translate
 
@@ -389,3 +393,86 @@ def outdoor_accuracy(truth, frames, photometry, edges, arrival, pushbroom, *, co
                                                      shake_dy=truth["shake_dy_px"].values,
                                                      shake_dx=truth["shake_dx_px"].values)
     return report
+
+
+#: what the ground truth is (shown with the table)
+GROUND_TRUTH_DEFINITION = (
+    "Ground truth: per-pixel shadow arrival time of the renderer (pixel_centre: the pixel-centre point "
+    "goes dark, bisected in time; half_coverage: half of the pixel footprint is dark), evaluated over the "
+    "non-sky pixels the shadow reaches (class 3); errors in median capture intervals "
+    "(docs/architecture.md, 'Datasets between stages', outdoor ground truth; shared data README 2.6)."
+)
+#: arrival statistics shown per estimator (primary GT definition): key -> (quantity, unit, scale)
+_ARRIVAL_ROWS = {
+    "median_abs": ("arrival |error| median", "interval", 1.0),
+    "p95_abs": ("arrival |error| p95", "interval", 1.0),
+    "frac_over_5": ("arrival |error| > 5 intervals", "%", 100.0),
+    "coverage": ("arrival coverage", "%", 100.0),
+}
+#: further statistics of the primary estimator
+_PRIMARY_ROWS = {
+    "frac_within_1": ("arrival |error| <= 1 interval", "%", 100.0),
+    "median_signed": ("arrival median signed error", "interval", 1.0),
+    "max_abs": ("arrival |error| max", "interval", 1.0),
+    "n_evaluated": ("pixels evaluated (shadow arrives)", "pixel", 1.0),
+}
+_SECTION_ROWS = {
+    "edge_row": {"median_abs_px": ("edge row |error| median", "pixel", 1.0),
+                 "p95_abs_px": ("edge row |error| p95", "pixel", 1.0),
+                 "found_fraction": ("edge found", "%", 100.0)},
+    "pushbroom": {"median_rel_error": ("pushbroom relative error median", "%", 100.0),
+                  "p95_rel_error": ("pushbroom relative error p95", "%", 100.0),
+                  "scale_to_gt": ("pushbroom scale to GT", "1", 1.0)},
+    "registration": {"rms_px": ("registration RMS error", "pixel", 1.0),
+                     "max_abs_px": ("registration |error| max", "pixel", 1.0),
+                     "true_max_px": ("true shake, max", "pixel", 1.0)},
+}
+
+
+def accuracy_table(report):
+    """The report as a table a reader scans: one row per quantity, targets on their quantity's row.
+
+    Every estimator gets its arrival errors against the primary GT definition; the primary
+    estimator also its remaining statistics and its errors against the other definitions;
+    then false arrivals, edge rows, pushbroom and registration where present.
+
+    Parameters
+    ----------
+    report : dict
+        From :func:`outdoor_accuracy` (``dataset`` optional).
+
+    Returns
+    -------
+    list of dict
+        Rows of :func:`shadowcam._shared.quantity_table.quantity_row`.
+    """
+    primary, definition = report["primary_estimator"], report["primary_definition"]
+    targets = {(t["target"], t["sweep"]): t for t in report.get("targets", [])}
+    rows = []
+    for name, by_definition in report["errors"].items():
+        stats = by_definition.get(definition, {})
+        spec = {**_ARRIVAL_ROWS, **_PRIMARY_ROWS} if name == primary else _ARRIVAL_ROWS
+        rows += [quantity_row(f"{quantity}, {name}", stats[key], unit, scale=scale, target=targets.get((key, name)))
+                 for key, (quantity, unit, scale) in spec.items() if key in stats]
+    for other, stats in report["errors"].get(primary, {}).items():
+        if other != definition:
+            rows += [quantity_row(f"{quantity}, {primary}, GT {other}", stats[key], unit, scale=scale)
+                     for key, (quantity, unit, scale) in _ARRIVAL_ROWS.items() if key in stats and key != "coverage"]
+    for cls, count in report.get("false_arrivals", {}).get(primary, {}).items():
+        rows.append(quantity_row(f"false arrivals, {primary}, GT {cls.replace('_', ' ')}", count, "pixel"))
+    for section, spec in _SECTION_ROWS.items():
+        stats = report.get(section) or {}
+        rows += [quantity_row(quantity, stats[key], unit, scale=scale)
+                 for key, (quantity, unit, scale) in spec.items() if key in stats]
+    rows.append(quantity_row("median capture interval", report["interval_s"], "s"))
+    rows.append(quantity_row("GT definition of the targets", definition))
+    rows.append(quantity_row("condition (targets that apply)", report["condition"]))
+    rows.append(quantity_row("all targets pass", report["all_targets_pass"]))
+    if "dataset" in report:
+        rows.append(quantity_row("dataset", report["dataset"]))
+    return rows
+
+
+def report_to_csv(report):
+    """The report's :func:`accuracy_table` as CSV text (``quantity,value,unit,target,pass``)."""
+    return table_to_csv(accuracy_table(report))

@@ -8,12 +8,15 @@ The directory receives:
 * ``dual_view.png`` - the dual view, next to the ground-truth reciprocal view when the
   capture has ground truth,
 * ``error_histogram.png`` - shadow-time errors against ground truth (ground truth only),
-* ``accuracy.html`` - the accuracy CSV as an HTML table (when given).
+* ``accuracy.html`` - the accuracy CSV as an HTML table with the ground truth's
+  definition (when given).
 
 Offers
 ------
+table_html : an HTML page with rows as a table (pass column coloured).
 csv_to_html : an HTML page with a CSV file as a table.
 primal_image : the camera image shown as the primal view.
+dual_view_report_figure : the dual view beside its ground truth on the same grid, model and coverage.
 write_report_figures : write every figure of a dataset into a directory, atomically.
 """
 
@@ -21,30 +24,51 @@ import csv
 import html
 from pathlib import Path
 
+import numpy as np
+
 from shadowcam._shared.atomic import atomic_directory
 from shadowcam.report import figures
 
 
-def csv_to_html(csv_path, *, title):
-    """Return an HTML page with the CSV file at `csv_path` as a table."""
+def table_html(rows, *, title, note=None):
+    """Return an HTML page with `rows` (first row = header) as a table, under `title` and `note`.
+
+    A ``pass`` column is coloured (yes green, no red); the first column is left-aligned.
+    """
+    rows = [list(row) for row in rows]
+    if not rows:
+        raise ValueError("rows must hold at least a header row")
+    verdict = rows[0].index("pass") if "pass" in rows[0] else None
+
+    def cell(index, text):
+        style = ""
+        if index == verdict and text in ("yes", "no"):
+            style = " style='color:{}'".format("#080" if text == "yes" else "#c00")
+        return f"<td{style}>{html.escape(text)}</td>"
+
+    head = "".join(f"<th>{html.escape(text)}</th>" for text in rows[0])
+    body = "\n".join("<tr>" + "".join(cell(i, text) for i, text in enumerate(row)) + "</tr>" for row in rows[1:])
+    paragraph = f"<p>{html.escape(note)}</p>\n" if note else ""
+    return (
+        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title)}</title><style>"
+        "body{font-family:sans-serif;font-size:14px;max-width:60em}"
+        "table{border-collapse:collapse}"
+        "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}"
+        "td:first-child,th:first-child{text-align:left}"
+        "th{background:#eee}</style></head><body>"
+        f"<h3>{html.escape(title)}</h3>\n{paragraph}<table>\n<tr>{head}</tr>\n{body}\n</table>"
+        "</body></html>\n"
+    )
+
+
+def csv_to_html(csv_path, *, title, note=None):
+    """Return an HTML page with the CSV file at `csv_path` as a table (:func:`table_html`)."""
     with open(csv_path, newline="") as handle:
         rows = list(csv.reader(handle))
     if not rows:
         raise ValueError(f"accuracy CSV {csv_path}: the file is empty")
-    head = "".join(f"<th>{html.escape(cell)}</th>" for cell in rows[0])
-    body = "\n".join(
-        "<tr>" + "".join(f"<td>{html.escape(cell)}</td>" for cell in row) + "</tr>"
-        for row in rows[1:]
-    )
-    return (
-        "<!DOCTYPE html>\n<html><head><meta charset='utf-8'>"
-        f"<title>{html.escape(title)}</title><style>"
-        "table{border-collapse:collapse;font-family:sans-serif;font-size:14px}"
-        "th,td{border:1px solid #bbb;padding:3px 8px;text-align:right}"
-        "th{background:#eee}</style></head><body>"
-        f"<h3>{html.escape(title)}</h3>\n<table>\n<tr>{head}</tr>\n{body}\n</table>"
-        "</body></html>\n"
-    )
+    return table_html(rows, title=title, note=note)
 
 
 def primal_image(shadow_time, reference=None):
@@ -72,8 +96,47 @@ def primal_image(shadow_time, reference=None):
     return lit.transpose("row", "col", ...).values
 
 
-def _write_all(outdir, shadow_time, dual_view, truth, reference, accuracy_csv):
+def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None):
+    """The dual view beside its ground truth on the same dual grid, with model and coverage.
+
+    The reciprocal render is resampled onto the dual grid exactly as the accuracy
+    step does (:func:`shadowcam.lab.accuracy.reciprocal_on_dual_grid`), so pixel
+    (v, u) of both panels is the same ray from the light.
+
+    Parameters
+    ----------
+    dual_view : xarray.Dataset
+        ``dual_view (v, u, channel)``, ``coverage (v, u)``.
+    dual_coords : xarray.Dataset, optional
+        Its attrs: the dual grid (``method``, ``scale``, ``offset``, ``plane_window``), the
+        chosen ``model`` and ``model_choice`` (why).
+    truth : xarray.Dataset, optional
+        Lab ground truth (``reciprocal``, ``dual_cam_visible``).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from shadowcam.lab.accuracy import reciprocal_on_dual_grid
+
     dual = dual_view["dual_view"].transpose("v", "u", ...).values
+    covered = np.asarray(dual_view["coverage"].transpose("v", "u").values, dtype=bool)
+    attrs = dual_coords.attrs if dual_coords is not None else {}
+    reciprocal = visible = None
+    if truth is not None:
+        reciprocal, visible = reciprocal_on_dual_grid(truth, covered.shape, dual_coords=dual_coords)
+    coverage = f"coverage {covered.mean():.0%} of the grid"
+    if visible is not None and visible.any():
+        coverage = f"coverage {(covered & visible).sum() / visible.sum():.0%} of what the camera sees"
+    model = attrs.get("model", dual_view.attrs.get("dual_coords_model", "?"))
+    title = f"dual view (shadow camera), model {model}\n{coverage}"
+    note = attrs.get("model_choice")
+    return figures.dual_view_figure(dual, reciprocal=reciprocal, title=title,
+                                    reciprocal_title="ground truth: reciprocal render from the light\nresampled onto the same dual grid",
+                                    note=f"dual model: {note}" if note else None)
+
+
+def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv):
     figures.save_png(figures.primal_figure(primal_image(shadow_time, reference)), outdir / "primal.png")
     times = shadow_time["shadow_time"]
     for sweep in times["sweep"].values:
@@ -82,9 +145,7 @@ def _write_all(outdir, shadow_time, dual_view, truth, reference, accuracy_csv):
                                     title=f"shadow time, sweep {sweep}"),
             outdir / f"shadow_time_{sweep}.png",
         )
-    reciprocal = None
     if truth is not None:
-        reciprocal = truth["reciprocal"].transpose("v", "u", ...).values
         errors = {}
         for sweep in ("u", "v"):
             if f"t_{sweep}" in truth and sweep in times["sweep"].values:
@@ -92,13 +153,18 @@ def _write_all(outdir, shadow_time, dual_view, truth, reference, accuracy_csv):
                 errors[f"sweep {sweep}"] = error.where(truth["lit"]).values.ravel()
         if errors:
             figures.save_png(figures.error_histogram_figure(errors), outdir / "error_histogram.png")
-    figures.save_png(figures.dual_view_figure(dual, reciprocal=reciprocal), outdir / "dual_view.png")
+    figures.save_png(dual_view_report_figure(dual_view, dual_coords=dual_coords, truth=truth),
+                     outdir / "dual_view.png")
     if accuracy_csv:
+        from shadowcam.lab.accuracy import GROUND_TRUTH_DEFINITION
+
         (outdir / "accuracy.html").write_text(
-            csv_to_html(accuracy_csv, title=f"accuracy: {Path(accuracy_csv).parent.name}"))
+            csv_to_html(accuracy_csv, title=f"accuracy: {Path(accuracy_csv).parent.name}",
+                        note=GROUND_TRUTH_DEFINITION))
 
 
-def write_report_figures(outdir, *, shadow_time, dual_view, truth=None, reference=None, accuracy_csv=None):
+def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, truth=None, reference=None,
+                         accuracy_csv=None):
     """Write the report figures of one dataset into `outdir` (replaced whole, or left as it was).
 
     Parameters
@@ -108,6 +174,8 @@ def write_report_figures(outdir, *, shadow_time, dual_view, truth=None, referenc
         ``shadow_time (sweep, row, col)`` and the lit image.
     dual_view : xarray.Dataset
         ``dual_view (v, u, channel)``.
+    dual_coords : xarray.Dataset, optional
+        Dual coordinates: their grid and model choice (attrs), for the dual-view figure.
     truth : xarray.Dataset, optional
         Lab ground truth (``reciprocal``, ``lit``, ``t_u``, ``t_v``).
     reference : xarray.Dataset, optional
@@ -123,5 +191,5 @@ def write_report_figures(outdir, *, shadow_time, dual_view, truth=None, referenc
     if accuracy_csv and not Path(accuracy_csv).is_file():
         raise FileNotFoundError(f"accuracy_csv {accuracy_csv}: no such file")
     with atomic_directory(outdir) as tmp:
-        _write_all(tmp, shadow_time, dual_view, truth, reference, accuracy_csv)
+        _write_all(tmp, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv)
     return sorted(p.name for p in Path(outdir).iterdir())

@@ -11,6 +11,8 @@ Offers
 FIGURE_DPI : dots per inch of every figure (image size = size x FIGURE_DPI pixels).
 NAN_GREY : RGB colour of pixels without a value.
 WHITE_PERCENTILE : percentile of the brightest channel shown as white.
+FRINGE_MEDIAN : median window of the primal figure's colour-fringe suppression.
+suppress_colour_fringes : median of the colour differences (demosaic false colour), for display.
 primal_figure : the camera (primal) image.
 time_map_figure : a shadow-time map with colour bar.
 dual_view_figure : the dual view, next to the ground-truth reciprocal view if given.
@@ -32,6 +34,8 @@ from shadowcam.io.images import HOLE_COLOUR, tone_map
 FIGURE_DPI = 100
 NAN_GREY = HOLE_COLOUR
 WHITE_PERCENTILE = 99.5
+#: median window of the colour differences in the primal figure (demosaic fringes)
+FRINGE_MEDIAN = 5
 
 
 def _new_figure(size):
@@ -50,14 +54,47 @@ def _show_image(axes, rgb, title, *, xlabel="col", ylabel="row"):
     axes.set_ylabel(ylabel)
 
 
-def primal_figure(image, *, title="primal (camera) image", size=(5.0, 5.0)):
-    """Figure of the camera image.
+def suppress_colour_fringes(image, *, size=FRINGE_MEDIAN):
+    """Median-filter the colour differences R - G and B - G of an RGB image (Freeman's method).
+
+    Bilinear demosaicing colours sharp grey edges (false colour along the edge, one to
+    two pixels wide); a median of the colour differences removes such narrow colour
+    while green, which carries the detail, is kept. For display only.
+
+    Parameters
+    ----------
+    image : (rows, cols, 3) ndarray
+        Linear RGB image (other shapes are returned as they are).
+    size : int, optional
+        Side of the median window (pixels); 0 or 1 returns `image` unchanged.
+
+    Returns
+    -------
+    ndarray, same shape, float32
+    """
+    from scipy.ndimage import median_filter
+
+    image = np.asarray(image, dtype=np.float32)
+    if image.ndim != 3 or image.shape[2] != 3 or int(size) <= 1:
+        return image
+    out = image.copy()
+    green = image[..., 1]
+    for channel in (0, 2):
+        difference = np.nan_to_num(image[..., channel] - green)
+        out[..., channel] = green + median_filter(difference, size=int(size), mode="nearest")
+    return np.where(np.isnan(image), np.nan, out)
+
+
+def primal_figure(image, *, title="primal (camera) image", fringe_median=FRINGE_MEDIAN, size=(5.0, 5.0)):
+    """Figure of the camera image, demosaic colour fringes suppressed for display.
 
     Parameters
     ----------
     image : (rows, cols) or (rows, cols, 1|3) ndarray
         Linear camera image (e.g. the unshadowed reference frame).
     title : str, optional
+    fringe_median : int, optional
+        Window of :func:`suppress_colour_fringes` (0 = show the image as it is).
     size : (float, float), optional
         Figure width, height in inches (pixels = inches x :data:`FIGURE_DPI`).
 
@@ -65,7 +102,7 @@ def primal_figure(image, *, title="primal (camera) image", size=(5.0, 5.0)):
     -------
     matplotlib.figure.Figure
     """
-    rgb = tone_map(image, percentile=WHITE_PERCENTILE)
+    rgb = tone_map(suppress_colour_fringes(image, size=fringe_median), percentile=WHITE_PERCENTILE)
     figure = _new_figure(size)
     _show_image(figure.add_subplot(), rgb, title)
     figure.tight_layout()
@@ -116,33 +153,50 @@ def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
     return figure
 
 
-def dual_view_figure(dual_view, *, reciprocal=None, size=None):
+def dual_view_figure(dual_view, *, reciprocal=None, title="dual view (shadow camera)",
+                     reciprocal_title="ground-truth reciprocal view", note=None, size=None):
     """Figure of the dual view, next to the ground-truth reciprocal view if given.
 
-    Each panel is scaled to its own white point: the two views differ photometrically
-    (the camera and light fall-off terms swap), so only geometry is compared.
+    Both panels must be on the same dual grid (pixel (v, u) of one is pixel (v, u)
+    of the other). Each panel is scaled to its own white point: the two views
+    differ photometrically (the camera and light fall-off terms swap), so only
+    geometry is compared.
 
     Parameters
     ----------
     dual_view : (v, u) or (v, u, 1|3) ndarray
         Linear dual view; NaN = hole (drawn grey).
     reciprocal : (v, u) or (v, u, 1|3) ndarray, optional
-        Ground-truth reciprocal view (rendered from the light).
+        Ground-truth reciprocal view (rendered from the light) on the same grid.
+    title, reciprocal_title : str, optional
+        Panel titles.
+    note : str, optional
+        Text under the panels (e.g. which dual model and why), wrapped.
     size : (float, float), optional
-        Figure width, height in inches; default (5, 5) for one panel, (10, 5) for two.
+        Figure width, height in inches; default 5 inches per panel by 5 (5.6 with a `note`).
 
     Returns
     -------
     matplotlib.figure.Figure
     """
-    panels = [("dual view (shadow camera)", tone_map(dual_view, percentile=WHITE_PERCENTILE))]
+    panels = [(title, tone_map(dual_view, percentile=WHITE_PERCENTILE))]
     if reciprocal is not None:
-        panels.append(("ground-truth reciprocal view", tone_map(reciprocal, percentile=WHITE_PERCENTILE)))
-    figure = _new_figure(size or (5.0 * len(panels), 5.0))
-    for index, (title, rgb) in enumerate(panels, start=1):
-        _show_image(figure.add_subplot(1, len(panels), index), rgb, title,
-                    xlabel="u (dual col)", ylabel="v (dual row)")
-    figure.tight_layout()
+        if np.shape(reciprocal)[:2] != np.shape(dual_view)[:2]:
+            raise ValueError(f"reciprocal must be on the dual grid {np.shape(dual_view)[:2]}; "
+                             f"got shape {np.shape(reciprocal)}")
+        panels.append((reciprocal_title, tone_map(reciprocal, percentile=WHITE_PERCENTILE)))
+    figure = _new_figure(size or (5.0 * len(panels), 5.6 if note else 5.0))
+    for index, (panel_title, rgb) in enumerate(panels, start=1):
+        _show_image(figure.add_subplot(1, len(panels), index), rgb, panel_title,
+                    xlabel="u (dual column, dual px)", ylabel="v (dual row, dual px)")
+    bottom = 0.0
+    if note:
+        import textwrap
+
+        lines = textwrap.wrap(note, width=int(16 * figure.get_figwidth()))
+        figure.text(0.01, 0.01, "\n".join(lines), fontsize="small", va="bottom", ha="left")
+        bottom = min(0.4, 0.03 + 0.032 * len(lines) * 5.6 / figure.get_figheight())
+    figure.tight_layout(rect=(0, bottom, 1, 0.97))
     return figure
 
 

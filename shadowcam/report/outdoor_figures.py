@@ -17,7 +17,7 @@ pushbroom_figure : the ridge pushbroom beside the real view.
 import numpy as np
 from matplotlib import colormaps
 
-from shadowcam._shared.validation import check_array
+from shadowcam._shared.validation import check_array, check_positive
 from shadowcam.io.images import tone_map
 from shadowcam.report.figures import NAN_GREY, WHITE_PERCENTILE, _new_figure
 
@@ -132,13 +132,23 @@ def edge_over_time_figure(edge_row, time_s, *, reference=None, sky=None, n_curve
     return figure
 
 
-def arrival_map_figure(arrival_s, *, sky, size=(6.5, 4.5)):
-    """The arrival-time map in minutes; sky and pixels without arrival grey.
+def arrival_map_figure(arrival_s, *, sky, truth_s=None, interval_s=None, error_limit=2.0, size=None):
+    """The arrival-time map in minutes, beside its ground truth and error if given; sky grey.
 
     Parameters
     ----------
     arrival_s : (H, W) ndarray
+        Estimated arrival times (s); NaN = none.
     sky : (H, W) bool ndarray
+    truth_s : (H, W) ndarray, optional
+        Ground-truth arrival times (s) on the same pixel grid; adds the ground-truth map
+        (same colour scale) and the error map.
+    interval_s : float, optional
+        Median capture interval (s): the unit of the error map (needed with `truth_s`).
+    error_limit : float, optional
+        The error colour scale spans +-`error_limit` intervals.
+    size : (float, float), optional
+        Figure size in inches; default (6.5, 4.5), (18, 4.5) with ground truth.
 
     Returns
     -------
@@ -146,17 +156,35 @@ def arrival_map_figure(arrival_s, *, sky, size=(6.5, 4.5)):
     """
     arrival = np.asarray(arrival_s, dtype=np.float64) / 60.0
     check_array(arrival, "arrival_s", ndim=2)
-    arrival = np.where(np.asarray(sky, dtype=bool), np.nan, arrival)
-    figure = _new_figure(size)
-    axes = figure.add_subplot()
+    sky = np.asarray(sky, dtype=bool)
+    arrival = np.where(sky, np.nan, arrival)
+    panels = [("shadow arrival, estimate\n(sky, never / always shadowed: grey)", arrival, "arrival time (min)",
+               "viridis", None)]
+    if truth_s is not None:
+        truth = np.where(sky, np.nan, np.asarray(truth_s, dtype=np.float64) / 60.0)
+        check_array(truth, "truth_s", shape=arrival.shape)
+        check_positive(interval_s, "interval_s")
+        error = (arrival - truth) * 60.0 / float(interval_s)
+        panels.append(("shadow arrival, ground truth\n(pixel centre goes dark)", truth, "arrival time (min)",
+                       "viridis", None))
+        panels.append(("error, estimate - ground truth", error,
+                       f"error (capture intervals of {float(interval_s):.3g} s)", "RdBu_r",
+                       (-error_limit, error_limit)))
+    finite = np.concatenate([p[1][np.isfinite(p[1])] for p in panels[:2]])
+    times_range = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    figure = _new_figure(size or ((6.5, 4.5) if len(panels) == 1 else (18.0, 4.5)))
     step = display_step(arrival.shape)
-    shown = axes.imshow(np.ma.masked_invalid(arrival[::step, ::step]),
-                        cmap=colormaps["viridis"].with_extremes(bad=NAN_GREY), interpolation="nearest",
-                        origin="upper", extent=_extent(arrival[::step, ::step].shape, step))
-    axes.set_title("shadow arrival (sky, never / always shadowed: grey)")
-    axes.set_xlabel("col")
-    axes.set_ylabel("row")
-    figure.colorbar(shown, ax=axes, label="arrival time (min)")
+    for index, (title, values, label, cmap, limits) in enumerate(panels, start=1):
+        axes = figure.add_subplot(1, len(panels), index)
+        vmin, vmax = limits or times_range
+        shown = axes.imshow(np.ma.masked_invalid(values[::step, ::step]),
+                            cmap=colormaps[cmap].with_extremes(bad=NAN_GREY), vmin=vmin, vmax=vmax,
+                            interpolation="nearest", origin="upper",
+                            extent=_extent(values[::step, ::step].shape, step))
+        axes.set_title(title)
+        axes.set_xlabel("col")
+        axes.set_ylabel("row")
+        figure.colorbar(shown, ax=axes, label=label)
     figure.tight_layout()
     return figure
 

@@ -4,10 +4,10 @@ Offers
 ------
 accuracy_html : an HTML page of an outdoor accuracy report against its targets.
 outdoor_summary : counts of arrival reasons, keyframes and interpolated edges.
+arrival_in_truth_camera : the arrival map and its ground truth on the ground truth's pixel grid.
 write_outdoor_figures : write the figures, ``summary.json`` and ``accuracy.html`` into a directory.
 """
 
-import html
 import json
 from pathlib import Path
 
@@ -18,6 +18,7 @@ from shadowcam.cameras.pushbroom import resample_uniform_time
 from shadowcam.io.frame_times import median_interval
 from shadowcam.outdoor.arrival import ARRIVAL_REASONS
 from shadowcam.outdoor.translation import translate
+from shadowcam.report.dataset_report import table_html
 from shadowcam.report.figures import save_png
 from shadowcam.report.outdoor_figures import (
     arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure, pushbroom_figure,
@@ -28,25 +29,16 @@ SHOWN_FRAMES = 6
 
 
 def accuracy_html(report):
-    """Return an HTML page of `report` (:func:`shadowcam.outdoor.accuracy.outdoor_accuracy`)."""
-    rows = []
-    for estimator, by_definition in report["errors"].items():
-        for definition, stats in by_definition.items():
-            rows.append(
-                f"<tr><td>{html.escape(estimator)}</td><td>{html.escape(definition)}</td>"
-                f"<td>{stats['median_abs']:.3f}</td><td>{stats['p95_abs']:.3f}</td>"
-                f"<td>{100 * stats['frac_over_5']:.2f}%</td><td>{100 * stats['frac_within_1']:.2f}%</td>"
-                f"<td>{100 * stats['coverage']:.2f}%</td></tr>")
-    targets = "".join(
-        f"<li>{html.escape(t['target'])} = {t['value']:.4f} (&lt;= {t['threshold']}): {'pass' if t['pass'] else 'FAIL'}</li>"
-        for t in report["targets"])
-    return (
-        "<html><body><h2>Outdoor arrival-time accuracy</h2>"
-        f"<p>Errors in median capture intervals ({report['interval_s']:.1f} s) over the {report['n_class3']} "
-        f"non-sky pixels the shadow reaches; targets ({html.escape(report['condition'])}) checked for "
-        f"{html.escape(report['primary_estimator'])} against {html.escape(report['primary_definition'])}.</p>"
-        f"<ul>{targets}</ul><table border='1'><tr><th>estimator</th><th>GT definition</th><th>median</th>"
-        "<th>p95</th><th>&gt; 5</th><th>within 1</th><th>coverage</th></tr>" + "".join(rows) + "</table></body></html>")
+    """Return an HTML page of `report` (:func:`shadowcam.outdoor.accuracy.outdoor_accuracy`).
+
+    The table is :func:`shadowcam.outdoor.accuracy.accuracy_table` (one row per quantity,
+    with unit, target and pass), under the ground truth's definition.
+    """
+    from shadowcam.outdoor.accuracy import GROUND_TRUTH_DEFINITION, accuracy_table
+
+    rows = accuracy_table(report)
+    return table_html([list(rows[0])] + [list(row.values()) for row in rows],
+                      title="Outdoor arrival-time accuracy", note=GROUND_TRUTH_DEFINITION)
 
 
 def outdoor_summary(edges, arrival, report=None):
@@ -71,7 +63,28 @@ def outdoor_summary(edges, arrival, report=None):
     return summary
 
 
-def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbroom, report=None):
+def arrival_in_truth_camera(arrival_s, truth):
+    """The arrival map, sky and ground-truth arrival on one grid: the ground truth's camera.
+
+    The map is in the first frame's pixel grid; synthetic ground truth is in the unshaken
+    camera, so the map is moved by the first frame's recorded shake, as the accuracy step does.
+
+    Returns
+    -------
+    estimate_s, truth_s : (H, W) ndarray
+    sky : (H, W) bool ndarray
+    """
+    from shadowcam.outdoor.accuracy import map_to_truth_camera
+
+    shift = {"shift_row": 0.0, "shift_col": 0.0}
+    if "shake_dy_px" in truth and truth["shake_dy_px"].size:
+        shift = {"shift_row": float(truth["shake_dy_px"].values[0]),
+                 "shift_col": float(truth["shake_dx_px"].values[0])}
+    sky = truth["sky_mask"].values.astype(bool) if "sky_mask" in truth else np.zeros(np.shape(arrival_s), bool)
+    return map_to_truth_camera(arrival_s, **shift), truth["arrival_time_s"].values, sky
+
+
+def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbroom, report=None, truth=None):
     """Write the outdoor figures, ``summary.json`` and (with `report`) ``accuracy.html``.
 
     Parameters
@@ -84,6 +97,9 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
         The pipeline's outdoor datasets.
     report : dict, optional
         Outdoor accuracy report.
+    truth : xarray.Dataset, optional
+        Outdoor ground truth: the arrival map is drawn beside the GT arrival map and the
+        error map, all in the ground truth's camera (:func:`arrival_in_truth_camera`).
 
     Returns
     -------
@@ -107,7 +123,12 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
     reference = photometry["reference"].values
     save_png(edge_over_time_figure(edges["edge_row"].values, time_s, reference=reference, sky=sky),
              outdir / "edge_over_time.png")
-    save_png(arrival_map_figure(arrival["arrival_time_s"].values, sky=sky), outdir / "arrival_map.png")
+    if truth is not None and "arrival_time_s" in truth:
+        estimate_s, truth_s, truth_sky = arrival_in_truth_camera(arrival["arrival_time_s"].values, truth)
+        figure = arrival_map_figure(estimate_s, sky=truth_sky, truth_s=truth_s, interval_s=median_interval(time_s))
+    else:
+        figure = arrival_map_figure(arrival["arrival_time_s"].values, sky=sky)
+    save_png(figure, outdir / "arrival_map.png")
     uniform_t, uniform = resample_uniform_time(pushbroom["pushbroom"].values, time_s,
                                                step_s=median_interval(time_s))
     save_png(pushbroom_figure(reference, uniform, uniform_t, sky=sky), outdir / "pushbroom.png")

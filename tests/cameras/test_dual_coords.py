@@ -193,3 +193,41 @@ def test_front_function_refuses_what_it_cannot_do():
         dual_coords_from_shadow_time(shadow_time.assign_attrs(n_frames_u=0))
     with pytest.raises(ValueError, match="cal_u"):
         dual_coords_from_shadow_time(shadow_time, method="calibration", homography=np.eye(3))
+
+
+def _calibration_capture(warp):
+    """Scene = calibration plane; times from PROJECTIVE_TRUTH, warped by `warp`, noise 0.1 frame."""
+    import xarray as xr
+
+    times = _times_from_plane(_plane_points(), PROJECTIVE_TRUTH)
+    times = warp(times) + np.random.default_rng(5).normal(0.0, 0.1, times.shape)
+    t_u, t_v = times[..., 0], times[..., 1]
+    stack = np.stack([t_u, t_v, t_u, t_v]).astype(np.float32)
+    return xr.Dataset({"shadow_time": (("sweep", "row", "col"), stack)},
+                      coords={"sweep": ["u", "v", "cal_u", "cal_v"]},
+                      attrs={"n_frames_u": 96, "n_frames_v": 96})
+
+
+def test_uniform_motion_is_chosen_when_the_calibration_plane_is_projective_within_noise():
+    from shadowcam.cameras.dual_coords import dual_coords_from_shadow_time
+
+    shadow_time = _calibration_capture(lambda t: t)
+    dataset = dual_coords_from_shadow_time(shadow_time, method="calibration", homography=CAM_TO_PLANE)
+    assert dataset.attrs["model"] == "uniform" and dataset.attrs["method"] == "uniform"
+    t_u = shadow_time["shadow_time"].sel(sweep="u").values
+    np.testing.assert_allclose(dataset["u"].values, t_u, atol=1e-5)  # frame index = dual column
+    names = [c["name"] for c in json.loads(dataset.attrs["candidates"])]
+    assert names[0] == "uniform" and "tps" in names
+    assert "uniform" in dataset.attrs["model_choice"] and "tps" in dataset.attrs["model_choice"]
+
+
+def test_calibration_plane_is_chosen_when_the_sweep_speed_is_not_uniform():
+    from shadowcam.cameras.dual_coords import dual_coords_from_shadow_time
+
+    # the wire accelerates: frame index is no longer proportional to mask position
+    shadow_time = _calibration_capture(lambda t: t + 4.0 * np.sin(np.pi * t / 40.0))
+    dataset = dual_coords_from_shadow_time(shadow_time, method="calibration", homography=CAM_TO_PLANE)
+    assert dataset.attrs["method"] == "calibration" and dataset.attrs["model"] == "tps"
+    candidates = {c["name"]: c for c in json.loads(dataset.attrs["candidates"])}
+    assert candidates["homography"]["cv_rms"] > 3 * candidates["tps"]["cv_rms"]
+    assert "tps" in dataset.attrs["model_choice"]

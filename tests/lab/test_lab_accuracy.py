@@ -112,9 +112,23 @@ def test_report_end_to_end_and_serialisation(tmp_path):
     assert report["all_targets_pass"]  # 0.05 frame error < 0.1, full coverage, no false times
     parsed = json.loads(report_to_json(report))
     assert parsed["dual_image"]["rel_rmse_masked"] == pytest.approx(0.0, abs=1e-7)
-    rows = dict(csv.reader(io.StringIO(report_to_csv(report))))
-    assert float(rows["shadow_time.v.median"]) == pytest.approx(0.05, abs=1e-5)
-    assert rows["targets.shadow_time_p95_frames.u.pass"] == "True"
+    table = list(csv.DictReader(io.StringIO(report_to_csv(report))))
+    assert list(table[0]) == ["quantity", "value", "unit", "target", "pass"]
+    quantities = [row["quantity"] for row in table]
+    assert len(quantities) == len(set(quantities))  # one row per quantity, targets included
+    rows = {row["quantity"]: row for row in table}
+    median = rows["shadow time |error| median, sweep v"]
+    assert (median["value"], median["unit"]) == ("0.05", "frame")
+    p95 = rows["shadow time |error| p95, sweep u"]
+    assert (p95["target"], p95["pass"]) == ("<= 0.1", "yes")
+    coverage = rows["shadow time coverage, sweep u"]
+    assert (coverage["value"], coverage["unit"], coverage["target"]) == ("100", "%", ">= 98")
+    assert all(row["unit"] or row["quantity"] in ("dual model", "noise condition", "all targets pass", "dataset")
+               for row in table)
+    assert rows["dual model"]["value"].startswith("uniform")  # the model the dual view was made with, and why
+    mantissas = [row["value"].split("e")[0].replace("-", "").replace(".", "").lstrip("0") for row in table
+                 if row["value"][:1].isdigit() and "." in row["value"]]
+    assert mantissas and all(len(m) <= 3 for m in mantissas)  # three significant digits at most
 
 
 def test_exact_gt_coordinates_give_the_dual_image_floor(shared_data):

@@ -80,3 +80,35 @@ def test_accuracy_condition_prefers_the_explicit_one():
     assert accuracy_condition({}, "clean") == "clean"
     with pytest.raises(ValueError, match="condition"):
         accuracy_condition({}, "cloudy")
+
+
+def test_accuracy_table_has_one_row_per_quantity_with_units_and_targets():
+    import csv
+    import io
+
+    from shadowcam.outdoor.accuracy import report_to_csv
+
+    def stats(median):
+        return {"n_evaluated": 100, "coverage": 0.98765, "median_abs": median, "p95_abs": 1.0185755643609078,
+                "max_abs": 12.49, "frac_over_5": 0.001047519283877726, "frac_within_1": 0.948, "median_signed": 0.02}
+
+    errors = {name: {"pixel_centre": stats(m), "half_coverage": stats(m)}
+              for name, m in (("combined", 0.14241332988455965), ("naive_baseline", 0.88))}
+    targets = check_targets(errors["combined"]["pixel_centre"], condition="nuisances")
+    report = {"errors": errors, "targets": targets, "all_targets_pass": True, "condition": "nuisances",
+              "primary_estimator": "combined", "primary_definition": "pixel_centre", "interval_s": 52.667,
+              "n_class3": 100, "false_arrivals": {"combined": {"sky": 0, "never_shadowed": 11}},
+              "edge_row": {"n": 10, "median_abs_px": 0.0985, "p95_abs_px": 0.623, "found_fraction": 0.956},
+              "dataset": "x"}
+    table = list(csv.DictReader(io.StringIO(report_to_csv(report))))
+    assert list(table[0]) == ["quantity", "value", "unit", "target", "pass"]
+    quantities = [row["quantity"] for row in table]
+    assert len(quantities) == len(set(quantities)) <= 40
+    rows = {row["quantity"]: row for row in table}
+    median = rows["arrival |error| median, combined"]
+    assert (median["value"], median["unit"], median["target"], median["pass"]) == (
+        "0.142", "interval", "<= 0.5", "yes")
+    assert rows["arrival |error| > 5 intervals, combined"]["value"] == "0.105"
+    assert rows["arrival |error| > 5 intervals, combined"]["unit"] == "%"
+    assert rows["edge row |error| median"]["unit"] == "pixel"
+    assert rows["median capture interval"]["value"] == "52.7" and rows["median capture interval"]["unit"] == "s"

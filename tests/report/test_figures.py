@@ -123,3 +123,42 @@ def test_accuracy_csv_becomes_html_table(tmp_path):
     assert page.count("<tr>") == 3
     assert "<th>metric</th>" in page and "<td>0.12</td>" in page
     assert "&lt;99%&gt;" in page  # cells are escaped
+
+
+def test_reciprocal_panel_is_the_truth_resampled_onto_the_dual_grid():
+    import xarray as xr
+
+    from shadowcam.report.dataset_report import dual_view_report_figure
+
+    reciprocal = np.full((40, 40, 3), 0.1, np.float32)
+    reciprocal[18:23, 8:13] = 1.0  # a bright square centred at mask-plane (t_u, t_v) = (10, 20)
+    truth = xr.Dataset({"reciprocal": (("v", "u", "channel"), reciprocal),
+                        "dual_cam_visible": (("v", "u"), np.ones((40, 40), bool))})
+    # uniform model, two dual pixels per frame: the point lands at (u, v) = (20.5, 40.5)
+    coords = xr.Dataset(attrs={"method": "uniform", "model": "uniform", "scale": [2.0, 2.0],
+                               "offset": [0.5, 0.5], "model_choice": "uniform: assumed"})
+    dual = xr.Dataset({"dual_view": (("v", "u", "channel"), np.full((80, 80, 3), 0.5, np.float32)),
+                       "coverage": (("v", "u"), np.ones((80, 80), bool))})
+    figure = dual_view_report_figure(dual, dual_coords=coords, truth=truth)
+    left, right = figure.axes[:2]
+    shown = np.asarray(right.images[0].get_array())
+    assert shown.shape[:2] == np.asarray(left.images[0].get_array()).shape[:2] == (80, 80)
+    rows, cols = np.nonzero(shown[..., 0] > 0.9 * shown[..., 0].max())
+    assert abs(rows.mean() - 40.5) <= 1 and abs(cols.mean() - 20.5) <= 1
+    assert "uniform" in left.get_title() and "coverage" in left.get_title()
+
+
+def test_primal_figure_shows_no_demosaic_colour_fringes_on_a_grey_edge():
+    from shadowcam.io.cfa import demosaic_bilinear
+
+    rows, cols = np.mgrid[0:40, 0:40]
+    grey = np.where(cols + 0.4 * rows > 24, 3000, 300).astype(np.uint16)  # slanted grey edge
+    rgb = demosaic_bilinear(grey, pattern="RGGB", max_value=4095)
+
+    def fringe(image):  # largest departure from grey, relative to white
+        image = np.asarray(image, dtype=np.float64)
+        return np.abs(image - image.mean(-1, keepdims=True)).max() / image.max()
+
+    assert fringe(rgb) > 0.3  # bilinear demosaic colours the edge
+    shown = figures.primal_figure(rgb).axes[0].images[0].get_array()
+    assert fringe(shown) < 0.02

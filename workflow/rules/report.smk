@@ -7,6 +7,7 @@ rule report_figures:
         capture=get_capture_input,
         shadow_time="results/{ds}/shadow_time.nc",
         dual_view="results/{ds}/dual_view.nc",
+        dual_coords="results/{ds}/dual_coords.nc",
         reference=get_reference,
         accuracy=get_accuracy,
     output:
@@ -16,7 +17,7 @@ rule report_figures:
             caption="../report/figures.rst",
             category="{ds}",
             subcategory="figures",
-            labels={"dataset": "{ds}", "figure": "{figure}"},
+            labels=get_figure_labels,
         ),
     log:
         "logs/{ds}/report_figures.log",
@@ -33,4 +34,4 @@ rule report_figures:
         accuracy=get_flag("--accuracy", "accuracy"),
     shell:
         "shadowcam report-figures --manifest {params.manifest} --shadow-time {input.shadow_time}"
-        " --dual-view {input.dual_view} {params.reference} {params.accuracy} --outdir {output} > {log} 2>&1"
+        " --dual-view {input.dual_view} --dual-coords {input.dual_coords} {params.reference} {params.accuracy} --outdir {output} > {log} 2>&1"
