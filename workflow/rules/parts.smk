@@ -2,7 +2,7 @@
 #
 # Wildcards
 # ---------
-# part    decode part of a sweep, 0000, 0001, ...: frames [i F, (i + 1) F) with
+# part    decode part of a sweep, 0000, 0001, ..., 9999, 10000, ... (no limit): frames [i F, (i + 1) F) with
 #         F = chunk_frames x decode.chunks_per_job; `decode` joins the part stores
 #         (hard links, no copy) into results/{ds}/frames/{sweep}.zarr, and the
 #         shadow_time_chunk jobs track the dips of the same frame ranges
@@ -13,29 +13,46 @@
 #         track_edges (config outdoor.edge_strips; 1 = one job, no strips)
 #
 # Memory of a job is bounded by one time chunk of chunk_frames frames, whatever the
-# frames per job.
+# frames per job. The part ranges and part file names of a sweep are computed once
+# per run (cached per dataset and sweep): an input function of one part looks its
+# range up, so planning stays linear in the number of parts.
 from shadowcam.io.frame_store import default_chunk_frames
 
 
 wildcard_constraints:
-    part=r"\d{4}",
+    part=r"\d\d\d\d+",
     span=r"\d+-(\d+|end)",
     strip=r"\d+",
 
 
+_PART_RANGES = {}
+_PART_NAMES = {}
+
+
 def decode_chunk_frames(ds):
-    """Frames per store chunk: config decode.chunk_frames, or ~64 MiB of float32 RGB if null."""
+    """Frames per store chunk: config decode.chunk_frames, or ~64 MiB of float32 RGB if null.
+
+    Never more than the longest sweep of `ds`: a chunk longer than the sweep would only
+    size the jobs' memory for frames that do not exist.
+    """
+    plan = capture(ds)
+    longest = max([plan.n_frames(s) for s in plan.sweeps] + [1])
     configured = config["decode"]["chunk_frames"]
     if configured:
-        return int(configured)
-    return default_chunk_frames(capture(ds).frame_shape + (3,))
+        return min(int(configured), longest)
+    return min(default_chunk_frames(plan.frame_shape + (3,)), longest)
 
 
 def decode_part_ranges(ds, sweep):
-    """Frame ranges [(start, stop), ...] of the decode_part jobs of a sweep."""
-    total = capture(ds).n_frames(sweep)
-    step = decode_chunk_frames(ds) * int(config["decode"]["chunks_per_job"])
-    return [(start, min(start + step, total)) for start in range(0, total, step)]
+    """Frame ranges [(start, stop), ...] of the decode_part jobs of a sweep (cached)."""
+    key = (ds, sweep)
+    if key not in _PART_RANGES:
+        total = capture(ds).n_frames(sweep)
+        step = decode_chunk_frames(ds) * int(config["decode"]["chunks_per_job"])
+        _PART_RANGES[key] = tuple(
+            (start, min(start + step, total)) for start in range(0, total, step)
+        )
+    return _PART_RANGES[key]
 
 
 def part_range(wildcards):
@@ -49,10 +66,18 @@ def part_range(wildcards):
     return ranges[index]
 
 
+def part_names(ds, sweep):
+    """Names of the decode parts of a sweep in time order: 0000, 0001, ... (cached)."""
+    key = (ds, sweep)
+    if key not in _PART_NAMES:
+        count = len(decode_part_ranges(ds, sweep))
+        _PART_NAMES[key] = tuple(f"{i:04d}" for i in range(count))
+    return _PART_NAMES[key]
+
+
 def sweep_parts(ds, sweep, template):
     """`template` (with {ds}, {sweep}, {part}) of every decode part of a sweep, in time order."""
-    count = len(decode_part_ranges(ds, sweep))
-    return [template.format(ds=ds, sweep=sweep, part=f"{i:04d}") for i in range(count)]
+    return [template.format(ds=ds, sweep=sweep, part=part) for part in part_names(ds, sweep)]
 
 
 def get_decode_parts(wildcards):
