@@ -5,9 +5,11 @@ A sweep store holds variable ``image (time, row, col, channel)`` float32
 float64, units ``frame``), ``time_s`` and ``exposure_s`` (seconds, NaN where
 unknown) and ``channel`` (``R``, ``G``, ``B``), chunked along time only and
 compressed with zstd level 1. A reference store holds ``image (row, col,
-channel)`` (the mean of the reference frames). Stores are written to
-``<out>.tmp`` and renamed when complete, so an interrupted job never leaves a
-store that looks finished.
+channel)`` (the mean of the reference frames). Stores are written to a hidden
+temporary directory beside the store and renamed when complete
+(:func:`shadowcam._shared.atomic.atomic_directory`), so an interrupted job never
+leaves a store that looks finished, and a killed job's leftovers are removed by
+the next write.
 
 A long sweep can be decoded as several *part* stores, one per job, each
 holding a range of frames that starts on a chunk boundary;
@@ -27,6 +29,7 @@ iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time orde
 iter_store_frames : yield the (H, W, C) float32 frames one at a time (logging progress).
 """
 
+import glob
 import json
 import logging
 import os
@@ -38,6 +41,7 @@ import numpy as np
 import xarray as xr
 from zarr.codecs import ZstdCodec
 
+from shadowcam._shared.atomic import atomic_directory
 from shadowcam.io.decode import iter_frames
 
 log = logging.getLogger(__name__)
@@ -109,28 +113,12 @@ def _block_dataset(block, start, times_s, exposure_s, *, first_frame=0):
     )
 
 
-class _AtomicStore:
-    """Context manager: write to ``<out>.tmp``; rename to ``out`` only on success."""
-
-    def __init__(self, out_path):
-        self.out = Path(out_path)
-        self.tmp = self.out.with_name(self.out.name + ".tmp")
-
-    def __enter__(self):
-        if self.out.suffix != ".zarr":
-            raise ValueError(f"out_path must end with .zarr; got {self.out}")
-        self.out.parent.mkdir(parents=True, exist_ok=True)
-        shutil.rmtree(self.tmp, ignore_errors=True)
-        return self.tmp
-
-    def __exit__(self, exc_type, exc, tb):
-        if exc_type is not None:
-            shutil.rmtree(self.tmp, ignore_errors=True)
-            return False
-        if self.out.exists():
-            shutil.rmtree(self.out)
-        os.replace(self.tmp, self.out)
-        return False
+def _atomic_store(out_path):
+    """Context manager: a temporary directory that replaces the ``.zarr`` store `out_path` on success."""
+    out_path = Path(out_path)
+    if out_path.suffix != ".zarr":
+        raise ValueError(f"out_path must end with .zarr; got {out_path}")
+    return atomic_directory(out_path)
 
 
 def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk_frames=None,
@@ -144,8 +132,8 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
     paths : sequence of str or Path
         Frame files in time order (all of the same size).
     out_path : str or Path
-        Store to create (``*.zarr``); replaced if it exists. Written to
-        ``<out_path>.tmp`` first and renamed when complete.
+        Store to create (``*.zarr``); replaced if it exists. Written to a
+        hidden temporary beside it first and renamed when complete.
     times_s : (T,) array_like of float
         Frame times in seconds.
     exposure_s : (T,) array_like of float, optional
@@ -192,7 +180,7 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
 
     n = len(paths)
     started = _time.perf_counter()
-    with _AtomicStore(out_path) as tmp:
+    with _atomic_store(out_path) as tmp:
         block, start, written = None, 0, 0
         for k, (path, image, info) in enumerate(iter_frames(paths)):
             if block is None:
@@ -264,7 +252,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
     the first part with the time length of the whole sweep. The result reads
     exactly like a store written by one :func:`write_frames` call over all frames
     with the same `chunk_frames` (same values, same chunk files). Written to
-    ``<out_path>.tmp`` and renamed when complete.
+    a hidden temporary beside it and renamed when complete.
 
     Parameters
     ----------
@@ -302,7 +290,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
             )
         expected += count
     total = expected
-    with _AtomicStore(out_path) as tmp:
+    with _atomic_store(out_path) as tmp:
         group = _read_json(parts[0] / "zarr.json")
         group["attributes"] = {**group.get("attributes", {}), **_json_safe(attrs), "n_frames": total}
         _write_json(tmp / "zarr.json", group)
@@ -356,7 +344,7 @@ def write_reference(paths, out_path, *, attrs=None):
         coords={"channel": ("channel", np.array(CHANNELS, dtype=object))},
         attrs={**_decoder_attrs(info), **_json_safe(attrs), "n_frames_averaged": len(paths)},
     )
-    with _AtomicStore(out_path) as tmp:
+    with _atomic_store(out_path) as tmp:
         ds.to_zarr(tmp, mode="w-", zarr_format=3, encoding={"image": {"compressors": _COMPRESSORS}}, consolidated=False)
     return Path(out_path)
 
@@ -376,9 +364,9 @@ def open_frames(path):
     """
     path = Path(path)
     if not path.is_dir():
-        tmp = path.with_name(path.name + ".tmp")
-        hint = " (an unfinished write left it as .tmp; rerun the decode step)" if tmp.exists() else ""
-        raise ValueError(f"frame store {path} does not exist{hint}")
+        unfinished = any(path.parent.glob(f".{glob.escape(path.name)}.*.tmp"))
+        hint = " (an unfinished write left a hidden temporary beside it)" if unfinished else ""
+        raise ValueError(f"frame store {path} does not exist{hint}; rerun the decode step that writes it")
     return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
 
 

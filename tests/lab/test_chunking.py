@@ -78,7 +78,7 @@ def test_merge_rejects_gaps_order_and_mixed_chunks(tmp_path, make_frames):
         merge_frame_stores([a, c], tmp_path / "out.zarr")
     with pytest.raises(ValueError, match="parts"):
         merge_frame_stores([], tmp_path / "out.zarr")
-    assert not (tmp_path / "out.zarr").exists() and not (tmp_path / "out.zarr.tmp").exists()
+    assert not (tmp_path / "out.zarr").exists() and not list(tmp_path.glob(".out.zarr.*"))
     with pytest.raises(ValueError, match="first_frame"):
         write_frames(paths[3:], tmp_path / "d.zarr", times_s=times[3:], chunk_frames=2, first_frame=3)
 
