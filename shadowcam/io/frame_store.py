@@ -258,10 +258,13 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
     ----------
     parts : sequence of str or Path
         Part stores from :func:`write_frames` (with ``first_frame``), in time
-        order: the first starts at frame 0, each starts where the previous
-        ends, all share the chunk size and frame shape.
+        order: the first starts at frame 0 (for a whole sweep) or on a chunk
+        boundary, each starts where the previous ends, all share the chunk
+        size and frame shape.
     out_path : str or Path
-        Sweep store to create (``*.zarr``); replaced if it exists.
+        Store to create (``*.zarr``); replaced if it exists. If the first part
+        starts at frame F > 0 the result is itself a part store starting at F,
+        which a later merge joins like any part (merges can be nested).
     attrs : mapping, optional
         Dataset attrs to set or replace (e.g. the merged provenance); ``n_frames``
         is set to the total. Other attrs are the first part's.
@@ -276,7 +279,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
         raise ValueError("parts must list at least one part store")
     layouts = [_part_layout(p) for p in parts]
     chunk, shape = layouts[0][2], layouts[0][3]
-    expected = 0
+    start = expected = layouts[0][0]
     for path, (first, count, part_chunk, part_shape) in zip(parts, layouts):
         if part_chunk != chunk or part_shape != shape:
             raise ValueError(
@@ -289,7 +292,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
                 f"{chunk}); list the parts in time order without gaps"
             )
         expected += count
-    total = expected
+    total = expected - start
     with _atomic_store(out_path) as tmp:
         group = _read_json(parts[0] / "zarr.json")
         group["attributes"] = {**group.get("attributes", {}), **_json_safe(attrs), "n_frames": total}
@@ -305,7 +308,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
                 meta["shape"][0] = total
             _write_json(tmp / name / "zarr.json", meta)
             for path, (first, *_rest) in zip(parts if along_time else parts[:1], layouts):
-                offset = first // chunk if along_time else 0
+                offset = (first - start) // chunk if along_time else 0
                 for source in sorted((path / name / "c").rglob("*")):
                     if source.is_file():
                         key = source.relative_to(path / name / "c").parts

@@ -55,3 +55,30 @@ def test_a_job_above_the_memory_ceiling_stops_the_plan(tmp_path, workflow_copy, 
             "(0.0023 MP) need ") in result.stdout, result.stdout[-3000:]
     assert "above max_job_mem_mb 400 MB (config)" in result.stdout
     assert "Traceback" not in result.stdout and "Job stats" not in result.stdout
+
+
+def test_sweep_joined_in_groups_equals_a_single_decode(tmp_path, workflow_copy, snakemake):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import xarray as xr
+
+    from shadowcam.io.frame_store import open_frames
+
+    workdir = workflow_copy(tmp_path / "wf")
+    parts = workdir / "workflow" / "rules" / "parts.smk"
+    text = parts.read_text()
+    assert "\nPARTS_PER_GROUP = 100\n" in text
+    parts.write_text(text.replace("\nPARTS_PER_GROUP = 100\n", "\nPARTS_PER_GROUP = 5\n"))
+    store = "results/synthetic_tiny/frames/u.zarr"  # 24 frames: 12 parts of 2, in 3 groups
+    result = snakemake(["--cores", "1", "--config", "datasets=[synthetic_tiny]",
+                        "decode={chunk_frames: 2, chunks_per_job: 1}", "--", store], workdir)
+    assert result.returncode == 0, result.stdout[-3000:]
+    assert re.search(r"^decode_group\s+3$", result.stdout, re.MULTILINE), result.stdout[-3000:]
+    reference = tmp_path / "u.zarr"
+    subprocess.run([str(Path(sys.executable).parent / "shadowcam"), "decode", "--manifest",
+                    str(workdir / "results/synthetic_tiny/capture/capture.json"), "--sweep", "u",
+                    "--chunk-frames", "2", "--out", str(reference)], check=True, capture_output=True)
+    xr.testing.assert_identical(open_frames(reference).load(), open_frames(workdir / store).load())
+    assert not (workdir / "results/synthetic_tiny/frames/u.groups").exists()

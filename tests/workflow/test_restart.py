@@ -147,7 +147,7 @@ def test_workflow_killed_and_restarted_equals_uninterrupted(tmp_path, workflow_c
         xr.testing.assert_identical(open_frames(reference / f"{sweep}.zarr").load(),
                                     open_frames(frames / f"{sweep}.zarr").load())
     subprocess.run([shadowcam, "shadow-time", "--frames", *(str(reference / f"{s}.zarr") for s in SWEEPS),
-                    "--sweeps", *SWEEPS, "--method", "edge_fit", "--params", "{}",
+                    "--sweeps", *SWEEPS, "--method", "edge_fit", "--params", '{"min_coverage": 0.01}',
                     "--out", str(reference / "shadow_time.nc")], check=True, capture_output=True)
     with xr.open_dataset(reference / "shadow_time.nc", engine="h5netcdf") as a, \
             xr.open_dataset(workdir / "results" / DS / "shadow_time.nc", engine="h5netcdf") as b:

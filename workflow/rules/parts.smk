@@ -6,6 +6,12 @@
 #         F = chunk_frames x decode.chunks_per_job; `decode` joins the part stores
 #         (hard links, no copy) into results/{ds}/frames/{sweep}.zarr, and the
 #         shadow_time_chunk jobs track the dips of the same frame ranges
+# group   group of PARTS_PER_GROUP consecutive parts of a sweep with more parts than
+#         that, 0000, 0001, ...: decode_group joins them (hard links) into
+#         results/{ds}/frames/{sweep}.groups/{group}.zarr and `decode` joins the groups,
+#         so no job lists more than PARTS_PER_GROUP inputs (Snakemake checks each
+#         consumer of the sweep store against its producer's inputs: a sweep store
+#         made of every part directly makes planning quadratic in the part count)
 # span    time span of the first outdoor pass, START-STOP (frames; `0-end` when the
 #         frame count is known only once the capture is rendered): config
 #         outdoor.part_frames frames per job, merged into photometry.nc
@@ -21,9 +27,13 @@ from shadowcam.io.frame_store import default_chunk_frames
 
 wildcard_constraints:
     part=r"\d\d\d\d+",
+    group=r"\d\d\d\d+",
     span=r"\d+-(\d+|end)",
     strip=r"\d+",
 
+
+#: parts joined by one decode_group job (sweeps with more parts are joined in two levels)
+PARTS_PER_GROUP = 100
 
 _PART_RANGES = {}
 _PART_NAMES = {}
@@ -81,9 +91,29 @@ def sweep_parts(ds, sweep, template):
 
 
 def get_decode_parts(wildcards):
-    """Part stores of a sweep, in time order (inputs of `decode`)."""
-    template = "results/{ds}/frames/{sweep}.parts/{part}.zarr"
-    return sweep_parts(wildcards.ds, wildcards.sweep, template)
+    """Part stores of a sweep, or its group stores if it has more parts than PARTS_PER_GROUP (inputs of `decode`)."""
+    parts = sweep_parts(wildcards.ds, wildcards.sweep, "results/{ds}/frames/{sweep}.parts/{part}.zarr")
+    if len(parts) <= PARTS_PER_GROUP:
+        return parts
+    count = -(-len(parts) // PARTS_PER_GROUP)
+    return [
+        f"results/{wildcards.ds}/frames/{wildcards.sweep}.groups/{i:04d}.zarr"
+        for i in range(count)
+    ]
+
+
+def get_group_parts(wildcards):
+    """Part stores of group `wildcards.group` of a sweep, in time order (inputs of `decode_group`)."""
+    names = part_names(wildcards.ds, wildcards.sweep)
+    first = int(wildcards.group) * PARTS_PER_GROUP
+    if len(names) <= PARTS_PER_GROUP or first >= len(names):
+        raise ValueError(
+            f"{wildcards.ds} sweep {wildcards.sweep} has {len(names)} parts, no group {wildcards.group}"
+        )
+    return [
+        f"results/{wildcards.ds}/frames/{wildcards.sweep}.parts/{name}.zarr"
+        for name in names[first : first + PARTS_PER_GROUP]
+    ]
 
 
 def get_part_files(wildcards):
