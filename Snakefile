@@ -1,17 +1,15 @@
 # shadowcam workflow: shadow cameras from moving shadows.
 # Run:    snakemake --profile profiles/local [--config datasets=[NAME]]
 # Report: snakemake --report results/report.html
-# Stages live in workflow/rules/*.smk; helpers in common.smk (capture plans, inputs),
-# parts.smk (time parts, spans, strips), resources.smk (job sizes), targets.smk.
-from snakemake.utils import min_version, validate
+# Stages live in workflow/rules/*.smk; the configuration in config.smk, helpers in
+# common.smk (capture plans, inputs), parts.smk (time parts, spans, strips), resources.smk (job sizes), targets.smk.
+from snakemake.utils import min_version
 
 min_version("9.0")
 
 
-configfile: "config/config.yaml"
-
-
-validate(config, "workflow/schemas/config.schema.yaml")
+# config/config.yaml, read and validated against workflow/schemas/config.schema.yaml
+include: "workflow/rules/config.smk"
 
 
 report: "workflow/report/workflow.rst"

@@ -1,5 +1,13 @@
 """Atomic writes: an output appears whole or not at all.
 
+A write goes to a hidden temporary beside the target, named after the target, the
+host and the writing process (``.<stem>.<host>.<pid>-XXXX<suffix>`` for a file,
+``.<name>.<host>.<pid>.tmp`` for a directory), and is renamed onto the target only
+when complete. On an exception (a full disk included) the temporary is removed. A
+process killed outright (SIGKILL, out of memory, a cluster's time limit) cannot clean
+up: the next write of the same target removes the temporaries of processes of this
+host that no longer run, so leftovers never keep holding disk space.
+
 Offers
 ------
 atomic_path : context manager yielding a temporary file path that replaces the target on success.
@@ -12,9 +20,43 @@ less the umask), so a group that shares the results can read them.
 
 import contextlib
 import os
+import re
 import shutil
+import socket
 import tempfile
 from pathlib import Path
+
+
+def _host():
+    """This machine's name as it appears in temporary names (no dots or path separators)."""
+    return re.sub(r"[^A-Za-z0-9_-]", "_", socket.gethostname().split(".")[0]) or "host"
+
+
+def _running(pid):
+    """True if process `pid` runs on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def _remove_leftovers(path, pattern):
+    """Remove the siblings of `path` matching `pattern` (groups ``host``, ``pid``) of dead processes here."""
+    if not path.parent.is_dir():
+        return
+    host = _host()
+    for sibling in path.parent.iterdir():
+        match = re.fullmatch(pattern, sibling.name)
+        if match is None or match["host"] != host or _running(int(match["pid"])):
+            continue
+        if sibling.is_dir() and not sibling.is_symlink():
+            shutil.rmtree(sibling, ignore_errors=True)
+        else:
+            with contextlib.suppress(FileNotFoundError):
+                sibling.unlink()
 
 
 @contextlib.contextmanager
@@ -22,11 +64,14 @@ def atomic_path(path):
     """Yield a temporary path beside `path`; rename it onto `path` if the block succeeds.
 
     The temporary name keeps the suffix of `path` (writers choose the format
-    from it). On an exception the temporary file is removed.
+    from it). On an exception the temporary file is removed; temporaries left
+    by killed writers of `path` are removed first.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    _remove_leftovers(path, rf"\.{re.escape(path.stem)}\.(?P<host>[A-Za-z0-9_-]+)\.(?P<pid>\d+)-[A-Za-z0-9_]+"
+                            rf"{re.escape(path.suffix)}")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.{_host()}.{os.getpid()}-", suffix=path.suffix, dir=path.parent)
     os.close(fd)
     os.chmod(tmp, 0o666 & ~umask())  # mkstemp creates 0o600
     try:
@@ -44,10 +89,13 @@ def atomic_directory(path):
 
     An old directory at `path` is replaced only after the block succeeded; on an
     exception the temporary directory is removed and `path` is left as it was.
+    Temporaries left by killed writers of `path` are removed first.
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
+    _remove_leftovers(path, rf"\.{re.escape(path.name)}\.(?P<host>[A-Za-z0-9_-]+)\.(?P<pid>\d+)\.(tmp|old)")
+    stem = f".{path.name}.{_host()}.{os.getpid()}"
+    tmp = path.parent / f"{stem}.tmp"
     if tmp.exists():
         shutil.rmtree(tmp)
     tmp.mkdir()
@@ -55,7 +103,7 @@ def atomic_directory(path):
         yield tmp
         old = None
         if path.exists():
-            old = path.parent / f".{path.name}.old-{os.getpid()}"
+            old = path.parent / f"{stem}.old"
             path.rename(old)
         tmp.rename(path)
         if old is not None:

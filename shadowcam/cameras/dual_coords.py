@@ -50,7 +50,8 @@ import xarray as xr
 from scipy.interpolate import RBFInterpolator
 from scipy.optimize import least_squares
 
-from shadowcam._shared.validation import check_array
+from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
+from shadowcam._shared.validation import check_array, check_in_interval
 
 #: reason codes of the ``reason`` output variable
 REASON_FLAGS = {
@@ -809,7 +810,8 @@ def _sweep_times(shadow_time, sweep, min_confidence):
 
 
 def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=None, dual_height=None,
-                                 min_confidence=0.0, homography=None, plane_mask=None, **options):
+                                 min_confidence=0.0, homography=None, plane_mask=None, min_coverage=MIN_COVERAGE,
+                                 **options):
     """Dual coordinates of every camera pixel from its shadow times.
 
     Parameters
@@ -827,6 +829,8 @@ def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=No
         Camera -> calibration plane (calibration method).
     plane_mask : (rows, cols) bool ndarray, optional
         Camera pixels on the calibration plane (calibration method).
+    min_coverage : float
+        Smallest fraction of the camera pixels that must get dual coordinates.
     **options
         :data:`UNIFORM_OPTIONS` or :data:`CALIBRATION_OPTIONS` of the method. The
         calibration method's ``test_uniform`` (default True) first tests uniform
@@ -840,7 +844,13 @@ def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=No
         :func:`dual_coords_dataset`; attrs ``method`` (the model family that ran),
         ``model``, ``candidates`` (with CV residuals) and ``model_choice`` (which
         model and why, one sentence).
+
+    Raises
+    ------
+    ValueError
+        If fewer than `min_coverage` of the camera pixels get dual coordinates (with the counts).
     """
+    check_in_interval(min_coverage, "min_coverage", 0.0, 1.0, closed="both")
     if method not in DUAL_COORD_METHODS:
         raise ValueError(f"method: must be one of {sorted(DUAL_COORD_METHODS)}; got {method!r}")
     allowed = UNIFORM_OPTIONS if method == "uniform" else CALIBRATION_OPTIONS
@@ -876,4 +886,15 @@ def dual_coords_from_shadow_time(shadow_time, *, method="uniform", dual_width=No
             (u, v, valid, _), info, reason = uniform, uniform_info, None
         info.setdefault("model_choice", f"calibration ({info['model']}): requested without the uniform test")
         method = info.pop("method", method)
+    _check_dual_coverage(valid, t_u, t_v, min_confidence=min_confidence, min_coverage=min_coverage)
     return dual_coords_dataset(u, v, valid, info=info, method=method, reason=reason)
+
+
+def _check_dual_coverage(valid, t_u, t_v, *, min_confidence, min_coverage):
+    """Fail with the counts of missing shadow times when (almost) no camera pixel has dual coordinates."""
+    reasons = {"without a shadow time in sweep u": np.count_nonzero(~np.isfinite(t_u)),
+               "without a shadow time in sweep v": np.count_nonzero(~np.isfinite(t_v))}
+    hint = (f"min_confidence is {min_confidence:g} (shadow-time confidence lies in [0, 1])" if min_confidence > 0
+            else "the shadow times leave these pixels out (see shadow_time's reason counts)")
+    check_coverage(np.count_nonzero(valid), np.size(valid), what="camera pixels with dual coordinates",
+                   reasons=reasons, hint=hint, min_coverage=min_coverage)

@@ -37,8 +37,10 @@ import numpy as np
 import xarray as xr
 from scipy.spatial import cKDTree
 
+from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
+from shadowcam._shared.validation import check_array, check_in, check_in_interval
+
 log = logging.getLogger(__name__)
-from shadowcam._shared.validation import check_array, check_in
 
 #: candidate (triangle, dual pixel) pairs processed at once by the mesh warp
 _CHUNK_CANDIDATES = 1 << 21
@@ -300,7 +302,8 @@ def dual_view_dataset(image, coverage, *, method, params=None, channels=("R", "G
     return ds
 
 
-def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh", **params):
+def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh", min_coverage=MIN_COVERAGE,
+                          **params):
     """Resample the camera colours into the dual grid of `coords`.
 
     Parameters
@@ -314,6 +317,8 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
         Reference frame store (``image``, averaged over ``time`` if it has one).
     method : str
         Key of :data:`DUAL_VIEW_METHODS`.
+    min_coverage : float
+        Smallest fraction of the dual pixels that must receive a colour.
     **params
         Method options.
 
@@ -322,7 +327,13 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     xarray.Dataset
         :func:`dual_view_dataset` with attrs ``colour_source``, ``dual_coords_model``,
         ``resampling_seconds``.
+
+    Raises
+    ------
+    ValueError
+        If the dual view covers less than `min_coverage` of its grid (with the counts).
     """
+    check_in_interval(min_coverage, "min_coverage", 0.0, 1.0, closed="both")
     if reference is not None:
         image = reference["image"]
         if "time" in image.dims:
@@ -343,6 +354,10 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     seconds = time.perf_counter() - start
     log.info("%s resampling: %d camera pixels in %.3f s (%.2f M px/s), coverage %.1f%% of %dx%d",
              method, u.size, seconds, u.size / seconds / 1e6, 100 * coverage.mean(), *shape)
+    valid = int(np.count_nonzero(coords["valid"].values))
+    check_coverage(np.count_nonzero(coverage), coverage.size, what=f"dual pixels of the {shape[0]}x{shape[1]} dual view "
+                   "covered", reasons={"uncovered": coverage.size - np.count_nonzero(coverage)},
+                   hint=f"{valid:,} of {u.size:,} camera pixels have dual coordinates", min_coverage=min_coverage)
     channels = ([str(c) for c in shadow_time["channel"].values] if "channel" in shadow_time.coords
                 else ("R", "G", "B"))
     dataset = dual_view_dataset(image, coverage, method=method, params=params, channels=channels)

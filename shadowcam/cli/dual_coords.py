@@ -20,6 +20,7 @@ run : compute and write the dataset.
 import logging
 from pathlib import Path
 
+from shadowcam._shared.coverage import MIN_COVERAGE
 from shadowcam.cameras.dual_coords import (
     CALIBRATION_OPTIONS, DUAL_COORD_METHODS, UNIFORM_OPTIONS, choose_dual_coords_method,
     dual_coords_from_shadow_time,
@@ -32,7 +33,7 @@ from shadowcam.io.provenance import file_sha256
 
 log = logging.getLogger(__name__)
 
-_GRID_KEYS = ("dual_width", "dual_height", "min_confidence")
+_GRID_KEYS = ("dual_width", "dual_height", "min_confidence", "min_coverage")
 
 
 def add_parser(subparsers, name):
@@ -42,7 +43,7 @@ def add_parser(subparsers, name):
     parser.add_argument("--manifest", required=True, help="data_manifest/<ds>.yaml or capture.json")
     parser.add_argument("--model", default="auto", choices=["auto", *DUAL_COORD_METHODS],
                         help="mapping from shadow times to u, v (default auto: the simplest the data support)")
-    parser.add_argument("--params", default="{}", help="JSON: dual_width, dual_height, min_confidence, "
+    parser.add_argument("--params", default="{}", help="JSON: dual_width, dual_height, min_confidence, min_coverage, "
                         f"uniform: {', '.join(UNIFORM_OPTIONS)}; calibration: {', '.join(CALIBRATION_OPTIONS)}")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/dual_coords.nc")
     return parser
@@ -63,7 +64,8 @@ def run(args):
     dataset = dual_coords_from_shadow_time(
         shadow_time, method=model, dual_width=params.get("dual_width", grid.get("width")),
         dual_height=params.get("dual_height", grid.get("height")),
-        min_confidence=params.get("min_confidence", 0.0), homography=plane.get("homography"), plane_mask=mask,
+        min_confidence=params.get("min_confidence", 0.0), min_coverage=params.get("min_coverage", MIN_COVERAGE),
+        homography=plane.get("homography"), plane_mask=mask,
         **{k: v for k, v in params.items() if k not in _GRID_KEYS})
     log.info("dual coordinates: method %s, model %s, residual %.4g, %d of %d pixels valid", dataset.attrs["method"],
              dataset.attrs["model"], dataset.attrs["model_residual_rms"], int(dataset["valid"].sum()),

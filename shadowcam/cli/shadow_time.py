@@ -18,6 +18,7 @@ add_parser : register the step and its options.
 run : compute and write the dataset.
 """
 
+from shadowcam._shared.coverage import MIN_COVERAGE
 from shadowcam.cli.options import parse_params
 from shadowcam.io.datasets import write_dataset
 from shadowcam.io.frame_store import open_frames
@@ -31,7 +32,7 @@ def add_parser(subparsers, name):
     parser.add_argument("--sweeps", nargs="+", required=True, help="sweep names, same order")
     parser.add_argument("--method", default="edge_fit", choices=sorted(SHADOW_TIME_METHODS),
                         help="how each pixel's sub-frame shadow time is found (default edge_fit)")
-    parser.add_argument("--params", default="{}", help="JSON: half_window, method_params, classify_params")
+    parser.add_argument("--params", default="{}", help="JSON: half_window, method_params, classify_params, min_coverage")
     parser.add_argument("--partials", nargs="+", action="append", metavar="SWEEP FILE",
                         help="a sweep name and the partial files of all its time chunks (repeat per sweep); "
                              "default: stream the frames")
@@ -43,7 +44,8 @@ def run(args):
     """Compute the shadow times of every sweep and write one dataset."""
     if len(args.frames) != len(args.sweeps):
         raise ValueError(f"--frames has {len(args.frames)} stores but --sweeps names {len(args.sweeps)}")
-    params = parse_params(args.params, allowed={"half_window", "method_params", "classify_params"})
+    params = parse_params(args.params, allowed={"half_window", "method_params", "classify_params",
+                                                     "min_coverage"})
     partials = {group[0]: group[1:] for group in args.partials or []}
     if args.partials and (set(partials) != set(args.sweeps) or not all(partials.values())):
         raise ValueError(f"--partials must name each of the sweeps {sorted(args.sweeps)} once, each with "
@@ -51,6 +53,7 @@ def run(args):
     stores = {sweep: open_frames(path) for path, sweep in zip(args.frames, args.sweeps)}
     dataset = shadow_time_of_stores(stores, method=args.method, partials=partials,
                                     half_window=params.get("half_window", 4), method_params=params.get("method_params"),
-                                    classify_params=params.get("classify_params"))
+                                    classify_params=params.get("classify_params"),
+                                    min_coverage=params.get("min_coverage", MIN_COVERAGE))
     write_dataset(dataset, args.out, config={"method": args.method, **params}, inputs=tuple(stores.values()),
                   step="shadow-time")

@@ -5,9 +5,11 @@ A sweep store holds variable ``image (time, row, col, channel)`` float32
 float64, units ``frame``), ``time_s`` and ``exposure_s`` (seconds, NaN where
 unknown) and ``channel`` (``R``, ``G``, ``B``), chunked along time only and
 compressed with zstd level 1. A reference store holds ``image (row, col,
-channel)`` (the mean of the reference frames). Stores are written to
-``<out>.tmp`` and renamed when complete, so an interrupted job never leaves a
-store that looks finished.
+channel)`` (the mean of the reference frames). Stores are written to a hidden
+temporary directory beside the store and renamed when complete
+(:func:`shadowcam._shared.atomic.atomic_directory`), so an interrupted job never
+leaves a store that looks finished, and a killed job's leftovers are removed by
+the next write.
 
 A long sweep can be decoded as several *part* stores, one per job, each
 holding a range of frames that starts on a chunk boundary;
@@ -27,6 +29,7 @@ iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time orde
 iter_store_frames : yield the (H, W, C) float32 frames one at a time (logging progress).
 """
 
+import glob
 import json
 import logging
 import os
@@ -38,6 +41,7 @@ import numpy as np
 import xarray as xr
 from zarr.codecs import ZstdCodec
 
+from shadowcam._shared.atomic import atomic_directory
 from shadowcam._shared.progress import Progress
 from shadowcam.io.decode import iter_frames
 
@@ -110,28 +114,12 @@ def _block_dataset(block, start, times_s, exposure_s, *, first_frame=0):
     )
 
 
-class _AtomicStore:
-    """Context manager: write to ``<out>.tmp``; rename to ``out`` only on success."""
-
-    def __init__(self, out_path):
-        self.out = Path(out_path)
-        self.tmp = self.out.with_name(self.out.name + ".tmp")
-
-    def __enter__(self):
-        if self.out.suffix != ".zarr":
-            raise ValueError(f"out_path must end with .zarr; got {self.out}")
-        self.out.parent.mkdir(parents=True, exist_ok=True)
-        shutil.rmtree(self.tmp, ignore_errors=True)
-        return self.tmp
-
-    def __exit__(self, exc_type, exc, tb):
-        if exc_type is not None:
-            shutil.rmtree(self.tmp, ignore_errors=True)
-            return False
-        if self.out.exists():
-            shutil.rmtree(self.out)
-        os.replace(self.tmp, self.out)
-        return False
+def _atomic_store(out_path):
+    """Context manager: a temporary directory that replaces the ``.zarr`` store `out_path` on success."""
+    out_path = Path(out_path)
+    if out_path.suffix != ".zarr":
+        raise ValueError(f"out_path must end with .zarr; got {out_path}")
+    return atomic_directory(out_path)
 
 
 def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk_frames=None,
@@ -146,8 +134,8 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
     paths : sequence of str or Path
         Frame files in time order (all of the same size).
     out_path : str or Path
-        Store to create (``*.zarr``); replaced if it exists. Written to
-        ``<out_path>.tmp`` first and renamed when complete.
+        Store to create (``*.zarr``); replaced if it exists. Written to a
+        hidden temporary beside it first and renamed when complete.
     times_s : (T,) array_like of float
         Frame times in seconds.
     exposure_s : (T,) array_like of float, optional
@@ -190,7 +178,7 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
 
     n = len(paths)
     progress = Progress(n, f"decode {Path(out_path).stem}")
-    with _AtomicStore(out_path) as tmp:
+    with _atomic_store(out_path) as tmp:
         block, start, written = None, 0, 0
         for k, (path, image, info) in enumerate(iter_frames(paths)):
             if block is None:
@@ -260,16 +248,19 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
     the first part with the time length of the whole sweep. The result reads
     exactly like a store written by one :func:`write_frames` call over all frames
     with the same `chunk_frames` (same values, same chunk files). Written to
-    ``<out_path>.tmp`` and renamed when complete.
+    a hidden temporary beside it and renamed when complete.
 
     Parameters
     ----------
     parts : sequence of str or Path
         Part stores from :func:`write_frames` (with ``first_frame``), in time
-        order: the first starts at frame 0, each starts where the previous
-        ends, all share the chunk size and frame shape.
+        order: the first starts at frame 0 (for a whole sweep) or on a chunk
+        boundary, each starts where the previous ends, all share the chunk
+        size and frame shape.
     out_path : str or Path
-        Sweep store to create (``*.zarr``); replaced if it exists.
+        Store to create (``*.zarr``); replaced if it exists. If the first part
+        starts at frame F > 0 the result is itself a part store starting at F,
+        which a later merge joins like any part (merges can be nested).
     attrs : mapping, optional
         Dataset attrs to set or replace (e.g. the merged provenance); ``n_frames``
         is set to the total. Other attrs are the first part's.
@@ -284,7 +275,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
         raise ValueError("parts must list at least one part store")
     layouts = [_part_layout(p) for p in parts]
     chunk, shape = layouts[0][2], layouts[0][3]
-    expected = 0
+    start = expected = layouts[0][0]
     for path, (first, count, part_chunk, part_shape) in zip(parts, layouts):
         if part_chunk != chunk or part_shape != shape:
             raise ValueError(
@@ -297,8 +288,8 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
                 f"{chunk}); list the parts in time order without gaps"
             )
         expected += count
-    total = expected
-    with _AtomicStore(out_path) as tmp:
+    total = expected - start
+    with _atomic_store(out_path) as tmp:
         group = _read_json(parts[0] / "zarr.json")
         group["attributes"] = {**group.get("attributes", {}), **_json_safe(attrs), "n_frames": total}
         _write_json(tmp / "zarr.json", group)
@@ -313,7 +304,7 @@ def merge_frame_stores(parts, out_path, *, attrs=None):
                 meta["shape"][0] = total
             _write_json(tmp / name / "zarr.json", meta)
             for path, (first, *_rest) in zip(parts if along_time else parts[:1], layouts):
-                offset = first // chunk if along_time else 0
+                offset = (first - start) // chunk if along_time else 0
                 for source in sorted((path / name / "c").rglob("*")):
                     if source.is_file():
                         key = source.relative_to(path / name / "c").parts
@@ -352,7 +343,7 @@ def write_reference(paths, out_path, *, attrs=None):
         coords={"channel": ("channel", np.array(CHANNELS, dtype=object))},
         attrs={**_decoder_attrs(info), **_json_safe(attrs), "n_frames_averaged": len(paths)},
     )
-    with _AtomicStore(out_path) as tmp:
+    with _atomic_store(out_path) as tmp:
         ds.to_zarr(tmp, mode="w-", zarr_format=3, encoding={"image": {"compressors": _COMPRESSORS}}, consolidated=False)
     return Path(out_path)
 
@@ -372,9 +363,9 @@ def open_frames(path):
     """
     path = Path(path)
     if not path.is_dir():
-        tmp = path.with_name(path.name + ".tmp")
-        hint = " (an unfinished write left it as .tmp; rerun the decode step)" if tmp.exists() else ""
-        raise ValueError(f"frame store {path} does not exist{hint}")
+        unfinished = any(path.parent.glob(f".{glob.escape(path.name)}.*.tmp"))
+        hint = " (an unfinished write left a hidden temporary beside it)" if unfinished else ""
+        raise ValueError(f"frame store {path} does not exist{hint}; rerun the decode step that writes it")
     with warnings.catch_warnings():
         # Snakemake marks directory outputs with a .snakemake_timestamp file, which zarr warns about
         warnings.filterwarnings("ignore", message=r"Object at \.snakemake_timestamp is not recognized")

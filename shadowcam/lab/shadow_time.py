@@ -20,6 +20,7 @@ lit_colour : unshadowed colour per pixel from a summary with channel sums.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
 summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
 shadow_time_dataset : assemble the per-sweep results into the ``shadow_time`` dataset.
+check_timed : fail with the reason counts when a sweep has (almost) no timed pixel.
 shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials) -> the ``shadow_time`` dataset.
 """
 
@@ -30,6 +31,7 @@ import numpy as np
 from scipy.special import ndtri
 
 from shadowcam._shared.progress import Progress
+from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
 from shadowcam._shared.validation import check_in_interval, check_positive
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
@@ -691,8 +693,37 @@ def shadow_time_dataset(per_sweep, *, channels=("R", "G", "B")):
     return ds
 
 
+#: what a sweep's most common reason says about the capture (message of an empty result)
+_EMPTY_HINTS = {
+    "never_shadowed": "the shadow crosses (almost) no pixel: check the sweep's files",
+    "low_contrast": "the sweep shows no shadow: check the exposure and that the shadow is in view",
+    "saturated": "the frames are saturated: lower the exposure",
+    "several_minima": "the pixels see several shadows: check the sweep's files and order",
+    "invalid_input": "the sweep is too short or its frames are invalid: it needs more frames than the dip window",
+    "wide_dip": "the shadow passes slower than the dip window: raise half_window",
+}
+
+
+def check_timed(shadow_time, *, min_coverage=MIN_COVERAGE):
+    """Raise ValueError with the reason counts if a sweep has (almost) no timed pixel.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        :func:`shadow_time_dataset`: ``reason (sweep, row, col)``.
+    min_coverage : float
+        Smallest fraction of a sweep's pixels that must carry a shadow time.
+    """
+    for sweep in shadow_time["sweep"].values:
+        codes = np.bincount(shadow_time["reason"].sel(sweep=sweep).values.ravel(), minlength=len(REASONS))
+        counts = {REASONS[code]: int(codes[code]) for code in REASONS if code != OK}
+        worst = max(counts, key=counts.get)
+        check_coverage(codes[OK], codes.sum(), what=f"camera pixels timed in sweep {sweep}", reasons=counts,
+                       hint=_EMPTY_HINTS[worst], min_coverage=min_coverage)
+
+
 def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_window=4, method_params=None,
-                          classify_params=None):
+                          classify_params=None, min_coverage=MIN_COVERAGE):
     """Shadow times of every sweep of a capture.
 
     Parameters
@@ -710,17 +741,25 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
         Dip half window of the streamed sweeps.
     method_params, classify_params : mapping, optional
         Options of the timing method and of :func:`classify_dips`.
+    min_coverage : float
+        Smallest fraction of each sweep's pixels that must be timed (:func:`check_timed`).
 
     Returns
     -------
     xarray.Dataset
         :func:`shadow_time_dataset` of the sweeps.
+
+    Raises
+    ------
+    ValueError
+        If a sweep has (almost) no timed pixel, with the reason counts.
     """
     from shadowcam.io.frame_store import iter_frame_chunks
     from shadowcam.lab.dip_tracker import DipPartial, merge_partials
 
     if method not in SHADOW_TIME_METHODS:
         raise ValueError(f"method: unknown {method!r}; choose from {sorted(SHADOW_TIME_METHODS)}")
+    check_in_interval(min_coverage, "min_coverage", 0.0, 1.0, closed="both")
     partials = dict(partials or {})
     unknown = set(partials) - set(stores)
     if unknown:
@@ -741,4 +780,6 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
             per_sweep[sweep] = sweep_shadow_times(
                 (block for _, block in iter_frame_chunks(frames)), shape,
                 half_window=half_window, progress=progress.update, **options)
-    return shadow_time_dataset(per_sweep)
+    dataset = shadow_time_dataset(per_sweep)
+    check_timed(dataset, min_coverage=min_coverage)
+    return dataset

@@ -231,3 +231,17 @@ def test_calibration_plane_is_chosen_when_the_sweep_speed_is_not_uniform():
     candidates = {c["name"]: c for c in json.loads(dataset.attrs["candidates"])}
     assert candidates["homography"]["cv_rms"] > 3 * candidates["tps"]["cv_rms"]
     assert "tps" in dataset.attrs["model_choice"]
+
+
+def test_front_function_fails_when_no_pixel_keeps_a_shadow_time():
+    from shadowcam.cameras.dual_coords import dual_coords_from_shadow_time
+
+    rows, cols = np.mgrid[0:6, 0:8].astype(np.float32)
+    shadow_time = _shadow_time_dataset(cols * 2.0, rows, n_frames=(20, 10))
+    shadow_time["confidence"] = shadow_time["shadow_time"] * 0 + 0.9
+    # confidence lies in [0, 1]: a threshold of 5 leaves no pixel
+    with pytest.raises(ValueError, match=r"0 of 48 camera pixels with dual coordinates .*48 without a shadow "
+                                         r"time in sweep u.*min_confidence is 5"):
+        dual_coords_from_shadow_time(shadow_time, method="uniform", min_confidence=5)
+    dataset = dual_coords_from_shadow_time(shadow_time, method="uniform", min_confidence=0.5)
+    assert dataset["valid"].values.all()

@@ -194,3 +194,22 @@ def test_front_function_resamples_the_reference_colours_into_the_dual_grid():
         dual_view_from_coords(coords, shadow_time, reference=reference, no_such_option=1)
     with pytest.raises(ValueError, match="coords"):
         dual_view_from_coords(coords.isel(row=slice(0, 6)), shadow_time, reference=reference)
+
+
+def test_front_function_fails_on_a_nearly_empty_dual_view():
+    from shadowcam.cameras.dual_view import dual_view_from_coords
+
+    rows, cols = np.mgrid[0:12, 0:16].astype(np.float64)
+    colours = np.ones(rows.shape + (3,), np.float32)
+    valid = np.zeros(rows.shape, bool)
+    valid[:2, :2] = True  # a 2x2 patch of camera pixels covers ~1 of 1600 dual pixels
+    coords = xr.Dataset({"u": (("row", "col"), cols), "v": (("row", "col"), rows),
+                         "valid": (("row", "col"), valid)},
+                        attrs={"dual_height": 40, "dual_width": 40, "model": "uniform"})
+    reference = xr.Dataset({"image": (("row", "col", "channel"), colours)})
+    shadow_time = xr.Dataset(coords={"sweep": ["u", "v"], "channel": ["R", "G", "B"]})
+    with pytest.raises(ValueError, match=r"of 1,600 dual pixels of the 40x40 dual view covered .*4 of 192 camera "
+                                         r"pixels have dual coordinates"):
+        dual_view_from_coords(coords, shadow_time, reference=reference)
+    dataset = dual_view_from_coords(coords, shadow_time, reference=reference, min_coverage=0)
+    assert dataset["coverage"].values.sum() < 16

@@ -50,7 +50,7 @@ def test_round_trip_and_chunks(tmp_path, make_frames):
     assert all(block.dtype == np.float32 for _, block in blocks)
     np.testing.assert_array_equal(np.concatenate([b for _, b in blocks]), expected)
     assert [s for s, _ in iter_frame_chunks(ds, chunk_frames=5)] == [0, 5]
-    assert not (tmp_path / "u.zarr.tmp").exists()
+    assert not list(tmp_path.glob(".u.zarr.*"))
 
 
 def test_reference_store_is_mean_of_frames(tmp_path, make_frames):
@@ -67,7 +67,7 @@ def test_failed_write_leaves_no_store_and_keeps_old(tmp_path, write_image, make_
     odd = write_image(tmp_path / "in" / "odd.tif", np.zeros((12, 11, 3), np.uint16))
     with pytest.raises(ValueError, match=r"odd\.tif.*12x11.*0000\.tif.*12x10"):
         write_frames(paths + [odd], out, times_s=np.arange(5.0), chunk_frames=2)
-    assert not (tmp_path / "u.zarr.tmp").exists()
+    assert not list(tmp_path.glob(".u.zarr.*"))
     assert open_frames(out).sizes["time"] == 2  # previous complete store untouched
     with pytest.raises(ValueError, match="does not exist"):
         open_frames(tmp_path / "v.zarr")

@@ -64,6 +64,20 @@ def test_extra_key_is_named(tmp_path, make_capture, rewrite):
     assert "sweeps.u" in str(info.value) and str(path) in str(info.value)
 
 
+@pytest.mark.parametrize("timing, expected", [
+    ({"source": "rate", "rate_hz": "fast"}, "key timing.rate_hz: 'fast' is not of type 'number'"),
+    ({"source": "filename", "regex": 3}, "key timing.regex: 3 is not of type 'string'"),
+    ({"source": "sidecar", "file": "t.json"}, "key timing: 'key' is a required property"),
+    ({"source": "clock"}, "key timing.source: 'clock' is not one of ['rate', 'filename', 'metadata', 'auto', 'sidecar']"),
+])
+def test_wrong_timing_names_the_key_of_its_source(tmp_path, make_capture, rewrite, timing, expected):
+    path, doc = make_capture(tmp_path)
+    doc["timing"] = timing
+    with pytest.raises(ValueError) as info:
+        load_manifest(rewrite(path, doc))
+    assert str(info.value).splitlines()[1:-1] == [f"  {expected}"], str(info.value)
+
+
 def test_missing_root_named(tmp_path, make_capture, rewrite):
     path, doc = make_capture(tmp_path)
     doc["root"] = "../nowhere"

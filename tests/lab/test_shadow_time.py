@@ -165,3 +165,20 @@ def test_stores_of_two_sweeps_give_one_dataset_equal_to_each_sweep_alone(wire_sw
         shadow_time_of_stores({"u": store(frames_u)}, partials={"w": ["x.npz"]})
     with pytest.raises(ValueError, match="method"):
         shadow_time_of_stores({"u": store(frames_u)}, method="guess")
+
+
+@pytest.mark.parametrize("case, reason", [("black", "low_contrast"), ("three_frames", "invalid_input")])
+def test_a_sweep_without_timed_pixels_fails_with_the_reason_counts(case, reason, wire_sweep):
+    import xarray as xr
+
+    from shadowcam.lab.shadow_time import shadow_time_of_stores
+
+    frames, _ = wire_sweep(seed=1)
+    frames = np.zeros_like(frames) if case == "black" else frames[:3]
+    pixels = frames.shape[1] * frames.shape[2]
+    store = xr.Dataset({"image": (("time", "row", "col", "channel"), frames)})
+    with pytest.raises(ValueError, match=rf"^0 of {pixels:,} camera pixels timed in sweep u \(0\.0%, "
+                                         rf"min_coverage 0\.01\): {pixels:,} {reason}; "):
+        shadow_time_of_stores({"u": store}, half_window=4)
+    with pytest.raises(ValueError, match="min_coverage must be"):
+        shadow_time_of_stores({"u": store}, half_window=4, min_coverage=5)

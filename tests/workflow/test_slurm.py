@@ -132,4 +132,4 @@ def test_slurm_results_equal_local_run(runs):
     for doc in accuracy:  # sha256 of the input files: dual_view.nc records its own run time
         assert set(doc.pop("inputs")) == {f"results/{DS}/{name}" for name in RESULTS}
     assert accuracy[0] == accuracy[1]
-    assert not list((remote / "results").rglob("*.tmp")), "no half-written store left behind"
+    assert not list((remote / "results").rglob(".*.tmp")), "no half-written store left behind"

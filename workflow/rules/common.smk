@@ -165,7 +165,7 @@ def get_dual_coords_params(wildcards):
     manifest's ``dual`` block, else frames per sweep) and fixed when the dual coordinates
     are computed, so a change reruns dual_coords and everything after it.
     """
-    options = dict(config["dual_coords"]["params"])
+    options = dict(config["dual_coords"]["params"], min_coverage=config["min_coverage"])
     for key in ("width", "height"):
         if config["dual_view"][key] is not None:
             options[f"dual_{key}"] = config["dual_view"][key]

@@ -2,7 +2,9 @@
 # unshadowed reference frame (when the capture has one) into its own store.
 # A sweep is decoded in time parts, one job each (decode_part: frames START:STOP into
 # a part store); `decode` joins the parts by hard-linking their chunk files, so the
-# sweep store equals a single-job decode bit for bit. Part sizes: parts.smk, which
+# sweep store equals a single-job decode bit for bit. A sweep of more than
+# PARTS_PER_GROUP parts is joined in two levels (decode_group, then decode), with the
+# same result. Part sizes and groups: parts.smk, which
 # also says why a user capture's frames are a param of `decode`, not inputs.
 
 # reference.zarr is a single image, not a sweep (wildcard `sweep` never matches it):
@@ -30,6 +32,24 @@ rule decode_part:
     shell:
         "shadowcam decode --manifest {params.manifest} --sweep {wildcards.sweep}"
         " --chunk-frames {params.chunk_frames} --frames {params.frames} --out {output} > {log} 2>&1"
+
+
+rule decode_group:
+    input:
+        get_group_parts,
+    output:
+        temp(directory("results/{ds}/frames/{sweep}.groups/{group}.zarr")),
+    log:
+        "logs/{ds}/decode_{sweep}_group{group}.log",
+    benchmark:
+        "benchmarks/{ds}/decode_{sweep}_group{group}.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=1024,
+        runtime=10,
+    shell:
+        "shadowcam merge-frames --parts {input} --out {output} > {log} 2>&1"
 
 
 rule decode:

@@ -47,7 +47,9 @@ rule dual_view:
     params:
         reference=get_flag("--reference", "reference"),
         method=config["dual_view"]["method"],
-        options=as_json(config["dual_view"]["params"]),
+        options=as_json(
+            {**config["dual_view"]["params"], "min_coverage": config["min_coverage"]}
+        ),
     shell:
         "shadowcam dual-view --dual-coords {input.dual_coords} --shadow-time {input.shadow_time}"
         " {params.reference} --method {params.method} --params {params.options:q}"

@@ -2,10 +2,16 @@
 #
 # Wildcards
 # ---------
-# part    decode part of a sweep, 0000, 0001, ...: frames [i F, (i + 1) F) with
+# part    decode part of a sweep, 0000, 0001, ..., 9999, 10000, ... (no limit): frames [i F, (i + 1) F) with
 #         F = chunk_frames x decode.chunks_per_job; `decode` joins the part stores
 #         (hard links, no copy) into results/{ds}/frames/{sweep}.zarr, and the
 #         shadow_time_chunk jobs track the dips of the same frame ranges
+# group   group of PARTS_PER_GROUP consecutive parts of a sweep with more parts than
+#         that, 0000, 0001, ...: decode_group joins them (hard links) into
+#         results/{ds}/frames/{sweep}.groups/{group}.zarr and `decode` joins the groups,
+#         so no job lists more than PARTS_PER_GROUP inputs (Snakemake checks each
+#         consumer of the sweep store against its producer's inputs: a sweep store
+#         made of every part directly makes planning quadratic in the part count)
 # span    time span of the first outdoor pass, START-STOP (frames; `0-end` when the
 #         frame count is known only once the capture is rendered): config
 #         outdoor.part_frames frames per job, merged into photometry.nc
@@ -13,7 +19,9 @@
 #         track_edges (config outdoor.edge_strips; 1 = one job, no strips)
 #
 # Memory of a job is bounded by one time chunk of chunk_frames frames, whatever the
-# frames per job.
+# frames per job. The part ranges and part file names of a sweep are computed once
+# per run (cached per dataset and sweep): an input function of one part looks its
+# range up, so planning stays linear in the number of parts.
 #
 # The frames of a user capture are not inputs of decode_part (a sweep has hundreds and
 # `snakemake -n` would print them all on one line): the manifest is, with their sha256
@@ -25,24 +33,43 @@ from shadowcam.io.frame_store import default_chunk_frames
 
 
 wildcard_constraints:
-    part=r"\d{4}",
+    part=r"\d\d\d\d+",
+    group=r"\d\d\d\d+",
     span=r"\d+-(\d+|end)",
     strip=r"\d+",
 
 
+#: parts joined by one decode_group job (sweeps with more parts are joined in two levels)
+PARTS_PER_GROUP = 100
+
+_PART_RANGES = {}
+_PART_NAMES = {}
+
+
 def decode_chunk_frames(ds):
-    """Frames per store chunk: config decode.chunk_frames, or ~64 MiB of float32 RGB if null."""
+    """Frames per store chunk: config decode.chunk_frames, or ~64 MiB of float32 RGB if null.
+
+    Never more than the longest sweep of `ds`: a chunk longer than the sweep would only
+    size the jobs' memory for frames that do not exist.
+    """
+    plan = capture(ds)
+    longest = max([plan.n_frames(s) for s in plan.sweeps] + [1])
     configured = config["decode"]["chunk_frames"]
     if configured:
-        return int(configured)
-    return default_chunk_frames(capture(ds).frame_shape + (3,))
+        return min(int(configured), longest)
+    return min(default_chunk_frames(plan.frame_shape + (3,)), longest)
 
 
 def decode_part_ranges(ds, sweep):
-    """Frame ranges [(start, stop), ...] of the decode_part jobs of a sweep."""
-    total = capture(ds).n_frames(sweep)
-    step = decode_chunk_frames(ds) * int(config["decode"]["chunks_per_job"])
-    return [(start, min(start + step, total)) for start in range(0, total, step)]
+    """Frame ranges [(start, stop), ...] of the decode_part jobs of a sweep (cached)."""
+    key = (ds, sweep)
+    if key not in _PART_RANGES:
+        total = capture(ds).n_frames(sweep)
+        step = decode_chunk_frames(ds) * int(config["decode"]["chunks_per_job"])
+        _PART_RANGES[key] = tuple(
+            (start, min(start + step, total)) for start in range(0, total, step)
+        )
+    return _PART_RANGES[key]
 
 
 def part_range(wildcards):
@@ -56,16 +83,44 @@ def part_range(wildcards):
     return ranges[index]
 
 
+def part_names(ds, sweep):
+    """Names of the decode parts of a sweep in time order: 0000, 0001, ... (cached)."""
+    key = (ds, sweep)
+    if key not in _PART_NAMES:
+        count = len(decode_part_ranges(ds, sweep))
+        _PART_NAMES[key] = tuple(f"{i:04d}" for i in range(count))
+    return _PART_NAMES[key]
+
+
 def sweep_parts(ds, sweep, template):
     """`template` (with {ds}, {sweep}, {part}) of every decode part of a sweep, in time order."""
-    count = len(decode_part_ranges(ds, sweep))
-    return [template.format(ds=ds, sweep=sweep, part=f"{i:04d}") for i in range(count)]
+    return [template.format(ds=ds, sweep=sweep, part=part) for part in part_names(ds, sweep)]
 
 
 def get_decode_parts(wildcards):
-    """Part stores of a sweep, in time order (inputs of `decode`)."""
-    template = "results/{ds}/frames/{sweep}.parts/{part}.zarr"
-    return sweep_parts(wildcards.ds, wildcards.sweep, template)
+    """Part stores of a sweep, or its group stores if it has more parts than PARTS_PER_GROUP (inputs of `decode`)."""
+    parts = sweep_parts(wildcards.ds, wildcards.sweep, "results/{ds}/frames/{sweep}.parts/{part}.zarr")
+    if len(parts) <= PARTS_PER_GROUP:
+        return parts
+    count = -(-len(parts) // PARTS_PER_GROUP)
+    return [
+        f"results/{wildcards.ds}/frames/{wildcards.sweep}.groups/{i:04d}.zarr"
+        for i in range(count)
+    ]
+
+
+def get_group_parts(wildcards):
+    """Part stores of group `wildcards.group` of a sweep, in time order (inputs of `decode_group`)."""
+    names = part_names(wildcards.ds, wildcards.sweep)
+    first = int(wildcards.group) * PARTS_PER_GROUP
+    if len(names) <= PARTS_PER_GROUP or first >= len(names):
+        raise ValueError(
+            f"{wildcards.ds} sweep {wildcards.sweep} has {len(names)} parts, no group {wildcards.group}"
+        )
+    return [
+        f"results/{wildcards.ds}/frames/{wildcards.sweep}.parts/{name}.zarr"
+        for name in names[first : first + PARTS_PER_GROUP]
+    ]
 
 
 def get_part_files(wildcards):

@@ -4,6 +4,7 @@
 # cluster stopped for lack of memory or time is retried with more (profiles set the
 # retries). The per-pixel and per-megapixel constants below name where they come from.
 import math
+import sys
 
 #: MB of a Python process with the shadowcam imports loaded, with margin
 #: (benchmarks/<ds>/decode_<sweep>.tsv max_rss: a step holding almost no data)
@@ -178,3 +179,49 @@ def get_per_pixel_mem_mb(wildcards, attempt):
 def get_per_pixel_runtime(wildcards, attempt):
     """Outdoor steps on per-pixel maps and (T, W) curves."""
     return _outdoor_runtime(wildcards, attempt, "per_pixel")
+
+
+class _PlanningWildcards(dict):
+    """Wildcards of a dataset's first job of each kind, for sizing before the DAG is built."""
+
+    __getattr__ = dict.__getitem__
+
+
+def planned_mem_mb(ds):
+    """Memory (MB, first attempt) of the largest job of each kind of dataset `ds`."""
+    plan = capture(ds)
+    sweep = plan.outdoor_sweep if plan.is_outdoor else plan.timed_sweeps[0]
+    wildcards = _PlanningWildcards(ds=ds, sweep=sweep, part="0000", span="0-end", strip="0")
+    sizes = {
+        "decode_part": get_decode_mem_mb(wildcards, 1),
+        "decode_reference and the image steps": get_image_mem_mb(wildcards, 1),
+    }
+    if plan.rendered:
+        sizes["render"] = get_render_mem_mb(wildcards, 1)
+    if plan.is_outdoor:
+        sizes["outdoor_normalise_part"] = get_normalise_mem_mb(wildcards, 1)
+        sizes["track_edges"] = get_track_edges_mem_mb(wildcards, 1)
+        sizes["outdoor per-pixel steps"] = get_per_pixel_mem_mb(wildcards, 1)
+    else:
+        sizes["shadow_time_chunk"] = get_shadow_time_chunk_mem_mb(wildcards, 1)
+        sizes["shadow_time"] = get_shadow_time_mem_mb(wildcards, 1)
+    return sizes
+
+
+def _check_job_sizes():
+    """Stop the plan when a configured dataset needs a job larger than config max_job_mem_mb."""
+    ceiling = int(config["max_job_mem_mb"])
+    for ds in config["datasets"]:
+        job, size = max(planned_mem_mb(ds).items(), key=lambda item: item[1])
+        if size > ceiling:
+            rows, cols = capture(ds).frame_shape
+            sys.exit(
+                f"error: dataset {ds!r} ({manifest_path(ds)}): frames of {rows} x {cols} pixels "
+                f"({rows * cols / 1e6:.3g} MP) need {size:,} MB of memory in job {job}, above "
+                f"max_job_mem_mb {ceiling:,} MB (config). Crop or bin the frames, lower "
+                f"decode.chunk_frames if decode_part is the largest job, or raise "
+                f"max_job_mem_mb if your machines have that much memory."
+            )
+
+
+_check_job_sizes()

@@ -46,7 +46,9 @@ rule shadow_time:
         sweeps=get_sweeps,
         partials=get_partials_option,
         method=config["shadow_time"]["method"],
-        options=as_json(config["shadow_time"]["params"]),
+        options=as_json(
+            {**config["shadow_time"]["params"], "min_coverage": config["min_coverage"]}
+        ),
     shell:
         "shadowcam shadow-time --frames {input.frames} --sweeps {params.sweeps} {params.partials}"
         " --method {params.method} --params {params.options:q} --out {output} > {log} 2>&1"
