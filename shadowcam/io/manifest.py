@@ -47,6 +47,9 @@ log = logging.getLogger(__name__)
 #: JSON schema of a manifest (YAML), shipped inside the package
 SCHEMA_PATH = Path(__file__).resolve().parent / "schemas" / "manifest.schema.yaml"
 
+#: libyaml's safe loader where PyYAML was built with it (a manifest lists every frame's checksum)
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
 _FIX_CHECKSUMS = "run `shadowcam checksum --manifest {m}` and paste its output into the manifest"
 
 
@@ -61,7 +64,7 @@ def _read_document(path):
         raise ValueError(f"manifest file {path} does not exist")
     text = path.read_text()
     try:
-        doc = json.loads(text) if path.suffix.lower() == ".json" else yaml.safe_load(text)
+        doc = json.loads(text) if path.suffix.lower() == ".json" else yaml.load(text, Loader=_YAML_LOADER)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
         raise ValueError(f"manifest {path} is not valid {'JSON' if path.suffix == '.json' else 'YAML'}: {exc}") from None
     if not isinstance(doc, dict):
