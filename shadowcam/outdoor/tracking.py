@@ -2,17 +2,20 @@
 
 With the shifts, gains and per-pixel levels of the first pass
 (:mod:`shadowcam.outdoor.normalise`), each frame becomes a coverage image
-(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`); frame differencing
-against the previous coverage gives the band where the edge moved
-(:mod:`shadowcam.outdoor.frame_difference`); the edge of every column is located with
-sub-pixel precision (:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions
-in the band or near the column's most recent edge (tracking) and the per-pixel
-dark episodes of every pixel are accumulated (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`).
-The lit level of each pixel follows slow shading changes (the sun moves) while
-the pixel is fully lit and well above the edge. Memory is a few ``(H, W)``
-arrays plus the ``(T, W)`` edges.
+(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`), from which a passing
+cloud's shade, measured just above each column's last edge, is divided out
+(:mod:`shadowcam.outdoor.shade`); frame differencing against the previous coverage
+gives the band where the edge moved (:mod:`shadowcam.outdoor.frame_difference`); the
+edge of every column is located with sub-pixel precision
+(:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions in the band, then near
+the column's most recent edge (tracking), and the dark episodes of every pixel are
+accumulated (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`). The lit level of each
+pixel follows slow shading changes (the sun moves) while the pixel is fully lit and well
+above the edge. Memory is a few ``(H, W)`` arrays, ``E`` episode slots per pixel and the
+``(T, W)`` edges.
 
-Every step but the frame differencing's widening (``margin`` columns) and the
+Every step but the frame differencing's widening (``margin`` columns), the episodes'
+neighbour count (one pixel each side) and the
 registration shift (:func:`shadowcam.outdoor.translation.translate`, ``"cubic_Keys1981"``,
 whose bits do not depend on where the frame is cut) works column by column,
 so column strips of the frames can be tracked as separate jobs and merged
