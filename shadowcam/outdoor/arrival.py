@@ -99,16 +99,21 @@ def arrival_from_edges(edge_row, time_s, *, eligible):
 
 def _at_the_edge(starts, edge_row, time_s, *, tolerance_rows):
     """Whether the tracked edge of the pixel's column is within `tolerance_rows` of its centre
-    in the first frame at or after each start."""
+    in the first frame at or after each start (one episode slot at a time)."""
     height, width = starts.shape[:2]
-    edge = np.asarray(edge_row, dtype=np.float64)
+    edge = np.asarray(edge_row, dtype=np.float32)
     times = np.asarray(time_s, dtype=np.float64)
-    known = np.isfinite(starts)
-    k = np.clip(np.searchsorted(times, np.where(known, starts, times[0])), 0, times.size - 1)
-    col = np.broadcast_to(np.arange(width)[None, :, None], starts.shape)
-    centre = np.broadcast_to(np.arange(height, dtype=np.float64)[:, None, None] + 0.5, starts.shape)
-    with np.errstate(invalid="ignore"):
-        return known & (np.abs(edge[k, col] - centre) <= tolerance_rows)
+    centre = np.arange(height, dtype=np.float32)[:, None] + np.float32(0.5)
+    col = np.arange(width, dtype=np.int32)[None, :]
+    near = np.zeros(starts.shape, dtype=bool)
+    for slot in range(starts.shape[-1]):
+        start = starts[..., slot]
+        known = np.isfinite(start)
+        k = np.searchsorted(times, np.where(known, start, times[0])).astype(np.int32)
+        np.minimum(k, times.size - 1, out=k)
+        with np.errstate(invalid="ignore"):
+            near[..., slot] = known & (np.abs(edge[k, col] - centre) <= tolerance_rows)
+    return near
 
 
 def resolve_episodes(final_s, event_start_s, edge_s, *, tolerance_s, edge_row=None, time_s=None, tolerance_rows=1.0):
@@ -148,7 +153,7 @@ def resolve_episodes(final_s, event_start_s, edge_s, *, tolerance_s, edge_row=No
         there, and no time is given.
     """
     final = np.asarray(final_s, dtype=np.float64)
-    starts = np.asarray(event_start_s, dtype=np.float64)
+    starts = np.asarray(event_start_s)
     edge = np.asarray(edge_s, dtype=np.float64)
     check_same_shape({"final_s": final, "edge_s": edge, "event_start_s[..., 0]": starts[..., 0]})
     with np.errstate(invalid="ignore"):
@@ -230,25 +235,30 @@ def event_table(final_s, final_depth, event_start_s, event_end_s, event_depth, *
         ``depth`` (1 - the mean lit fraction) and ``kind`` (codes of :data:`EVENT_KINDS`),
         pixel by pixel in time order.
     """
-    starts = np.asarray(event_start_s, dtype=np.float64)
-    final = np.asarray(final_s, dtype=np.float64)
-    chosen = np.asarray(chosen)
-    ambiguous = np.asarray(ambiguous, dtype=bool)
+    starts = np.asarray(event_start_s)
+    # only the pixels with an earlier episode: (N, E) arrays
+    pixel = np.isfinite(starts).any(axis=-1) & np.asarray(eligible, dtype=bool)
+    row, col = np.nonzero(pixel)
+    starts = starts[pixel].astype(np.float64)
+    ends = np.asarray(event_end_s)[pixel].astype(np.float64)
+    depths = np.asarray(event_depth)[pixel].astype(np.float32)
+    final = np.asarray(final_s, dtype=np.float64)[pixel]
+    chosen = np.asarray(chosen)[pixel]
+    ambiguous = np.asarray(ambiguous, dtype=bool)[pixel]
     relit = chosen < starts.shape[-1]
     slot = np.arange(starts.shape[-1])
-    kind = np.where(slot < chosen[..., None], 2, np.where(slot == chosen[..., None], 0, 1))
+    kind = np.where(slot < chosen[:, None], 2, np.where(slot == chosen[:, None], 0, 1))
     final_kind = np.where(relit, 1, 0)
-    kind = np.where(ambiguous[..., None], 3, kind)
+    kind = np.where(ambiguous[:, None], 3, kind)
     final_kind = np.where(ambiguous, 3, final_kind)
-    # all episodes, the final one last, of the pixels with an earlier one
-    start = np.concatenate([starts, final[..., None]], axis=-1)
-    end = np.concatenate([np.asarray(event_end_s, dtype=np.float64), np.full(final.shape + (1,), np.nan)], axis=-1)
-    depth = np.concatenate([np.asarray(event_depth, dtype=np.float32),
-                            np.asarray(final_depth, dtype=np.float32)[..., None]], axis=-1)
-    kinds = np.concatenate([kind, final_kind[..., None]], axis=-1).astype(np.uint8)
-    listed = np.isfinite(start) & (np.isfinite(starts).any(axis=-1) & np.asarray(eligible, dtype=bool))[..., None]
-    row, col, _ = np.nonzero(listed)
-    return {"row": row.astype(np.int32), "col": col.astype(np.int32), "start_s": start[listed],
+    # all episodes of those pixels, the final one last
+    start = np.concatenate([starts, final[:, None]], axis=-1)
+    end = np.concatenate([ends, np.full((final.size, 1), np.nan)], axis=-1)
+    depth = np.concatenate([depths, np.asarray(final_depth, dtype=np.float32)[pixel][:, None]], axis=-1)
+    kinds = np.concatenate([kind, final_kind[:, None]], axis=-1).astype(np.uint8)
+    listed = np.isfinite(start)
+    index = np.broadcast_to(np.arange(final.size)[:, None], listed.shape)[listed]
+    return {"row": row[index].astype(np.int32), "col": col[index].astype(np.int32), "start_s": start[listed],
             "end_s": end[listed], "depth": depth[listed], "kind": kinds[listed]}
 
 

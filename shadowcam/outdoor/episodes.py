@@ -59,7 +59,7 @@ class ShadowEpisodes:
     Feed frames in time order with :meth:`update`; read :meth:`result`.
     """
 
-    def __init__(self, shape, *, eligible, level=0.5, max_events=4):
+    def __init__(self, shape, *, eligible, level=0.5, max_events=2):
         shape = tuple(int(n) for n in shape)
         self.eligible = np.asarray(eligible, dtype=bool)
         if self.eligible.shape != shape:
@@ -69,14 +69,15 @@ class ShadowEpisodes:
             raise ValueError(f"max_events must be >= 1; got {max_events}")
         self.level = float(level)
         self.dark = np.zeros(shape, dtype=bool)  # accepted state
-        self.start = np.full(shape, np.nan)  # start of the current dark episode (NaN: lit)
-        self._sum = np.zeros(shape, dtype=np.float64)  # coverage summed over the current episode
+        # times are float32 (1 ms resolution up to ~2 h after the first frame)
+        self.start = np.full(shape, np.nan, dtype=np.float32)  # start of the current dark episode (NaN: lit)
+        self._sum = np.zeros(shape, dtype=np.float32)  # coverage summed over the current episode
         self._count = np.zeros(shape, dtype=np.int32)
         self._pending = np.zeros(shape, dtype=bool)  # a one-frame change waiting for the next frame
-        self._pending_t = np.full(shape, np.nan)
+        self._pending_t = np.full(shape, np.nan, dtype=np.float32)
         self._pending_cover = np.zeros(shape, dtype=np.float32)
-        self.event_start = np.full((*shape, int(max_events)), np.nan, dtype=np.float64)
-        self.event_end = np.full((*shape, int(max_events)), np.nan, dtype=np.float64)
+        self.event_start = np.full((*shape, int(max_events)), np.nan, dtype=np.float32)
+        self.event_end = np.full((*shape, int(max_events)), np.nan, dtype=np.float32)
         self.event_depth = np.full((*shape, int(max_events)), np.nan, dtype=np.float32)
         self.n_events = np.zeros(shape, dtype=np.int16)
         self._previous = None
@@ -126,7 +127,7 @@ class ShadowEpisodes:
         with np.errstate(invalid="ignore"):
             known = np.isfinite(cover)
             raw_dark = np.where(known, cover < self.level, self.dark ^ self._pending)
-        value = np.where(known, cover, 0.0).astype(np.float64)
+        value = np.where(known, cover, np.float32(0.0)).astype(np.float32)
         # a change pending from the previous frame is confirmed when it lasts into this one
         confirmed = self._pending & (raw_dark != self.dark)
         if confirmed.any():
@@ -140,7 +141,7 @@ class ShadowEpisodes:
         self._count[in_dark] += 1
         # changes in this frame
         if change.any():
-            times = np.full(cover.shape, np.nan)
+            times = np.full(cover.shape, np.nan, dtype=np.float32)
             times[change] = self._crossing_time(self._previous, cover, change, time_s)
             agree = _neighbours_agree(change & raw_dark) | _neighbours_agree(change & ~raw_dark)
             if agree.any():
