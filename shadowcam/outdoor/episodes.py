@@ -72,7 +72,7 @@ class ShadowEpisodes:
         # times are float32 (1 ms resolution up to ~2 h after the first frame)
         self.start = np.full(shape, np.nan, dtype=np.float32)  # start of the current dark episode (NaN: lit)
         self._sum = np.zeros(shape, dtype=np.float32)  # coverage summed over the current episode
-        self._count = np.zeros(shape, dtype=np.int32)
+        self._count = np.zeros(shape, dtype=np.int32)  # frames of the current episode
         self._pending = np.zeros(shape, dtype=bool)  # a one-frame change waiting for the next frame
         self._pending_t = np.full(shape, np.nan, dtype=np.float32)
         self._pending_cover = np.zeros(shape, dtype=np.float32)
@@ -90,7 +90,8 @@ class ShadowEpisodes:
         return self._time + np.clip(frac, 0.0, 1.0) * (time_s - self._time)
 
     def _accept(self, change, times, cover_sum, cover_count):
-        """Switch the state of `change` pixels at `times` (their crossing times)."""
+        """Switch the state of `change` pixels at `times` (their crossing times); an episode
+        that starts holds `cover_sum` over `cover_count` frames so far."""
         to_dark = change & ~self.dark
         to_lit = change & self.dark
         # closing: an episode that had a start (not dark since frame 0)
@@ -108,7 +109,7 @@ class ShadowEpisodes:
         self.start[to_lit] = np.nan
         self.start[to_dark] = times[to_dark]
         self._sum[to_dark] = cover_sum[to_dark]
-        self._count[to_dark] = cover_count[to_dark]
+        self._count[to_dark] = cover_count
         self.dark ^= change
 
     def update(self, cover, time_s):
@@ -131,8 +132,8 @@ class ShadowEpisodes:
         # a change pending from the previous frame is confirmed when it lasts into this one
         confirmed = self._pending & (raw_dark != self.dark)
         if confirmed.any():
-            pend_sum = np.where(confirmed, self._pending_cover + value, 0.0)
-            self._accept(confirmed, self._pending_t, pend_sum, np.full(cover.shape, 2, np.int32))
+            pend_sum = self._pending_cover + value
+            self._accept(confirmed, self._pending_t, pend_sum, 2)
         self._pending[:] = False
         change = (raw_dark != self.dark) & self.eligible
         # the dark episode accumulates its coverage (a frame that may end it does not count)
@@ -145,7 +146,7 @@ class ShadowEpisodes:
             times[change] = self._crossing_time(self._previous, cover, change, time_s)
             agree = _neighbours_agree(change & raw_dark) | _neighbours_agree(change & ~raw_dark)
             if agree.any():
-                self._accept(agree, times, np.where(agree, value, 0.0), np.ones(cover.shape, np.int32))
+                self._accept(agree, times, value, 1)
             wait = change & ~agree
             self._pending[wait] = True
             self._pending_t[wait] = times[wait]
@@ -153,36 +154,25 @@ class ShadowEpisodes:
         self._previous, self._time = cover.copy(), float(time_s)
 
     def result(self):
-        """The episodes so far (a change pending in the last frame is kept).
+        """The episodes, after the last frame (a change pending in it is kept; no copies).
 
         Returns
         -------
         dict
             ``final_start_s (H, W)``: start of the final dark episode (NaN: lit at the
-            end, or not eligible) and ``final_depth (H, W)`` (1 - its mean coverage); ``event_start_s``, ``event_end_s``,
-            ``event_depth`` ``(H, W, max_events)``: the closed (relit) episodes in time
-            order, depth = 1 - their mean coverage; ``n_events (H, W)``: how many there were.
+            end, or not eligible) and ``final_depth (H, W)`` (1 - its mean coverage);
+            ``event_start_s``, ``event_end_s``, ``event_depth`` ``(H, W, max_events)``: the
+            closed (relit) episodes in time order, depth = 1 - their mean coverage;
+            ``n_events (H, W)``: how many there were.
         """
-        dark, start = self.dark.copy(), self.start.copy()
-        pending = self._pending
         # in the last frame a change is kept: to dark starts the final episode, to lit ends it
-        to_dark = pending & ~dark
-        start[to_dark] = self._pending_t[to_dark]
-        start[pending & dark] = np.nan
-        n_events = self.n_events.copy()
-        ev_start, ev_end, ev_depth = self.event_start.copy(), self.event_end.copy(), self.event_depth.copy()
-        close = pending & dark & np.isfinite(self.start)
-        if close.any():
-            r, c = np.nonzero(close)
-            slot = n_events[r, c].astype(np.intp)
-            keep = slot < ev_start.shape[-1]
-            r, c, slot = r[keep], c[keep], slot[keep]
-            ev_start[r, c, slot] = self.start[r, c]
-            ev_end[r, c, slot] = self._pending_t[r, c]
-            ev_depth[r, c, slot] = np.clip(1.0 - self._sum[r, c] / np.maximum(self._count[r, c], 1), 0.0, 1.0)
-            n_events[close] += 1
-        with np.errstate(invalid="ignore", divide="ignore"):
-            final_depth = np.where(np.isfinite(start) & (self._count > 0),
-                                   np.clip(1.0 - self._sum / self._count, 0.0, 1.0), np.nan).astype(np.float32)
-        return {"final_start_s": start, "final_depth": final_depth, "event_start_s": ev_start, "event_end_s": ev_end,
-                "event_depth": ev_depth, "n_events": n_events}
+        pending = self._pending
+        if pending.any():
+            self._accept(pending, self._pending_t, self._pending_cover, 1)
+            pending[:] = False
+        start = self.start
+        final_depth = np.full(start.shape, np.nan, dtype=np.float32)
+        open_ = np.isfinite(start) & (self._count > 0)
+        final_depth[open_] = np.clip(1.0 - self._sum[open_] / self._count[open_], 0.0, 1.0)
+        return {"final_start_s": start, "final_depth": final_depth, "event_start_s": self.event_start,
+                "event_end_s": self.event_end, "event_depth": self.event_depth, "n_events": self.n_events}

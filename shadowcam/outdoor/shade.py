@@ -95,11 +95,12 @@ def remove_shade(cover, shade, edge_row, *, gap=4, rows=8):
     cover = np.array(cover, dtype=np.float32)
     shade = np.asarray(shade, dtype=np.float32)
     edge = np.asarray(edge_row, dtype=np.float64)
-    dimmed = (shade < 1) & np.isfinite(edge)
-    if not dimmed.any():
+    dimmed = np.flatnonzero((shade < 1) & np.isfinite(edge))
+    if not dimmed.size:
         return cover
-    top = np.floor(np.where(dimmed, edge, 0.0)).astype(np.int64) - int(gap) - int(rows)
+    top = np.maximum(np.floor(edge[dimmed]).astype(np.int64) - int(gap) - int(rows), 0)
     below = np.arange(cover.shape[0])[:, None] >= top[None, :]
-    scale = np.where(below & dimmed[None, :], shade[None, :], np.float32(1.0))
-    cover /= scale
+    block = cover[:, dimmed]  # only the dimmed columns: (H, n) temporaries
+    np.divide(block, shade[dimmed][None, :], out=block, where=below)
+    cover[:, dimmed] = block
     return cover
