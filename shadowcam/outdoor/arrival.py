@@ -7,21 +7,31 @@ Two estimators, combined:
   centre ``r + 0.5``, linear in time between the two frames whose edges
   straddle it. The sub-frame part comes from where the edge sits *spatially*
   (sub-pixel) in each frame.
-* **coverage crossing** (:class:`CoverageCrossing`, streamed frame by frame):
-  the first time the pixel's own lit fraction drops through 0.5, linear in
-  time between the two frames around it. It covers what a single edge per
-  column cannot represent (a second transition in a column, a sunlit tongue
-  that sweeps sideways, pixels relit and shadowed again).
+* **coverage crossing** (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`, streamed
+  frame by frame): the start of the pixel's final dark episode (its lit fraction
+  drops through 0.5 and never relights for good after), linear in time between
+  the two frames around it. It covers what a single edge per column cannot
+  represent (a second transition in a column, a sunlit tongue that sweeps
+  sideways) and is not fooled by a shadow that passes (a cloud).
 
-:func:`combine_arrivals` takes the edge crossing where the two agree within a
-tolerance and the coverage crossing elsewhere, and gives each pixel a reason.
+Earlier dark episodes of a pixel are resolved by :func:`resolve_episodes`: one
+whose start agrees with the ridge edge's crossing of the pixel is the ridge
+shadow's arrival, relit later by the geometry (a sunlit tongue through a
+saddle); the others are transient shadows (a cloud). A pixel whose episodes
+none of this explains gets no time but a reason. :func:`combine_arrivals` takes
+the edge crossing where it agrees with the coverage crossing within a tolerance
+and the coverage crossing elsewhere, and gives each pixel a reason; every
+episode of a pixel with more than one is listed as an event (:func:`event_table`).
 
 Offers
 ------
 ARRIVAL_REASONS : reason code -> name (CF flag meanings).
 arrival_from_edges : arrival time of every pixel from the per-frame edge rows.
-CoverageCrossing : streaming first downward 0.5-crossing of per-pixel coverage.
+EVENT_KINDS : event kind code -> name (CF flag meanings).
+resolve_episodes : which dark episode of each pixel is the ridge shadow's arrival.
 combine_arrivals : the final arrival map and its reasons.
+arrivals : arrival map, reasons and events from tracked edges and pixel episodes (arrays).
+event_table : the dark episodes of pixels with more than one, as a table.
 arrival_dataset : the arrival-time map over (row, col) with reasons.
 arrival_map : the arrival dataset of a capture from its photometry and edges datasets.
 """
@@ -39,8 +49,14 @@ ARRIVAL_REASONS = {
     2: "never_shadowed",
     3: "shadowed_at_start",
     4: "sky",
+    5: "relit_after_arrival",
+    6: "ambiguous_history",
 }
 REASON_CODE = {name: code for code, name in ARRIVAL_REASONS.items()}
+#: event kind code -> meaning: the ridge shadow's arrival (end = relit time, NaN if it lasts),
+#: the ridge shadow again after the pixel was relit, a transient (passing) shadow, an
+#: episode of a pixel whose history is ambiguous
+EVENT_KINDS = {0: "arrival", 1: "shadowed_again", 2: "transient", 3: "ambiguous"}
 
 
 def arrival_from_edges(edge_row, time_s, *, eligible):
@@ -81,72 +97,81 @@ def arrival_from_edges(edge_row, time_s, *, eligible):
     return arrival
 
 
-class CoverageCrossing:
-    """Streaming first downward crossing of coverage 0.5 per pixel.
+def _at_the_edge(starts, edge_row, time_s, *, tolerance_rows):
+    """Whether the tracked edge of the pixel's column is within `tolerance_rows` of its centre
+    in the first frame at or after each start (one episode slot at a time)."""
+    height, width = starts.shape[:2]
+    edge = np.asarray(edge_row, dtype=np.float32)
+    times = np.asarray(time_s, dtype=np.float64)
+    centre = np.arange(height, dtype=np.float32)[:, None] + np.float32(0.5)
+    col = np.arange(width, dtype=np.int32)[None, :]
+    near = np.zeros(starts.shape, dtype=bool)
+    for slot in range(starts.shape[-1]):
+        start = starts[..., slot]
+        known = np.isfinite(start)
+        k = np.searchsorted(times, np.where(known, start, times[0])).astype(np.int32)
+        np.minimum(k, times.size - 1, out=k)
+        with np.errstate(invalid="ignore"):
+            near[..., slot] = known & (np.abs(edge[k, col] - centre) <= tolerance_rows)
+    return near
+
+
+def resolve_episodes(final_s, event_start_s, edge_s, *, tolerance_s, edge_row=None, time_s=None, tolerance_rows=1.0):
+    """Which dark episode of each pixel is the ridge shadow's arrival.
 
     Parameters
     ----------
-    shape : tuple of int
-        ``(H, W)``.
-    eligible : (H, W) bool ndarray
-        Pixels that may receive an arrival.
-    level : float, optional
-        The coverage level whose crossing is the arrival (0.5 = half the
-        footprint shadowed).
-    confirm : bool, optional
-        A crossing counts only if the next frame is still below `level`
-        (a cloud or a noisy frame darkening a pixel for one frame is not an
-        arrival); a crossing in the last interval is kept.
+    final_s : (H, W) ndarray
+        Start of the final dark episode (NaN: none).
+    event_start_s : (H, W, E) ndarray
+        Starts of the earlier (relit) dark episodes, in time order (NaN: none).
+    edge_s : (H, W) ndarray
+        When the tracked ridge edge crossed the pixel centre (NaN: never).
+    tolerance_s : float
+        An episode is the ridge shadow's when its start is within this many seconds of `edge_s`, ...
+    edge_row : (T, W) ndarray, optional
+        ... or when the tracked edge of its column (pixel-edge rows) is within
+        `tolerance_rows` of the pixel's centre in the first frame at or after its start
+        (the edge passes the pixel as it darkens: a relit tongue along the edge, not a
+        cloud drifting over the lit cliff).
+    time_s : (T,) ndarray, optional
+        Frame times of `edge_row`.
+    tolerance_rows : float, optional
 
-    Notes
-    -----
-    State is a few ``(H, W)`` arrays (previous coverage, pending and final
-    arrival), so memory does not depend on the number of frames. Feed frames
-    in time order with :meth:`update`; read :attr:`arrival_s`.
+    Returns
+    -------
+    coverage_s : (H, W) float64 ndarray
+        The start of the first earlier episode that agrees with the edge crossing (the
+        pixel was relit after the arrival), else the start of the final episode; NaN for
+        ambiguous pixels.
+    chosen : (H, W) int ndarray
+        Slot of the earlier episode that is the arrival (the pixel was relit after it);
+        ``E`` where the arrival is the final episode.
+    ambiguous : (H, W) bool ndarray
+        Pixels with earlier episodes where the edge crossed the pixel at a time that none
+        of its episodes, final or earlier, agrees with: the edge or the episodes are wrong
+        there, and no time is given.
     """
-
-    def __init__(self, shape, *, eligible, level=0.5, confirm=True):
-        self.eligible = np.asarray(eligible, dtype=bool)
-        if self.eligible.shape != tuple(shape):
-            raise ValueError(f"eligible {self.eligible.shape} must have shape {tuple(shape)}")
-        self.level = float(level)
-        self.confirm = bool(confirm)
-        self._arrival = np.full(tuple(shape), np.nan)
-        self._pending = np.full(tuple(shape), np.nan)
-        self._previous = None
-        self._time = None
-
-    @property
-    def arrival_s(self):
-        """(H, W) float64 ndarray: arrival seconds so far (NaN = none)."""
-        return np.where(np.isnan(self._arrival), self._pending, self._arrival)
-
-    def update(self, cover, time_s):
-        """Add the coverage ``(H, W)`` of the next frame, taken at `time_s` seconds."""
-        cover = np.asarray(cover)
-        if cover.shape != self._arrival.shape:
-            raise ValueError(f"cover {cover.shape} must have shape {self._arrival.shape}")
-        if self._previous is not None:
-            if time_s <= self._time:
-                raise ValueError(f"time_s must increase: got {time_s} after {self._time}")
-            with np.errstate(invalid="ignore"):
-                below = cover < self.level
-                pending = np.isfinite(self._pending)
-                confirmed = pending & below
-                self._arrival[confirmed] = self._pending[confirmed]
-                self._pending[pending] = np.nan
-                cross = (self._previous >= self.level) & below & self.eligible & np.isnan(self._arrival)
-            # interpolate (float64) only where a crossing happened: few pixels per frame
-            prev = self._previous[cross].astype(np.float64)
-            curr = cover[cross].astype(np.float64)
-            frac = (prev - self.level) / np.where(prev > curr, prev - curr, 1.0)
-            value = self._time + np.clip(frac, 0.0, 1.0) * (time_s - self._time)
-            (self._pending if self.confirm else self._arrival)[cross] = value
-        self._previous = cover.copy()
-        self._time = float(time_s)
+    final = np.asarray(final_s, dtype=np.float64)
+    starts = np.asarray(event_start_s)
+    edge = np.asarray(edge_s, dtype=np.float64)
+    check_same_shape({"final_s": final, "edge_s": edge, "event_start_s[..., 0]": starts[..., 0]})
+    with np.errstate(invalid="ignore"):
+        agree = np.abs(starts - edge[..., None]) <= tolerance_s
+        final_agrees = np.abs(final - edge) <= tolerance_s
+    if edge_row is not None:
+        agree |= _at_the_edge(starts, edge_row, time_s, tolerance_rows=tolerance_rows)
+    relit = agree.any(axis=-1)
+    chosen = np.where(relit, np.argmax(agree, axis=-1), starts.shape[-1])
+    first = np.take_along_axis(starts, np.minimum(chosen, starts.shape[-1] - 1)[..., None], axis=-1)[..., 0]
+    earlier = np.isfinite(starts).any(axis=-1)
+    ambiguous = earlier & np.isfinite(edge) & ~relit & ~final_agrees
+    coverage = np.where(relit, first, final)
+    coverage[ambiguous] = np.nan
+    return coverage, chosen, ambiguous
 
 
-def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start):
+def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start, relit=None, ambiguous=None):
     """Final arrival map and per-pixel reason.
 
     Parameters
@@ -157,6 +182,9 @@ def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start):
         The edge crossing is kept where the two agree within this many seconds
         (or where only it exists); elsewhere the coverage crossing is used.
     sky, lit_at_start : (H, W) bool ndarray
+    relit, ambiguous : (H, W) bool ndarray, optional
+        :func:`resolve_episodes` results: reasons ``relit_after_arrival`` and
+        ``ambiguous_history`` (no time).
 
     Returns
     -------
@@ -173,22 +201,83 @@ def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start):
     arrival = np.where(use_edge, edge_s, coverage_s)
     reason = np.full(edge_s.shape, REASON_CODE["coverage_crossing"], dtype=np.uint8)
     reason[use_edge] = REASON_CODE["edge_crossing"]
+    if relit is not None:
+        reason[np.asarray(relit, dtype=bool) & np.isfinite(arrival)] = REASON_CODE["relit_after_arrival"]
     reason[np.isnan(arrival)] = REASON_CODE["never_shadowed"]
+    if ambiguous is not None:
+        ambiguous = np.asarray(ambiguous, dtype=bool)
+        arrival[ambiguous] = np.nan
+        reason[ambiguous] = REASON_CODE["ambiguous_history"]
     reason[~np.asarray(lit_at_start, dtype=bool)] = REASON_CODE["shadowed_at_start"]
     sky = np.asarray(sky, dtype=bool)
     reason[sky] = REASON_CODE["sky"]
     arrival[sky | ~np.asarray(lit_at_start, dtype=bool)] = np.nan
     return arrival, reason
 
-def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverage_arrival_s, interval_s):
+def event_table(final_s, final_depth, event_start_s, event_end_s, event_depth, *, chosen, ambiguous, eligible):
+    """The dark episodes of every pixel that had more than one, with their kind.
+
+    Parameters
+    ----------
+    final_s, final_depth : (H, W) ndarray
+        Start and depth of the final dark episode (NaN: none).
+    event_start_s, event_end_s, event_depth : (H, W, E) ndarray
+        The earlier (relit) episodes in time order (NaN: none).
+    chosen, ambiguous : (H, W) ndarray
+        :func:`resolve_episodes` results.
+    eligible : (H, W) bool ndarray
+        Pixels that may have an arrival (lit at start, not sky).
+
+    Returns
+    -------
+    dict of (N,) ndarray
+        ``row``, ``col``, ``start_s``, ``end_s`` (NaN: lasts to the last frame),
+        ``depth`` (1 - the mean lit fraction) and ``kind`` (codes of :data:`EVENT_KINDS`),
+        pixel by pixel in time order.
+    """
+    starts = np.asarray(event_start_s)
+    # only the pixels with an earlier episode: (N, E) arrays
+    pixel = np.isfinite(starts).any(axis=-1) & np.asarray(eligible, dtype=bool)
+    row, col = np.nonzero(pixel)
+    starts = starts[pixel].astype(np.float64)
+    ends = np.asarray(event_end_s)[pixel].astype(np.float64)
+    depths = np.asarray(event_depth)[pixel].astype(np.float32)
+    final = np.asarray(final_s, dtype=np.float64)[pixel]
+    chosen = np.asarray(chosen)[pixel]
+    ambiguous = np.asarray(ambiguous, dtype=bool)[pixel]
+    relit = chosen < starts.shape[-1]
+    slot = np.arange(starts.shape[-1])
+    kind = np.where(slot < chosen[:, None], 2, np.where(slot == chosen[:, None], 0, 1))
+    final_kind = np.where(relit, 1, 0)
+    kind = np.where(ambiguous[:, None], 3, kind)
+    final_kind = np.where(ambiguous, 3, final_kind)
+    # all episodes of those pixels, the final one last
+    start = np.concatenate([starts, final[:, None]], axis=-1)
+    end = np.concatenate([ends, np.full((final.size, 1), np.nan)], axis=-1)
+    depth = np.concatenate([depths, np.asarray(final_depth, dtype=np.float32)[pixel][:, None]], axis=-1)
+    kinds = np.concatenate([kind, final_kind[:, None]], axis=-1).astype(np.uint8)
+    listed = np.isfinite(start)
+    index = np.broadcast_to(np.arange(final.size)[:, None], listed.shape)[listed]
+    return {"row": row[index].astype(np.int32), "col": col[index].astype(np.int32), "start_s": start[listed],
+            "end_s": end[listed], "depth": depth[listed], "kind": kinds[listed]}
+
+
+def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverage_arrival_s, interval_s,
+                    events=None):
     """Assemble the arrival map.
+
+    Parameters
+    ----------
+    events : dict, optional
+        :func:`event_table`.
 
     Returns
     -------
     xarray.Dataset
         ``arrival_time_s``, ``arrival_frame``, ``reason`` (CF flags),
-        ``edge_arrival_s``, ``coverage_arrival_s`` over ``(row, col)``;
-        attr ``median_interval_s``.
+        ``edge_arrival_s``, ``coverage_arrival_s`` over ``(row, col)``; with `events`,
+        ``event_row``, ``event_col``, ``event_start_s``, ``event_end_s``, ``event_depth``,
+        ``event_kind`` (CF flags) over ``event``; attr ``median_interval_s``.
     """
     cam = ("row", "col")
     codes = sorted(ARRIVAL_REASONS)
@@ -201,9 +290,63 @@ def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverag
         "edge_arrival_s": (cam, np.asarray(edge_arrival_s), {"units": "s", "long_name": "arrival from the tracked edge crossing the pixel centre"}),
         "coverage_arrival_s": (cam, np.asarray(coverage_arrival_s), {"units": "s", "long_name": "arrival from the pixel's lit fraction crossing 0.5"}),
     }
+    if events is not None:
+        kinds = sorted(EVENT_KINDS)
+        data.update({
+            "event_row": ("event", events["row"], {"long_name": "row of the pixel of a dark episode"}),
+            "event_col": ("event", events["col"], {"long_name": "column of the pixel of a dark episode"}),
+            "event_start_s": ("event", events["start_s"], {"units": "s", "long_name": "start of the dark episode"}),
+            "event_end_s": ("event", events["end_s"], {"units": "s", "long_name": "end (relighting); NaN: lasts to the last frame"}),
+            "event_depth": ("event", events["depth"], {"units": "1", "long_name": "1 - mean lit fraction during the episode"}),
+            "event_kind": ("event", events["kind"], {
+                "long_name": "what the episode is", "flag_values": np.array(kinds, np.uint8),
+                "flag_meanings": " ".join(EVENT_KINDS[c] for c in kinds)}),
+        })
     dataset = xr.Dataset(data)
     dataset.attrs["median_interval_s"] = float(interval_s)
     return dataset
+
+
+#: the tracker's per-pixel results the arrival step reads (the episodes are optional)
+EPISODE_KEYS = ("coverage_arrival_s", "final_depth", "event_start_s", "event_end_s", "event_depth")
+
+
+def arrivals(edge_row, time_s, pixels, *, sky, lit_at_start, tolerance_s):
+    """Arrival map of tracked edges and pixel episodes (the arrays behind :func:`arrival_map`).
+
+    Parameters
+    ----------
+    edge_row : (T, W) ndarray
+        Edge rows after keyframe interpolation.
+    time_s : (T,) ndarray
+    pixels : mapping
+        ``coverage_arrival_s (H, W)`` and, optionally, ``final_depth``, ``event_start_s``,
+        ``event_end_s``, ``event_depth`` (:func:`shadowcam.outdoor.tracking.track_frames`).
+    sky, lit_at_start : (H, W) bool ndarray
+    tolerance_s : float
+        Agreement of the edge crossing with an episode's start.
+
+    Returns
+    -------
+    dict
+        ``arrival_s``, ``reason``, ``edge_s``, ``coverage_s`` (the resolved coverage
+        crossing) ``(H, W)`` and ``events`` (:func:`event_table`, None without episodes).
+    """
+    sky = np.asarray(sky, dtype=bool)
+    lit = np.asarray(lit_at_start, dtype=bool)
+    edge_s = arrival_from_edges(edge_row, time_s, eligible=lit & ~sky)
+    final_s = np.asarray(pixels["coverage_arrival_s"], dtype=np.float64)
+    coverage_s, relit, ambiguous, events = final_s, None, None, None
+    if "event_start_s" in pixels:
+        episodes = [np.asarray(pixels[name]) for name in ("event_start_s", "event_end_s", "event_depth")]
+        coverage_s, chosen, ambiguous = resolve_episodes(final_s, episodes[0], edge_s, tolerance_s=tolerance_s,
+                                                         edge_row=edge_row, time_s=time_s)
+        relit = chosen < episodes[0].shape[-1]
+        events = event_table(final_s, pixels["final_depth"], *episodes, chosen=chosen, ambiguous=ambiguous,
+                             eligible=lit & ~sky)
+    arrival, reason = combine_arrivals(edge_s, coverage_s, sky=sky, lit_at_start=lit, tolerance_s=tolerance_s,
+                                       relit=relit, ambiguous=ambiguous)
+    return {"arrival_s": arrival, "reason": reason, "edge_s": edge_s, "coverage_s": coverage_s, "events": events}
 
 
 def arrival_map(photometry, edges, *, tolerance_intervals=1.5):
@@ -214,7 +357,9 @@ def arrival_map(photometry, edges, *, tolerance_intervals=1.5):
     photometry : xarray.Dataset
         First-pass result: ``sky`` and ``lit_at_start`` over ``(row, col)``.
     edges : xarray.Dataset
-        Tracked edges: ``edge_row (time, col)``, ``coverage_arrival_s (row, col)``, coord ``time_s``.
+        Tracked edges: ``edge_row (time, col)``, ``coverage_arrival_s (row, col)``, coord ``time_s``;
+        with the earlier dark episodes (``final_depth``, ``event_start_s``, ``event_end_s``,
+        ``event_depth``) they are resolved (:func:`resolve_episodes`) and listed as events.
     tolerance_intervals : float, keyword-only
         Largest disagreement between the edge and coverage crossings, in median
         capture intervals, for the edge crossing to be kept.
@@ -229,9 +374,9 @@ def arrival_map(photometry, edges, *, tolerance_intervals=1.5):
     interval = median_interval(time_s)
     sky = photometry["sky"].values.astype(bool)
     lit = photometry["lit_at_start"].values.astype(bool)
-    edge_s = arrival_from_edges(edges["edge_row"].values, time_s, eligible=lit & ~sky)
-    coverage_s = edges["coverage_arrival_s"].values
-    arrival, reason = combine_arrivals(edge_s, coverage_s, sky=sky, lit_at_start=lit,
-                                       tolerance_s=tolerance_intervals * interval)
-    return arrival_dataset(arrival, time_to_frame(arrival, time_s, outside="clamp"), reason,
-                           edge_arrival_s=edge_s, coverage_arrival_s=coverage_s, interval_s=interval)
+    pixels = {name: edges[name].values for name in EPISODE_KEYS if name in edges}
+    result = arrivals(edges["edge_row"].values, time_s, pixels, sky=sky, lit_at_start=lit,
+                      tolerance_s=tolerance_intervals * interval)
+    return arrival_dataset(result["arrival_s"], time_to_frame(result["arrival_s"], time_s, outside="clamp"),
+                           result["reason"], edge_arrival_s=result["edge_s"], coverage_arrival_s=result["coverage_s"],
+                           interval_s=interval, events=result["events"])

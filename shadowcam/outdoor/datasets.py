@@ -150,7 +150,9 @@ def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpo
     xarray.Dataset
         ``edge_row``, ``edge_row_measured``, ``confidence``, ``n_transitions``,
         ``interpolated`` over ``(time, col)``; ``is_keyframe``, ``band_fraction``
-        over ``time``; ``coverage_arrival_s`` over ``(row, col)``.
+        over ``time``; ``coverage_arrival_s``, ``n_events`` over ``(row, col)`` and
+        ``event_start_s``, ``event_end_s``, ``event_depth`` over ``(row, col, event_slot)``
+        (the earlier dark episodes, when `tracked` has them).
     """
     tc = ("time", "col")
     rows = "pixel-edge coordinates: row r spans [r, r+1], centre r+0.5; lit above"
@@ -164,8 +166,18 @@ def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpo
         "is_keyframe": ("time", np.asarray(is_keyframe, bool), {"long_name": "frame whose edge is reliable"}),
         "band_fraction": ("time", tracked["band_fraction"], {"units": "1", "long_name": "share of valid pixels in the frame-differencing band"}),
         "coverage_arrival_s": (("row", "col"), tracked["coverage_arrival_s"],
-                               {"units": "s", "long_name": "first time the pixel's lit fraction drops below 0.5"}),
+                               {"units": "s", "long_name": "start of the pixel's final dark episode "
+                                "(lit fraction below 0.5, never relit after)"}),
     }
+    if "n_events" in tracked:
+        slot = ("row", "col", "event_slot")
+        data.update({
+            "final_depth": (("row", "col"), tracked["final_depth"], {"units": "1", "long_name": "1 - mean lit fraction during the final dark episode"}),
+            "n_events": (("row", "col"), tracked["n_events"], {"long_name": "dark episodes before the final one (relit after)"}),
+            "event_start_s": (slot, tracked["event_start_s"], {"units": "s", "long_name": "start of an earlier dark episode"}),
+            "event_end_s": (slot, tracked["event_end_s"], {"units": "s", "long_name": "end (relighting) of an earlier dark episode"}),
+            "event_depth": (slot, tracked["event_depth"], {"units": "1", "long_name": "1 - mean lit fraction during the episode"}),
+        })
     return xr.Dataset(data, coords=_frame_coords(time_s, photometry))
 
 

@@ -34,8 +34,11 @@ def column_edges(cover, *, valid, band=None, previous=None, half_window=3, max_s
         Pixels that can hold the edge (not sky).
     band : (H, W) bool ndarray, optional
         Frame-differencing band (:func:`shadowcam.outdoor.frame_difference.difference_band`);
-        transitions inside the band or within `max_step` rows of `previous`
-        are preferred; other transitions are used only if there is none.
+        transitions inside the band are preferred (the shadow edge moves; a
+        static lit-above / shadowed-below pair, e.g. a pixel shadowed from the
+        start but bright enough to be taken for lit, does not); without one,
+        transitions within `max_step` rows of `previous`; other transitions
+        are used only if there is neither.
     previous : (W,) ndarray, optional
         Edge rows of the previous frame (NaN where none).
     half_window : int, optional
@@ -68,17 +71,22 @@ def column_edges(cover, *, valid, band=None, previous=None, half_window=3, max_s
     lit = (clipped >= 0.5) & usable
     pairs = lit[:-1] & ~lit[1:] & usable[1:]
     n_transitions = pairs.sum(axis=0).astype(np.int16)
-    preferred = np.zeros_like(pairs)
+    # the shadow edge moves: transitions in the frame-differencing band come first, then those
+    # near the column's previous edge (a frame where the edge barely moved), then any
+    in_band = np.zeros_like(pairs)
     if band is not None:
         band = np.asarray(band, dtype=bool)
-        preferred |= pairs & (band[:-1] | band[1:])
+        in_band = pairs & (band[:-1] | band[1:])
+    near = np.zeros_like(pairs)
     if previous is not None:
         prev = np.asarray(previous, dtype=np.float64)
         boundary = np.arange(1, height, dtype=np.int32)[:, None]
         # |boundary - prev| <= max_step for integer boundaries, without an (H, W) float temporary
         with np.errstate(invalid="ignore"):
             low, high = np.ceil(prev - max_step)[None, :], np.floor(prev + max_step)[None, :]
-            preferred |= pairs & (boundary >= low) & (boundary <= high)
+            near = pairs & (boundary >= low) & (boundary <= high)
+    use_band = in_band.any(axis=0)
+    preferred = np.where(use_band[None, :], in_band, near)
     use_preferred = preferred.any(axis=0)
     chosen = np.where(use_preferred[None, :], preferred, pairs)
     has = chosen.any(axis=0)

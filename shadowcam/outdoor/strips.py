@@ -42,14 +42,14 @@ import math
 import numpy as np
 
 from shadowcam._shared.atomic import atomic_path
-from shadowcam.outdoor.tracking import EdgeTracker
+from shadowcam.outdoor.tracking import PIXEL_KEYS, EdgeTracker
 
 #: extra halo columns against the band errors creeping in from the window's cut
 GUARD_COLUMNS = 8
 #: per-frame (time, col) results of the pass
 COLUMN_KEYS = ("edge_row", "confidence", "n_transitions")
 #: arrays of a strip file (:func:`save_strip`)
-STRIP_KEYS = ("cols", "kept", "width", "edge_row", "confidence", "n_transitions", "coverage_arrival_s",
+STRIP_KEYS = ("cols", "kept", "width", "edge_row", "confidence", "n_transitions", *PIXEL_KEYS,
               "band_count", "valid_count")
 
 
@@ -126,7 +126,7 @@ def track_strip(frames, photometry, time_s, *, cols, halo=None, **options):
     dict
         ``cols (c0, c1)``, ``kept (k0, k1)`` (the strip's columns plus one each side,
         clipped: the columns of the arrays), ``width``; ``edge_row``, ``confidence``,
-        ``n_transitions`` ``(T, k1 - k0)``; ``coverage_arrival_s (H, k1 - k0)``;
+        ``n_transitions`` ``(T, k1 - k0)``; :data:`~shadowcam.outdoor.tracking.PIXEL_KEYS` ``(H, k1 - k0, ...)``;
         ``band_count (T,)`` int64 and ``valid_count`` (band and valid pixels of the
         strip's own columns).
     """
@@ -146,7 +146,7 @@ def track_strip(frames, photometry, time_s, *, cols, halo=None, **options):
         tracker.update(frame)
     result = tracker.result()
     local = np.s_[:, kept[0] - a:kept[1] - a]
-    strip = {key: result[key][local] for key in (*COLUMN_KEYS, "coverage_arrival_s")}
+    strip = {key: result[key][local] for key in (*COLUMN_KEYS, *PIXEL_KEYS)}
     strip.update(cols=(int(c0), int(c1)), kept=kept, width=int(width), band_count=tracker.band_count,
                  valid_count=tracker.valid_count)
     return strip
@@ -170,7 +170,7 @@ def merge_strips(strips):
         As :func:`shadowcam.outdoor.tracking.track_frames`: ``edge_row``,
         ``confidence``, ``n_transitions`` ``(T, W)``, ``band_fraction (T,)``
         (float32 of the summed band count over the summed valid count, which is
-        how the single job's mean rounds), ``coverage_arrival_s (H, W)``.
+        how the single job's mean rounds), :data:`~shadowcam.outdoor.tracking.PIXEL_KEYS` ``(H, W, ...)``.
 
     Raises
     ------
@@ -188,7 +188,7 @@ def merge_strips(strips):
         raise ValueError(f"strips must tile columns [0, {width}) without gaps or overlap; got {list(zip(starts, stops))}")
     for left, right in zip(strips[:-1], strips[1:]):
         boundary = left["cols"][1]
-        for key in (*COLUMN_KEYS, "coverage_arrival_s"):
+        for key in (*COLUMN_KEYS, *PIXEL_KEYS):
             mine = left[key][:, boundary - 1 - left["kept"][0]:boundary + 1 - left["kept"][0]]
             theirs = right[key][:, boundary - 1 - right["kept"][0]:boundary + 1 - right["kept"][0]]
             if not _same(mine, theirs):
@@ -197,12 +197,12 @@ def merge_strips(strips):
                     f"{boundary - 1}-{boundary}: the halo is too narrow for this sequence; raise it")
     merged = {key: np.concatenate([s[key][:, s["cols"][0] - s["kept"][0]:s["cols"][1] - s["kept"][0]]
                                    for s in strips], axis=1)
-              for key in (*COLUMN_KEYS, "coverage_arrival_s")}
+              for key in (*COLUMN_KEYS, *PIXEL_KEYS)}
     band = np.sum([s["band_count"] for s in strips], axis=0).astype(np.float64)
     valid = float(sum(s["valid_count"] for s in strips))
     merged["band_fraction"] = (band / valid if valid else np.zeros_like(band)).astype(np.float32)
     return {key: merged[key] for key in ("edge_row", "confidence", "n_transitions", "band_fraction",
-                                         "coverage_arrival_s")}
+                                         *PIXEL_KEYS)}
 
 
 def save_strip(strip, path):

@@ -2,17 +2,20 @@
 
 With the shifts, gains and per-pixel levels of the first pass
 (:mod:`shadowcam.outdoor.normalise`), each frame becomes a coverage image
-(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`); frame differencing
-against the previous coverage gives the band where the edge moved
-(:mod:`shadowcam.outdoor.frame_difference`); the edge of every column is located with
-sub-pixel precision (:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions
-in the band or near the column's most recent edge (tracking) and the per-pixel
-coverage crossing is accumulated (:class:`shadowcam.outdoor.arrival.CoverageCrossing`).
-The lit level of each pixel follows slow shading changes (the sun moves) while
-the pixel is fully lit and well above the edge. Memory is a few ``(H, W)``
-arrays plus the ``(T, W)`` edges.
+(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`), from which a passing
+cloud's shade, measured just above each column's last edge, is divided out
+(:mod:`shadowcam.outdoor.shade`); frame differencing against the previous coverage
+gives the band where the edge moved (:mod:`shadowcam.outdoor.frame_difference`); the
+edge of every column is located with sub-pixel precision
+(:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions in the band, then near
+the column's most recent edge (tracking), and the dark episodes of every pixel are
+accumulated (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`). The lit level of each
+pixel follows slow shading changes (the sun moves) while the pixel is fully lit and well
+above the edge. Memory is a few ``(H, W)`` arrays, ``E`` episode slots per pixel and the
+``(T, W)`` edges.
 
-Every step but the frame differencing's widening (``margin`` columns) and the
+Every step but the frame differencing's widening (``margin`` columns), the episodes'
+neighbour count (one pixel each side) and the
 registration shift (:func:`shadowcam.outdoor.translation.translate`, ``"cubic_Keys1981"``,
 whose bits do not depend on where the frame is cut) works column by column,
 so column strips of the frames can be tracked as separate jobs and merged
@@ -20,17 +23,23 @@ exactly (:mod:`shadowcam.outdoor.strips`).
 
 Offers
 ------
+PIXEL_KEYS : the per-pixel ``(row, col, ...)`` results.
 EdgeTracker : the streaming pass; :meth:`update` per frame, :meth:`result`.
 track_frames : run it over an iterable of frames.
 """
 
 import numpy as np
 
-from shadowcam.outdoor.arrival import CoverageCrossing
 from shadowcam.outdoor.edge_tracking import column_edges
+from shadowcam.outdoor.episodes import ShadowEpisodes
 from shadowcam.outdoor.frame_difference import difference_band
 from shadowcam.outdoor.photometric import coverage, luminance
+from shadowcam.outdoor.shade import remove_shade, shade_above_edge
 from shadowcam.outdoor.translation import translate
+
+
+#: per-pixel (row, col, ...) results of the pass
+PIXEL_KEYS = ("coverage_arrival_s", "final_depth", "event_start_s", "event_end_s", "event_depth", "n_events")
 
 
 class EdgeTracker:
@@ -92,7 +101,7 @@ class EdgeTracker:
         self._counted = np.s_[:, c0:c1]
         self.band_count = np.zeros(n_frames, dtype=np.int64)
         self.valid_count = int(self.valid[self._counted].sum())
-        self.crossing = CoverageCrossing((height, width), eligible=self.lit_at_start & self.valid)
+        self.episodes = ShadowEpisodes((height, width), eligible=self.lit_at_start & self.valid)
         self._previous = None
         self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
         self._k = 0
@@ -106,6 +115,9 @@ class EdgeTracker:
         luma = translate(luminance(frame), self.shift[k], method="cubic_Keys1981") / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
+        if k:  # a passing cloud's shade at the edge (measured above the last edge found)
+            shade = shade_above_edge(cover, self._last_edge, valid=self.lit_at_start & self.valid)
+            cover = remove_shade(cover, shade, self._last_edge)
         band = None
         if self._previous is not None:
             band = difference_band(self._previous, cover, valid=self.valid, **self.band_options)
@@ -115,7 +127,7 @@ class EdgeTracker:
             cover, valid=self.valid, band=band, previous=self._last_edge if k else None, **self.options)
         found = np.isfinite(self.edge_row[k])
         self._last_edge[found] = self.edge_row[k][found]
-        self.crossing.update(cover, self.time_s[k])
+        self.episodes.update(cover, self.time_s[k])
         if self.lit_update > 0:
             with np.errstate(invalid="ignore"):
                 far = ~(self._centre > self.edge_row[k][None, :] - self.update_distance)
@@ -134,7 +146,8 @@ class EdgeTracker:
             "confidence": self.confidence,
             "n_transitions": self.n_transitions,
             "band_fraction": self.band_fraction,
-            "coverage_arrival_s": self.crossing.arrival_s,
+            **{"coverage_arrival_s" if key == "final_start_s" else key: value
+               for key, value in self.episodes.result().items()},
         }
 
 
@@ -156,7 +169,9 @@ def track_frames(frames, photometry, time_s, **options):
     dict
         ``edge_row (T, W)`` (pixel-edge rows, NaN = none), ``confidence (T, W)``,
         ``n_transitions (T, W)``, ``band_fraction (T,)`` (share of valid pixels in
-        the frame-differencing band) and ``coverage_arrival_s (H, W)``.
+        the frame-differencing band), ``coverage_arrival_s (H, W)`` (start of the final dark
+        episode) and the earlier episodes: ``event_start_s``, ``event_end_s``, ``event_depth``
+        ``(H, W, E)``, ``n_events (H, W)`` (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`).
     """
     tracker = EdgeTracker(photometry, time_s, **options)
     for frame in frames:

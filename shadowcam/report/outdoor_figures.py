@@ -12,6 +12,7 @@ keyframes_figure : frames with their tracked edge overlaid.
 edge_over_time_figure : edge rows of every column over time (time x col image) and sample curves.
 arrival_map_figure : the arrival-time map in minutes, sky masked.
 pushbroom_figure : the ridge pushbroom beside the real view.
+transient_events_figure : where transient (passing) shadows were seen, how often and when.
 """
 
 import numpy as np
@@ -223,5 +224,51 @@ def pushbroom_figure(view, pushbroom, time_s, *, sky, size=(11.0, 4.5)):
     axes.set_title("ridge pushbroom (colour along the edge)")
     axes.set_xlabel("col")
     axes.set_ylabel("time (min)")
+    figure.tight_layout()
+    return figure
+
+
+def transient_events_figure(event_row, event_col, event_start_s, transient, *, sky, size=(11.0, 4.5)):
+    """Transient shadows (a passing cloud): episodes per pixel and when the first one began.
+
+    Parameters
+    ----------
+    event_row, event_col, event_start_s : (N,) ndarray
+        The event table of the arrival dataset (``event_row``, ``event_col``, ``event_start_s``).
+    transient : (N,) bool ndarray
+        Events to show (``event_kind`` is ``transient``).
+    sky : (H, W) bool ndarray
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    sky = np.asarray(sky, dtype=bool)
+    check_array(sky, "sky", ndim=2)
+    rows, cols = np.asarray(event_row, dtype=np.int64), np.asarray(event_col, dtype=np.int64)
+    start = np.asarray(event_start_s, dtype=np.float64)
+    keep = np.asarray(transient, dtype=bool)
+    if not rows.shape == cols.shape == start.shape == keep.shape:
+        raise ValueError(f"event_row {rows.shape}, event_col {cols.shape}, event_start_s {start.shape} and "
+                         f"transient {keep.shape} must be the same (N,) shape")
+    count = np.zeros(sky.shape)
+    np.add.at(count, (rows[keep], cols[keep]), 1)
+    first = np.full(sky.shape, np.inf)
+    np.minimum.at(first, (rows[keep], cols[keep]), start[keep] / 60.0)
+    count[sky] = np.nan
+    first[~np.isfinite(first) | sky] = np.nan
+    figure = _new_figure(size)
+    step = display_step(sky.shape)
+    for index, (image, title, label, cmap) in enumerate((
+            (count, "transient shadows per pixel", "episodes", "magma"),
+            (first, "start of the first transient shadow", "time (min)", "viridis"))):
+        axes = figure.add_subplot(1, 2, index + 1)
+        shown = axes.imshow(np.ma.masked_invalid(image[::step, ::step]),
+                            cmap=colormaps[cmap].with_extremes(bad=NAN_GREY), interpolation="nearest",
+                            origin="upper", extent=_extent(image[::step, ::step].shape, step))
+        axes.set_title(title)
+        axes.set_xlabel("col")
+        axes.set_ylabel("row")
+        figure.colorbar(shown, ax=axes, label=label)
     figure.tight_layout()
     return figure

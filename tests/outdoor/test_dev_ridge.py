@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from shadowcam.outdoor.arrival import arrival_from_edges, combine_arrivals
+from shadowcam.outdoor.arrival import arrivals
 from shadowcam.io.decode import iter_frames
 from shadowcam.io.ground_truth import load_ground_truth
 from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
@@ -39,9 +39,8 @@ def run(shared_data):  # the repository manifest reads the shared dev data
     key = select_keyframes(tracked["confidence"], tracked["edge_row"])
     edges, _ = interpolate_edges(tracked["edge_row"], tracked["confidence"], time_s, is_keyframe=key)
     interval = float(np.median(np.diff(time_s)))
-    edge_s = arrival_from_edges(edges, time_s, eligible=photometry["lit_at_start"] & ~photometry["sky"])
-    arrival, _ = combine_arrivals(edge_s, tracked["coverage_arrival_s"], tolerance_s=1.5 * interval,
-                                  sky=photometry["sky"], lit_at_start=photometry["lit_at_start"])
+    arrival = arrivals(edges, time_s, tracked, sky=photometry["sky"], lit_at_start=photometry["lit_at_start"],
+                       tolerance_s=1.5 * interval)["arrival_s"]
     baseline = NaiveBaseline(arrival.shape)
     for frame, t in zip(frames(), time_s):
         baseline.update(frame, t)

@@ -66,3 +66,17 @@ def test_band_and_previous_edge_are_preferred_and_noisy_steps_score_lower():
     noisy = np.clip(cover + rng.normal(0, 0.2, cover.shape), 0, 1)
     _, low, _ = column_edges(noisy, valid=np.ones_like(cover, bool), previous=np.array([20.0, 20.0]))
     assert (low < confidence).all()
+
+
+def test_moving_edge_in_the_band_wins_over_a_static_transition_near_the_previous_edge():
+    # a pixel shadowed from the start but taken for lit sits over a shadowed one near the bottom:
+    # a lit-above / shadowed-below pair that never moves. The column's previous edge was put
+    # there (frame 0 has no band); the shadow edge, moving in the band, must be found.
+    cover = np.ones((40, 1), np.float32)
+    cover[20:] = 0.0  # the ridge shadow's edge at row 20, moving (in the band)
+    cover[34] = 1.0  # the static pair: rows 34 (lit) / 35 (shadowed)
+    band = np.zeros_like(cover, bool)
+    band[18:22] = True
+    row, _, n = column_edges(cover, valid=np.ones_like(cover, bool), band=band, previous=np.array([35.0]))
+    assert n[0] == 2
+    assert row[0] == pytest.approx(20.0)

@@ -55,3 +55,13 @@ def test_cloud_shadow_is_a_soft_moving_blob():
     np.testing.assert_allclose(c, [0.5, 1 - 0.5 * np.exp(-0.5), 1.0], atol=1e-12)
     later = cloud_transmittance(pts, 250.0, start_xy=(0, 0), velocity_xy=(1.0, 0.0), depth=0.5)
     assert later[1] == pytest.approx(0.5)
+
+
+def test_a_cloud_with_a_rim_is_a_disk_with_a_hard_or_soft_border():
+    pts = np.array([[0.0, 0.0], [100.0, 0.0], [104.0, 0.0], [300.0, 0.0]])
+    hard = cloud_transmittance(pts, 0.0, start_xy=(0, 0), velocity_xy=(1.0, 0.0), sigma_m=100.0, depth=0.8, rim_m=2.0)
+    np.testing.assert_allclose(hard, [0.2, 0.6, 1 - 0.8 / (1 + np.exp(2.0)), 1.0], atol=1e-9)
+    soft = cloud_transmittance(pts, 0.0, start_xy=(0, 0), velocity_xy=(1.0, 0.0), sigma_m=100.0, depth=0.8, rim_m=40.0)
+    assert soft[2] < hard[2] and soft[0] > hard[0]  # the soft rim reaches further out and in
+    with pytest.raises(ValueError, match="rim_m"):
+        cloud_transmittance(pts, 0.0, start_xy=(0, 0), velocity_xy=(1.0, 0.0), rim_m=0.0)

@@ -28,6 +28,7 @@ from shadowcam._shared.progress import Progress
 from shadowcam.io.frame_times import time_to_frame
 from shadowcam.synthetic.outdoor import nuisance as nz
 from shadowcam.synthetic.outdoor import truth as gt
+from shadowcam.synthetic.outdoor.clouds import CLOUD_SCENARIOS, cloud_shadows
 from shadowcam.synthetic.outdoor.render import frame_radiance, sample_grid, sky_colour, trace_samples
 from shadowcam.synthetic.outdoor.sun import elevation_azimuth, sun_colour
 
@@ -36,9 +37,6 @@ log = logging.getLogger(__name__)
 #: nuisance switches and their defaults (all on)
 NUISANCES = {"auto_exposure": True, "shake_px": 1.0, "cloud": True, "irregular_timing": True,
              "dropped_frames": 2}
-#: the cloud shadow: depth (1 - minimum transmittance) and Gaussian radius on the ground (m)
-CLOUD_DEPTH = 0.5
-CLOUD_SIGMA_M = 150.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,16 +61,13 @@ class OutdoorCapture:
         return self.ground_truth["times_s"].values
 
 
-def _cloud_path(scene, seed):
-    """Seeded straight drift of the cloud shadow: from the valley over the cliff toward the
-    plateau (+a), across a band of the view (b), during the whole sequence."""
-    rng = np.random.default_rng([int(seed), 53])
-    a0, b0 = -700.0, rng.uniform(-700.0, 100.0)
-    va, vb = 1600.0 / scene.duration_s, rng.uniform(-0.05, 0.05)
-    start = scene.terrain.to_xy(a0, b0)
-    end = scene.terrain.to_xy(a0 + va * scene.duration_s, b0 + vb * scene.duration_s)
-    velocity = (np.asarray(end) - np.asarray(start)) / scene.duration_s
-    return np.asarray(start), velocity
+def _cloud_record(spec):
+    model = ("1 - depth exp(-|p_xy - c(t)|^2 / (2 sigma^2))" if spec["rim_m"] is None
+             else "1 - depth / (1 + exp((|p_xy - c(t)| - sigma) / rim))")
+    record = {"model": model, "depth": spec["depth"], "sigma_m": spec["sigma_m"],
+              "start_xy": np.asarray(spec["start_xy"]).tolist(),
+              "velocity_xy_m_per_s": np.asarray(spec["velocity_xy"]).tolist()}
+    return record if spec["rim_m"] is None else record | {"rim_m": spec["rim_m"]}
 
 
 def _pixel_mean(values, shape, s2):
@@ -92,7 +87,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
     seed : int, keyword-only
         Seed of the nuisances.
     **nuisances
-        Keys of :data:`NUISANCES`.
+        Keys of :data:`NUISANCES`. ``cloud``: False, True (the ``"drifting"`` cloud) or a
+        scenario of :data:`shadowcam.synthetic.outdoor.clouds.CLOUD_SCENARIOS`.
 
     Returns
     -------
@@ -104,6 +100,9 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
     if unknown:
         raise ValueError(f"nuisances: unknown switch(es) {sorted(unknown)}; known: {sorted(NUISANCES)}")
     opts = dict(NUISANCES, **nuisances)
+    cloud = opts["cloud"]
+    if not (isinstance(cloud, bool) or cloud in CLOUD_SCENARIOS):
+        raise ValueError(f"cloud: must be true, false or one of {list(CLOUD_SCENARIOS)}; got {cloud!r}")
     if int(supersample) < 1:
         raise ValueError(f"supersample must be >= 1; got {supersample}")
     rows, cols = scene.camera.height, scene.camera.width
@@ -129,17 +128,24 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
     sky_img = centres.sky.reshape(rows, cols)
 
     # frames
-    cloud_on = bool(opts["cloud"])
-    start_xy, velocity_xy = _cloud_path(scene, seed)
+    cloud_on = cloud is not False
+    seen = ~centres.sky
+    clouds = cloud_shadows("drifting" if cloud in (True, False) else cloud, terrain=scene.terrain,
+                           duration_s=scene.duration_s, points_xy=centres.position[seen, :2],
+                           arrival_s=t_centre[seen], times_s=times, seed=seed)
+    # without a cloud the record still holds where the drifting one would have been
+    cloud_attrs = {"enabled": cloud_on, **_cloud_record(clouds[0])}
+    if cloud not in (True, False):
+        cloud_attrs.update(scenario=cloud, clouds=[_cloud_record(spec) for spec in clouds])
+    if not cloud_on:
+        clouds = []
     hit = ~samples.sky
     radiance, clean, cloud_att = [], [], []
     progress = Progress(len(times), "outdoor render: frames")
     for k, t in enumerate(times):
         trans = np.ones(len(samples.sky))
-        if cloud_on:
-            trans[hit] = nz.cloud_transmittance(samples.position[hit, :2], t, start_xy=start_xy,
-                                                velocity_xy=velocity_xy, depth=CLOUD_DEPTH,
-                                                sigma_m=CLOUD_SIGMA_M)
+        for spec in clouds:
+            trans[hit] *= nz.cloud_transmittance(samples.position[hit, :2], t, **spec)
         L, L_clear = frame_radiance(samples, scene, t, shape=(rows, cols), supersample=s,
                                     lit=lit_sub[k], cloud=trans if cloud_on else None)
         radiance.append(L)
@@ -230,7 +236,9 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         "shake_dx_px": var(("time",), dx, "pixel", "camera shake: content moves by +dx (columns)"),
         "shake_dy_px": var(("time",), dy, "pixel", "camera shake: content moves by +dy (rows)"),
         "cloud_attenuation": var(trc, np.stack(cloud_att), "1", "mean cloud-shadow transmittance of the sun term over the pixel"),
-        "cloud_center_xy": var(("time", "xy"), start_xy + np.outer(times, velocity_xy), "m", "centre of the cloud shadow on the ground"),
+        "cloud_center_xy": var(("time", "xy"), np.asarray(cloud_attrs["start_xy"])
+                               + np.outer(times, cloud_attrs["velocity_xy_m_per_s"]), "m",
+                               "centre of the cloud shadow on the ground"),
         "pb_edge_y": var(tc, edge_y, "pixel", "shadow-edge row coordinate per column"),
         "pb_n_transitions": var(tc, n_trans, "1", "lit-above/shadowed-below pairs per column"),
         "pb_front": var(tcc, pb_front, "1", "ground-truth ridge pushbroom"),
@@ -252,10 +260,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         "hour_angle0_deg": scene.sun.hour_angle0_deg,
         "dropped_nominal_indices": json.dumps(dropped.tolist()),
         "nuisances": json.dumps(opts),
-        "cloud": json.dumps({"enabled": cloud_on, "model": "1 - depth exp(-|p_xy - c(t)|^2 / (2 sigma^2))",
-                             "depth": CLOUD_DEPTH, "sigma_m": CLOUD_SIGMA_M,
-                             "start_xy": start_xy.tolist(),
-                             "velocity_xy_m_per_s": velocity_xy.tolist()}),
+        "cloud": json.dumps(cloud_attrs),
         "class_counts": json.dumps({name: int((cls == c).sum()) for c, name in gt.SHADOW_CLASSES.items()}
                                    | {"relit_after_arrival": int(classes["relit_after_arrival"].sum()),
                                       "always_shadowed": int(classes["always_shadowed"].sum())}),

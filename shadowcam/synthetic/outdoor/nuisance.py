@@ -8,7 +8,8 @@ auto_exposure : auto-exposure gain per frame: 1/3-EV steps from centre-weighted 
 metered_level : the centre-weighted mean that auto-exposure meters.
 shake_offsets : per-frame camera shake (dx, dy) in pixels, AR(1) jitter plus gust jolts.
 apply_shake : move an image's content by a sub-pixel offset (cubic spline, edges replicated).
-cloud_transmittance : sun-term transmittance of a soft cloud shadow drifting over the ground.
+cloud_transmittance : sun-term transmittance of a cloud shadow (soft, or a disk with a sharp or
+    soft rim) drifting over the ground.
 """
 
 import numpy as np
@@ -151,10 +152,13 @@ def apply_shake(image, dx, dy):
     return np.clip(out, 0, None, out=out)
 
 
-def cloud_transmittance(points_xy, t_s, *, start_xy, velocity_xy, sigma_m=250.0, depth=0.5):
-    """Transmittance of the sun term under a soft drifting cloud shadow.
+def cloud_transmittance(points_xy, t_s, *, start_xy, velocity_xy, sigma_m=250.0, depth=0.5, rim_m=None):
+    """Transmittance of the sun term under a drifting cloud shadow.
 
-    ``c = 1 - depth exp(-|p - (start + velocity t)|^2 / (2 sigma^2))`` on the ground (x, y).
+    Soft (``rim_m`` None): ``c = 1 - depth exp(-r^2 / (2 sigma^2))``; with a rim: a disk of
+    radius ``sigma_m`` whose border is a logistic ramp of width ``rim_m``,
+    ``c = 1 - depth / (1 + exp((r - sigma) / rim))`` (small `rim_m`: a hard-edged cloud);
+    ``r = |p - (start + velocity t)|`` on the ground (x, y).
 
     Parameters
     ----------
@@ -164,6 +168,9 @@ def cloud_transmittance(points_xy, t_s, *, start_xy, velocity_xy, sigma_m=250.0,
     start_xy, velocity_xy : 2-sequences, keyword-only
         Centre of the cloud shadow at t = 0 (m) and its drift (m/s).
     sigma_m, depth : float, keyword-only
+        Radius (m) and depth (1 - the smallest transmittance).
+    rim_m : float, keyword-only, optional
+        Width of the border ramp (m); None for the Gaussian profile.
 
     Returns
     -------
@@ -171,6 +178,11 @@ def cloud_transmittance(points_xy, t_s, *, start_xy, velocity_xy, sigma_m=250.0,
     """
     if not 0 <= depth < 1:
         raise ValueError(f"depth must be in [0, 1); got {depth}")
+    check_positive(sigma_m, "sigma_m")
     centre = np.asarray(start_xy, dtype=np.float64) + np.asarray(velocity_xy) * float(t_s)
     r2 = ((np.asarray(points_xy) - centre) ** 2).sum(axis=1)
-    return 1.0 - depth * np.exp(-0.5 * r2 / sigma_m**2)
+    if rim_m is None:
+        return 1.0 - depth * np.exp(-0.5 * r2 / sigma_m**2)
+    check_positive(rim_m, "rim_m")
+    u = np.clip((np.sqrt(r2) - sigma_m) / rim_m, -60.0, 60.0)
+    return 1.0 - depth / (1.0 + np.exp(u))
