@@ -140,15 +140,34 @@ def get_dual_model(wildcards):
     return capture(wildcards.ds).dual_model
 
 
-FIGURE_ORDER = ("primal", "shadow_time_u", "shadow_time_v", "shadow_time_cal_u", "shadow_time_cal_v", "dual_view",
-                "keyframes", "edge_over_time", "arrival_map", "pushbroom", "accuracy", "error_histogram")
+FIGURE_ORDER = (
+    "primal",
+    "shadow_time_u",
+    "shadow_time_v",
+    "shadow_time_cal_u",
+    "shadow_time_cal_v",
+    "dual_view",
+    "keyframes",
+    "edge_over_time",
+    "arrival_map",
+    "pushbroom",
+    "accuracy",
+    "error_histogram",
+)
 
 
 def get_figure_labels(wildcards):
     """Report labels of a figure: the dataset, and the figure's place in reading order (the report sorts
     a dataset's results by label) and name."""
-    order = FIGURE_ORDER.index(wildcards.figure) if wildcards.figure in FIGURE_ORDER else len(FIGURE_ORDER)
-    return {"dataset": wildcards.ds, "figure": f"{order + 1:02d} {wildcards.figure.replace('_', ' ')}"}
+    order = (
+        FIGURE_ORDER.index(wildcards.figure)
+        if wildcards.figure in FIGURE_ORDER
+        else len(FIGURE_ORDER)
+    )
+    return {
+        "dataset": wildcards.ds,
+        "figure": f"{order + 1:02d} {wildcards.figure.replace('_', ' ')}",
+    }
 
 
 def get_accuracy(wildcards):

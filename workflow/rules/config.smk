@@ -50,7 +50,9 @@ def _from_command_line(value, schema):
     """`value` with command-line strings read as YAML where `schema` wants another type."""
     if isinstance(value, dict):
         properties = schema.get("properties", {})
-        return {k: _from_command_line(v, properties.get(k, {})) for k, v in value.items()}
+        return {
+            k: _from_command_line(v, properties.get(k, {})) for k, v in value.items()
+        }
     if isinstance(value, list):
         items = schema.get("items", {})
         return [_from_command_line(v, items) for v in value]
@@ -60,7 +62,9 @@ def _from_command_line(value, schema):
             parsed = yaml.safe_load(value)
         except yaml.YAMLError:
             return value
-        return _from_command_line(parsed, schema) if not isinstance(parsed, str) else value
+        return (
+            _from_command_line(parsed, schema) if not isinstance(parsed, str) else value
+        )
     return value
 
 
@@ -68,8 +72,12 @@ def _schema_messages(doc, schema):
     """One ``key A.B: message`` line per schema violation of `doc`."""
     validator = jsonschema.Draft202012Validator(schema)
     lines = []
-    for error in sorted(validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))):
-        best = jsonschema.exceptions.best_match(error.context) if error.context else error
+    for error in sorted(
+        validator.iter_errors(doc), key=lambda e: list(map(str, e.absolute_path))
+    ):
+        best = (
+            jsonschema.exceptions.best_match(error.context) if error.context else error
+        )
         where = ".".join(str(p) for p in best.absolute_path) or "(top level)"
         lines.append(f"  key {where}: {best.message}")
     return lines

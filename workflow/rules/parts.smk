@@ -94,12 +94,16 @@ def part_names(ds, sweep):
 
 def sweep_parts(ds, sweep, template):
     """`template` (with {ds}, {sweep}, {part}) of every decode part of a sweep, in time order."""
-    return [template.format(ds=ds, sweep=sweep, part=part) for part in part_names(ds, sweep)]
+    return [
+        template.format(ds=ds, sweep=sweep, part=part) for part in part_names(ds, sweep)
+    ]
 
 
 def get_decode_parts(wildcards):
     """Part stores of a sweep, or its group stores if it has more parts than PARTS_PER_GROUP (inputs of `decode`)."""
-    parts = sweep_parts(wildcards.ds, wildcards.sweep, "results/{ds}/frames/{sweep}.parts/{part}.zarr")
+    parts = sweep_parts(
+        wildcards.ds, wildcards.sweep, "results/{ds}/frames/{sweep}.parts/{part}.zarr"
+    )
     if len(parts) <= PARTS_PER_GROUP:
         return parts
     count = -(-len(parts) // PARTS_PER_GROUP)

@@ -193,7 +193,9 @@ def planned_mem_mb(ds):
     """Memory (MB, first attempt) of the largest job of each kind of dataset `ds`."""
     plan = capture(ds)
     sweep = plan.outdoor_sweep if plan.is_outdoor else plan.timed_sweeps[0]
-    wildcards = _PlanningWildcards(ds=ds, sweep=sweep, part="0000", span="0-end", strip="0")
+    wildcards = _PlanningWildcards(
+        ds=ds, sweep=sweep, part="0000", span="0-end", strip="0"
+    )
     sizes = {
         "decode_part": get_decode_mem_mb(wildcards, 1),
         "decode_reference and the image steps": get_image_mem_mb(wildcards, 1),
