@@ -1,20 +1,25 @@
-"""Irradiance of a light field on any plane, flux-conserving.
+"""Irradiance of a light field on any plane, flux-conserving, with exact area weights.
 
-The rays of a :mod:`shadowcam.lightfield.rays` dataset sit on the near screen's pixel
-grid, so neighbouring rays bound ray tubes: each pixel cell carries the flux
-``irradiance * cell area`` and keeps it along the tube. On a target plane the cell's
-corners land where the four rays hit it; the cell is cut into ``s x s`` sub-cells
-(bilinear in the corners, ``s`` chosen so a sub-cell spans at most half a target pixel)
-whose flux is splatted bilinearly onto the target grid. Irradiance is flux over target
-pixel area. The change of a tube's cross-section is the exact form of the
-inverse-square and cosine terms along each ray (for rays from one point it reduces to
-``I cos(theta) / d^2``); folded tubes (caustics) add up; no smoothing beyond the
-bilinear splat.
+The rays of a :mod:`shadowcam.lightfield.rays` dataset sit at the near screen's pixel
+centres; each pixel is a ray tube carrying the pixel's flux ``irradiance * pixel area``
+along it. On a target plane the tube's corners land where the ray map, interpolated
+to the pixel's corners (the mean of the four surrounding rays' hits, linearly
+extrapolated at the border), puts them. The tube's image is cut into triangles along
+both diagonals (each carrying a quarter of the flux, so no diagonal is preferred), and
+each triangle's flux is spread uniformly over it and given to every target pixel in
+proportion to the exact area of their intersection (a conservative rasterisation: no
+filter beyond the target pixel itself). Irradiance is flux over target pixel area. On
+the near screen itself this reproduces the captured image; the change of a tube's
+cross-section is the exact form of the inverse-square and cosine terms along each ray
+(for rays from one point it reduces to ``I cos(theta) / d^2``); folded tubes
+(caustics) add up.
 
 Offers
 ------
 plane_frame : origin, col axis, row axis and unit normal of a plane.
 splat_bilinear : add weights at fractional (row, col) positions to a grid.
+splat_polygons : spread weights uniformly over polygons onto a grid with exact area weights.
+tube_triangles : the triangles of the pixel ray tubes of a grid of plane hits.
 irradiance_on_plane : the rays' irradiance on a plane grid (position, tilt), as a DataArray.
 """
 
@@ -89,15 +94,123 @@ def _hits(origin, direction, plane_origin, e_col, e_row, n):
     return hit @ e_col, hit @ e_row
 
 
-def irradiance_on_plane(rays, *, centre, shape, pixel_size, normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0),
-                        max_subdivision=16):
+def _quadrant_area(x, y, qx, qy):
+    """Signed area of polygons ``(x, y)`` ``(N, V)`` inside the quadrants ``x <= qx, y <= qy`` ``(N, K)``.
+
+    Clamping a closed curve onto a quadrant keeps its winding number around every
+    point inside, so the area is the shoelace area of the clamped boundary; each edge
+    is split where it crosses ``x = qx`` or ``y = qy`` so that the clamp is affine on
+    every piece. Returns ``(N, K)``.
+    """
+    x0, y0 = x[:, None, :], y[:, None, :]
+    x1, y1 = np.roll(x, -1, axis=1)[:, None, :], np.roll(y, -1, axis=1)[:, None, :]
+    qx, qy = qx[..., None], qy[..., None]
+    dx, dy = x1 - x0, y1 - y0
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tx = np.clip(np.where(dx != 0, (qx - x0) / dx, 0.0), 0.0, 1.0)
+        ty = np.clip(np.where(dy != 0, (qy - y0) / dy, 0.0), 0.0, 1.0)
+    ts = (np.zeros_like(tx), np.minimum(tx, ty), np.maximum(tx, ty), np.ones_like(tx))
+    px = [np.minimum(x0 + t * dx, qx) for t in ts]
+    py = [np.minimum(y0 + t * dy, qy) for t in ts]
+    twice = sum(px[i] * py[i + 1] - px[i + 1] * py[i] for i in range(3))
+    return 0.5 * twice.sum(axis=-1)
+
+
+def splat_polygons(rows, cols, weights, shape):
+    """Spread each weight uniformly over its polygon and sum it into a grid by exact area.
+
+    Parameters
+    ----------
+    rows, cols : (N, V) ndarray
+        Polygon vertices in pixel units (pixel ``(i, j)`` covers ``[i - 1/2, i + 1/2] x
+        [j - 1/2, j + 1/2]``); polygons must not self-intersect (e.g. triangles),
+        either orientation.
+    weights : (N,) ndarray
+    shape : (rows, cols)
+
+    Returns
+    -------
+    (rows, cols) float64 ndarray
+        Each pixel holds ``sum weight * area(polygon & pixel) / area(polygon)``; weight
+        outside the grid is dropped; a polygon of (nearly) zero area gives its weight
+        to the pixel of its centroid.
+    """
+    rows = np.asarray(rows, np.float64)
+    cols = np.asarray(cols, np.float64)
+    weights = np.asarray(weights, np.float64)
+    h, w = shape
+    out = np.zeros(h * w, np.float64)
+    keep = np.all(np.isfinite(rows) & np.isfinite(cols), axis=1) & np.isfinite(weights) & (weights != 0)
+    rows, cols, weights = rows[keep], cols[keep], weights[keep]
+    x0, y0 = np.roll(cols, -1, axis=1), np.roll(rows, -1, axis=1)
+    area = 0.5 * np.sum(cols * y0 - x0 * rows, axis=1)
+    tiny = np.abs(area) < 1e-9
+    if tiny.any():  # degenerate tubes: the whole weight at the centroid's pixel
+        r = np.rint(rows[tiny].mean(axis=1)).astype(np.int64)
+        c = np.rint(cols[tiny].mean(axis=1)).astype(np.int64)
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        out += np.bincount((r * w + c)[inside], weights[tiny][inside], minlength=h * w)
+        rows, cols, weights, area = rows[~tiny], cols[~tiny], weights[~tiny], area[~tiny]
+    # lattice lines bounding each polygon; group polygons by how many pixels they span
+    r_lo = np.floor(rows.min(axis=1) + 0.5).astype(np.int64)
+    c_lo = np.floor(cols.min(axis=1) + 0.5).astype(np.int64)
+    span = np.maximum(np.floor(rows.max(axis=1) + 0.5).astype(np.int64) - r_lo,
+                      np.floor(cols.max(axis=1) + 0.5).astype(np.int64) - c_lo) + 1
+    visible = (r_lo + span > 0) & (r_lo < h) & (c_lo + span > 0) & (c_lo < w)
+    for k in np.unique(span[visible]):
+        sel = np.flatnonzero(visible & (span == k))
+        for part in np.array_split(sel, max(1, sel.size * (k + 1) ** 2 // 200_000)):
+            offsets = np.arange(k + 1)
+            qy = (r_lo[part, None] + offsets[None, :] - 0.5)[:, :, None] + np.zeros(k + 1)
+            qx = (c_lo[part, None] + offsets[None, :] - 0.5)[:, None, :] + np.zeros((k + 1, 1))
+            a = _quadrant_area(cols[part], rows[part], qx.reshape(part.size, -1),
+                               qy.reshape(part.size, -1)).reshape(part.size, k + 1, k + 1)
+            cell = a[:, 1:, 1:] - a[:, :-1, 1:] - a[:, 1:, :-1] + a[:, :-1, :-1]
+            share = cell * (weights[part] / area[part])[:, None, None]
+            r = r_lo[part, None, None] + np.arange(k)[None, :, None]
+            c = c_lo[part, None, None] + np.arange(k)[None, None, :]
+            r, c = np.broadcast_arrays(r, c)
+            inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+            out += np.bincount((r * w + c)[inside], share[inside], minlength=h * w)
+    return out.reshape(h, w)
+
+
+def tube_triangles(u, v):
+    """Triangles of the pixel ray tubes whose rays hit a plane at ``(u, v)``.
+
+    Parameters
+    ----------
+    u, v : (H, W) ndarray
+        Plane coordinates of the rays through the pixel centres.
+
+    Returns
+    -------
+    tri_u, tri_v : (4, H, W, 3) ndarray
+        Four triangles per pixel (the pixel's corner quad cut along both diagonals); each
+        covers half the pixel, so each carries a quarter of its flux. Corners are the mean
+        of the four surrounding rays' hits (linear extrapolation beyond the border).
+    """
+    def corners(a):
+        a = np.pad(a, 1, mode="reflect", reflect_type="odd")
+        return 0.25 * (a[:-1, :-1] + a[:-1, 1:] + a[1:, :-1] + a[1:, 1:])
+
+    out = []
+    for a in (u, v):
+        c = corners(a)
+        c00, c01, c10, c11 = c[:-1, :-1], c[:-1, 1:], c[1:, :-1], c[1:, 1:]
+        out.append(np.stack([np.stack(t, -1) for t in ((c00, c01, c11), (c00, c11, c10),
+                                                        (c00, c01, c10), (c01, c11, c10))]))
+    return out[0], out[1]
+
+
+def irradiance_on_plane(rays, *, centre, shape, pixel_size, normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0)):
     """Irradiance of a ray set on a plane grid.
 
     Parameters
     ----------
     rays : xarray.Dataset
         A rays dataset (:func:`shadowcam.lightfield.rays.rays_dataset`): ``origin`` and
-        ``direction`` ``(row, col, axis)`` mm, ``flux`` ``(row, col)`` lm per cell.
+        ``direction`` ``(row, col, axis)`` mm, ``flux`` ``(row, col)`` lm per pixel.
     centre : (3,) array_like, keyword-only
         Centre of the target grid, mm.
     shape : (rows, cols), keyword-only
@@ -105,41 +218,23 @@ def irradiance_on_plane(rays, *, centre, shape, pixel_size, normal=(0.0, 0.0, 1.
         Target pitch, mm.
     normal, up : (3,) array_like, keyword-only
         Plane normal (tilt) and the direction of increasing rows.
-    max_subdivision : int, keyword-only
-        Upper bound on sub-cells per cell side.
 
     Returns
     -------
     xarray.DataArray
-        ``(row, col)`` irradiance in lux, with ``y``/``x`` plane coordinates in mm.
+        ``(row, col)`` irradiance in lux (mean over each target pixel), with ``y``/``x``
+        plane coordinates in mm.
     """
     check_positive(pixel_size, "pixel_size", finite=True)
     if len(shape) != 2 or min(shape) < 1:
         raise ValueError(f"shape must be (rows, cols) of positive ints; got {shape}")
     plane = plane_frame(centre, normal, up)
-    origin = rays["origin"].values
-    direction = rays["direction"].values
-    flux = rays["flux"].values
-    u, v = _hits(origin, direction, *plane)
-    # cells between four neighbouring rays; the cell's flux is the mean of its corners' flux
-    corners_u = np.stack([u[:-1, :-1], u[:-1, 1:], u[1:, :-1], u[1:, 1:]])
-    corners_v = np.stack([v[:-1, :-1], v[:-1, 1:], v[1:, :-1], v[1:, 1:]])
-    cell_flux = 0.25 * (flux[:-1, :-1] + flux[:-1, 1:] + flux[1:, :-1] + flux[1:, 1:])
-    good = np.all(np.isfinite(corners_u) & np.isfinite(corners_v), axis=0) & np.isfinite(cell_flux)
-    cu = corners_u[:, good] / pixel_size + (shape[1] - 1) / 2
-    cv = corners_v[:, good] / pixel_size + (shape[0] - 1) / 2
-    cf = cell_flux[good]
-    span = max(np.nanmax(np.abs(cu[3] - cu[0])), np.nanmax(np.abs(cu[1] - cu[2])),
-               np.nanmax(np.abs(cv[3] - cv[0])), np.nanmax(np.abs(cv[1] - cv[2]))) if cf.size else 0.0
-    s = int(np.clip(np.ceil(2 * span), 1, max_subdivision))
-    grid = np.zeros(shape, np.float64)
-    f = (np.arange(s) + 0.5) / s
-    for a in f:          # along the cell's col direction
-        for b in f:      # along its row direction
-            w00, w01, w10, w11 = (1 - a) * (1 - b), a * (1 - b), (1 - a) * b, a * b
-            pr = w00 * cv[0] + w01 * cv[1] + w10 * cv[2] + w11 * cv[3]
-            pc = w00 * cu[0] + w01 * cu[1] + w10 * cu[2] + w11 * cu[3]
-            grid += splat_bilinear(pr, pc, cf / (s * s), shape)
+    u, v = _hits(rays["origin"].values, rays["direction"].values, *plane)
+    tri_u, tri_v = tube_triangles(u, v)
+    flux = np.broadcast_to(0.25 * rays["flux"].values, tri_u.shape[:3])
+    cols = tri_u.reshape(-1, 3) / pixel_size + (shape[1] - 1) / 2
+    rows = tri_v.reshape(-1, 3) / pixel_size + (shape[0] - 1) / 2
+    grid = splat_polygons(rows, cols, flux.ravel(), shape)
     irradiance = grid / (pixel_size * 1e-3) ** 2
     rows = (np.arange(shape[0]) - (shape[0] - 1) / 2) * pixel_size
     cols = (np.arange(shape[1]) - (shape[1] - 1) / 2) * pixel_size
