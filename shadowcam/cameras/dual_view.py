@@ -24,6 +24,7 @@ DUAL_VIEW_METHODS : name -> resampler, ``mesh`` and ``idw``.
 dual_view_mesh : forward mesh warp.
 dual_view_idw : k-nearest inverse-distance weighting.
 resample_dual_view : dispatch through `DUAL_VIEW_METHODS` with input checks.
+reference_image : the image of a decoded reference frame store.
 camera_colours : the camera colours to resample (reference frame or mean lit image).
 dual_view_dataset : assemble the ``dual_view`` xarray Dataset.
 dual_view_from_coords : dual-coordinates + shadow-time datasets -> dual-view dataset.
@@ -231,6 +232,24 @@ def resample_dual_view(colours, u, v, *, shape, valid=None, method="mesh", **par
     return DUAL_VIEW_METHODS[method](colours, u, v, valid=ok, shape=(height, width), **params)
 
 
+def reference_image(reference):
+    """The reference frame of a decoded reference store as an image.
+
+    Parameters
+    ----------
+    reference : xarray.Dataset
+        Frame store with ``image ([time,] row, col, channel)`` (several frames are averaged).
+
+    Returns
+    -------
+    (rows, cols, channel) ndarray
+    """
+    image = reference["image"]
+    if "time" in image.dims:
+        image = image.mean("time")
+    return image.transpose("row", "col", "channel").values
+
+
 def camera_colours(shadow_time, *, reference=None, sweeps=("u", "v")):
     """Camera colours to resample: the reference frame, else the mean lit image.
 
@@ -335,10 +354,7 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     """
     check_in_interval(min_coverage, "min_coverage", 0.0, 1.0, closed="both")
     if reference is not None:
-        image = reference["image"]
-        if "time" in image.dims:
-            image = image.mean("time")
-        reference = image.transpose("row", "col", "channel").values
+        reference = reference_image(reference)
     colours = camera_colours(shadow_time, reference=reference)
     shape = (int(coords.attrs["dual_height"]), int(coords.attrs["dual_width"]))
     u = coords["u"].transpose("row", "col").values

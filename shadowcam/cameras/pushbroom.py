@@ -27,6 +27,7 @@ assemble_pushbroom : the (time, col, channel) pushbroom from all edge curves (or
 resample_uniform_time : rows resampled to evenly spaced times.
 edge_from_time_map : the lab's edge per (frame, row) from a shadow-time map.
 pushbroom_from_shadow_time : the lab pushbroom dataset of one sweep (front function).
+shadow_line_axis : the camera axis a sweep's shadow line runs along.
 """
 
 import numpy as np
@@ -179,17 +180,21 @@ def pushbroom_from_shadow_time(shadow_time, *, sweep, reference=None):
         ``n_frames_<sweep>``.
     sweep : str, keyword-only
         The sweep's name.
-    reference : (H, W, C) ndarray, optional
-        Colour source instead of the lit image.
+    reference : (H, W, C) ndarray or xarray.Dataset, optional
+        Colour source instead of the lit image (a Dataset: a decoded reference frame store).
 
     Returns
     -------
     xarray.Dataset
-        ``pushbroom (time, position, channel)`` float32 and ``edge (time, position)``
-        (pixel-edge coordinates across the shadow line); attrs ``along`` (``row``: position
-        is the camera row, ``col``: the column) and ``sweep``.
+        ``pushbroom (time, row, channel)`` float32 (linear, the colour source's units) and
+        ``edge (time, row)`` (pixel-edge column of the edge) for a shadow line along the
+        camera columns; ``(time, col, channel)`` and the edge row for one along the rows.
+        ``time`` is the frame index of the sweep. Attrs ``along`` (``row`` or ``col``: the
+        position dimension) and ``sweep``.
     """
     import xarray as xr
+
+    from shadowcam.cameras.dual_view import reference_image
 
     names = [str(s) for s in shadow_time["sweep"].values]
     if sweep not in names:
@@ -200,21 +205,44 @@ def pushbroom_from_shadow_time(shadow_time, *, sweep, reference=None):
         raise ValueError(f"shadow_time: attr n_frames_{sweep} missing or < 2")
     if reference is None:
         reference = shadow_time["lit_image"].sel(sweep=sweep).transpose("row", "col", "channel").values
+    elif hasattr(reference, "data_vars"):
+        reference = reference_image(reference)
     reference = np.asarray(reference)
     if reference.ndim != 3 or reference.shape[:2] != t.shape:
         raise ValueError(f"reference must be {t.shape + ('C',)}; got shape {reference.shape}")
-    with np.errstate(invalid="ignore"):
-        d_col = np.nanmedian(np.abs(np.diff(t, axis=1)))
-        d_row = np.nanmedian(np.abs(np.diff(t, axis=0)))
-    along = "col" if d_row > d_col else "row"
+    along = shadow_line_axis(t)
     edge = edge_from_time_map(t, np.arange(n_frames), along=along)
     image = assemble_pushbroom(reference, edge, along=along)
     channels = shadow_time["channel"].values if "channel" in shadow_time.coords else None
+    across = "col" if along == "row" else "row"
     return xr.Dataset(
-        {"pushbroom": (("time", "position", "channel"), image.astype(np.float32),
-                       {"long_name": f"colours along the shadow edge of sweep {sweep}"}),
-         "edge": (("time", "position"), edge.astype(np.float32),
-                  {"units": "pixel", "long_name": "edge across the shadow line (pixel-edge coordinates)"})},
-        coords={"time": np.arange(n_frames), "position": np.arange(edge.shape[1]),
+        {"pushbroom": (("time", along, "channel"), image.astype(np.float32),
+                       {"units": "linear intensity of the colour source",
+                        "long_name": f"colours along the shadow edge of sweep {sweep}"}),
+         "edge": (("time", along), edge.astype(np.float32),
+                  {"units": "pixel", "long_name": f"edge {across} (pixel-edge coordinates)"})},
+        coords={"time": ("time", np.arange(n_frames), {"units": "frame"}),
+                along: (along, np.arange(edge.shape[1]), {"units": "pixel"}),
                 **({"channel": channels} if channels is not None else {})},
         attrs={"sweep": sweep, "along": along, "projection": "pushbroom"})
+
+
+def shadow_line_axis(shadow_time):
+    """The camera axis the shadow line runs along, from a shadow-time map.
+
+    Parameters
+    ----------
+    shadow_time : (H, W) ndarray
+        Shadow times; NaN = none.
+
+    Returns
+    -------
+    str
+        ``row`` when the times change faster across columns (a vertical wire: one edge column
+        per row), else ``col``.
+    """
+    t = check_array(np.asarray(shadow_time, dtype=np.float64), "shadow_time", ndim=2)
+    with np.errstate(invalid="ignore"):
+        d_col = np.nanmedian(np.abs(np.diff(t, axis=1)))
+        d_row = np.nanmedian(np.abs(np.diff(t, axis=0)))
+    return "col" if d_row > d_col else "row"

@@ -33,7 +33,7 @@ STEPS = {
     "track-edges": "track_edges",
     "track-edges-strip": "track_edges_strip",
     "arrival": "arrival",
-    "pushbroom": "pushbroom",
+    "pushbroom": "pushbroom", "lab-pushbroom": "lab_pushbroom",  # ridge (outdoor), single-sweep lab
     "outdoor-accuracy": "outdoor_accuracy",
     "outdoor-figures": "outdoor_figures",
     "bench": "bench",

@@ -35,6 +35,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--shadow-time", required=True, help="results/<ds>/shadow_time.nc")
     parser.add_argument("--dual-coords", default=None, help="results/<ds>/dual_coords.nc")
     parser.add_argument("--dual-view", default=None, help="results/<ds>/dual_view.nc")
+    parser.add_argument("--pushbroom", default=None, help="results/<ds>/pushbroom.nc (single-sweep lab capture)")
+    parser.add_argument("--reference", default=None, help="reference frame store the pushbroom was coloured with")
     parser.add_argument("--params", default="{}", help='JSON: {"noise": "noise_free" | "raw12"}')
     parser.add_argument("--out-json", required=True, help="results/<ds>/accuracy.json")
     parser.add_argument("--out-csv", required=True, help="results/<ds>/accuracy.csv")
@@ -43,6 +45,8 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Evaluate the products against the manifest's ground truth and write the report."""
+    from shadowcam.cameras.dual_view import reference_image
+    from shadowcam.io.frame_store import open_frames
     from shadowcam.io.ground_truth import load_ground_truth
     from shadowcam.io.manifest import load_manifest
     from shadowcam.io.provenance import file_sha256
@@ -54,9 +58,11 @@ def run(args):
     noise, source = noise_condition(manifest, params.get("noise"))
     report = accuracy_report(open_dataset(args.shadow_time), gt, noise=noise,
                              dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None,
-                             dual_view=open_dataset(args.dual_view) if args.dual_view else None)
+                             dual_view=open_dataset(args.dual_view) if args.dual_view else None,
+                             pushbroom=open_dataset(args.pushbroom) if args.pushbroom else None,
+                             reference=reference_image(open_frames(args.reference)) if args.reference else None)
     report.update(noise_source=source, dataset=manifest["name"],
-                  inputs={str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view) if p},
+                  inputs={str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view, args.pushbroom) if p},
                   ground_truth_sha256=gt.attrs.get("source_sha256", ""))
     for target in report["targets"]:
         log.info("%s [%s] = %.4g (%s %.4g): %s", target["target"], target["sweep"], target["value"],

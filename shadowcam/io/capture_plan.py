@@ -8,7 +8,8 @@ rules (recursive globs, files only, natural order), and answers what the
 workflow plans jobs from: frame counts, the frame shape, the frame times,
 whether there is a reference frame, calibration sweeps and ground truth,
 whether the capture is outdoor or lab, which sweeps are timed, which dual
-coordinate model runs and the halo of an edge-tracking strip.
+coordinate model runs (both scene sweeps) or that the capture is a shadow
+pushbroom (one scene sweep), and the halo of an edge-tracking strip.
 
 A manifest with a ``synthetic:`` block (and no ``sweeps``) describes a capture
 the renderer writes; its plan takes the frame count and shape from that block
@@ -102,10 +103,17 @@ class CapturePlan:
     has_calibration : bool
         Both calibration sweeps and the ``calibration_plane`` exist.
     dual_model : str or None
-        ``uniform`` or ``calibration``: the dual-coordinate model that runs (lab only).
+        ``uniform`` or ``calibration``: the dual-coordinate model that runs (lab with both
+        scene sweeps only).
+    scene_sweeps : tuple of str
+        The scene sweeps of a lab capture: ``u, v``, or the one of a single-sweep capture
+        (empty outdoors).
+    stages : tuple of str
+        Lab stages after the shadow times that the capture supports: ``dual_coords,
+        dual_view`` with both scene sweeps, ``pushbroom`` with one (empty outdoors).
     timed_sweeps : tuple of str
-        Sweeps whose shadow times are estimated: ``u, v`` and, when the calibration
-        model runs, ``cal_u, cal_v`` (lab only; empty outdoors).
+        Sweeps whose shadow times are estimated: the scene sweeps and, when the
+        calibration model runs, ``cal_u, cal_v`` (lab only; empty outdoors).
     outdoor_sweep : str or None
         The time-lapse sweep (outdoor only).
     strip_halo : int
@@ -125,6 +133,8 @@ class CapturePlan:
     has_ground_truth: bool = False
     has_calibration: bool = False
     dual_model: str = None
+    scene_sweeps: tuple = ()
+    stages: tuple = ()
     timed_sweeps: tuple = ()
     outdoor_sweep: str = None
     strip_halo: int = 0
@@ -138,6 +148,11 @@ class CapturePlan:
     def uses_calibration(self):
         """True if the calibration sweeps are decoded and timed (the calibration model runs)."""
         return self.dual_model == "calibration"
+
+    @property
+    def single_sweep(self):
+        """True for a lab capture with one scene sweep (its camera is the shadow pushbroom)."""
+        return len(self.scene_sweeps) == 1
 
     @property
     def megapixels(self):
@@ -217,7 +232,7 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         Naming the manifest and the key when the manifest does not match the
         schema, a file or glob it references is missing, its checksums block
         does not list a file, frame times cannot be resolved, a lab capture lacks
-        the scene sweeps ``u``, ``v``, an outdoor capture has several sweeps and
+        a scene sweep (``u`` or ``v``), an outdoor capture has several sweeps and
         none named ``timelapse``, `dual_model` is ``calibration`` without
         calibration sweeps, or the first frames of the sweeps and the reference
         differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`).
@@ -238,15 +253,17 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         first = OUTDOOR_SWEEP if OUTDOOR_SWEEP in names else names[0]
         facts.update(outdoor_sweep=first, strip_halo=_planned_halo(edge_margin))
     else:
-        missing = [s for s in SCENE_SWEEPS if s not in sweeps]
-        if missing:
+        scene = tuple(s for s in SCENE_SWEEPS if s in sweeps)
+        if not scene:
             raise ValueError(
-                f"manifest {path}: key 'sweeps' lacks {', '.join(missing)}; "
-                "the lab dual view needs the two perpendicular sweeps u and v"
+                f"manifest {path}: key 'sweeps' has no scene sweep; a lab capture needs sweep u "
+                "(or v) for the shadow pushbroom, or both u and v for the dual view"
             )
-        first = SCENE_SWEEPS[0]
+        first = scene[0]
     calibration = all(s in sweeps for s in CALIBRATION_SWEEPS) and (rendered or "calibration_plane" in manifest)
-    if not outdoor:
+    if not outdoor and len(scene) == 1:
+        facts.update(scene_sweeps=scene, stages=("pushbroom",), timed_sweeps=scene)
+    elif not outdoor:
         model = choose_dual_model(
             dual_model,
             calibration_available=calibration,
@@ -254,6 +271,8 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         )
         facts.update(
             dual_model=model,
+            scene_sweeps=SCENE_SWEEPS,
+            stages=("dual_coords", "dual_view"),
             timed_sweeps=SCENE_SWEEPS + (CALIBRATION_SWEEPS if model == "calibration" else ()),
         )
     if rendered:

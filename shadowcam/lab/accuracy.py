@@ -16,6 +16,9 @@ Metrics (synthetic data with exact ground truth, docs/contracts.md form):
   differ): relative RMSE inside that mask, and over the whole image with
   holes counted as zero -- the two curves of the paper's Fig. 5.
 
+* shadow pushbroom (one sweep) against the same assembly applied to the GT shadow
+  times and the same colour source, after ONE least-squares gain: relative RMSE over
+  the cells both have, and coverage = fraction of the GT cells the estimate has.
 Targets (foundation issue) are checked and reported pass/fail.
 
 Offers
@@ -24,6 +27,7 @@ ACCURACY_TARGETS : the targets and their thresholds.
 shadow_time_errors : error statistics of one sweep's shadow times.
 dual_coord_errors : error statistics of dual coordinates.
 dual_image_errors : gain-fitted relative RMSE of a dual view, masked and whole image.
+pushbroom_errors : gain-fitted relative RMSE and coverage of a lab shadow pushbroom.
 check_targets : pass/fail of every target for a report.
 reciprocal_on_dual_grid : the GT reciprocal render resampled onto a dual grid.
 accuracy_report : the nested report for one dataset's products.
@@ -39,7 +43,7 @@ import json
 import numpy as np
 
 from shadowcam._shared.quantity_table import quantity_row, table_to_csv
-from shadowcam._shared.validation import check_in
+from shadowcam._shared.validation import check_array, check_in
 
 #: targets of the foundation issue; the shadow-time p95 depends on the noise condition
 ACCURACY_TARGETS = {
@@ -206,6 +210,54 @@ def dual_image_errors(dual_view, coverage, reciprocal, *, dual_cam_visible):
     return out
 
 
+def pushbroom_errors(pushbroom, true_time, reference, *, along):
+    """Accuracy of a lab shadow pushbroom against the one the exact shadow times give.
+
+    The ground-truth pushbroom is the same assembly
+    (:func:`shadowcam.cameras.pushbroom.edge_from_time_map`, then
+    :func:`~shadowcam.cameras.pushbroom.assemble_pushbroom`) applied to `true_time` and
+    `reference`; one least-squares gain maps the estimate onto it.
+
+    Parameters
+    ----------
+    pushbroom : (T, P, C) ndarray
+        Estimated pushbroom (time, position along the shadow line, channel); NaN = no edge.
+    true_time : (H, W) ndarray
+        GT shadow times of the sweep (frames; NaN = none).
+    reference : (H, W, C) ndarray
+        Colour source of the estimate.
+    along : {"row", "col"}, keyword-only
+        Camera axis the shadow line runs along (the estimate's ``along``).
+
+    Returns
+    -------
+    dict
+        ``rel_rmse`` (RMSE of gain * estimate - GT over the cells both have, relative to the
+        RMS of GT there), ``gain``, ``coverage`` (fraction of GT cells the estimate has),
+        ``n_evaluated`` (cells in both).
+    """
+    from shadowcam.cameras.pushbroom import assemble_pushbroom, edge_from_time_map
+
+    estimate = check_array(np.asarray(pushbroom, dtype=np.float64), "pushbroom", ndim=3)
+    truth_edge = edge_from_time_map(true_time, np.arange(estimate.shape[0]), along=along)
+    truth = assemble_pushbroom(np.asarray(reference, dtype=np.float64), truth_edge, along=along)
+    if truth.shape != estimate.shape:
+        raise ValueError(f"pushbroom must have the shape of the GT pushbroom {truth.shape}; "
+                         f"got {estimate.shape}")
+    has_truth = np.all(np.isfinite(truth), axis=-1)
+    both = has_truth & np.all(np.isfinite(estimate), axis=-1)
+    n = int(both.sum())
+    coverage = float(both.sum() / has_truth.sum()) if has_truth.any() else float("nan")
+    if n == 0:
+        return {"rel_rmse": float("nan"), "gain": float("nan"), "coverage": coverage, "n_evaluated": 0}
+    est, gt = estimate[both], truth[both]
+    denom = float(np.sum(est * est))
+    gain = float(np.sum(est * gt) / denom) if denom > 0 else 1.0
+    rms = float(np.sqrt(np.mean(gt * gt)))
+    rel = float(np.sqrt(np.mean((gain * est - gt) ** 2)) / rms) if rms > 0 else float("nan")
+    return {"rel_rmse": rel, "gain": gain, "coverage": coverage, "n_evaluated": n}
+
+
 def _compare(value, threshold, comparison):
     if not np.isfinite(value):
         return False
@@ -347,7 +399,7 @@ def reciprocal_on_dual_grid(ground_truth, shape, *, dual_coords=None):
 
 
 def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=None,
-                    noise="noise_free", sweeps=("u", "v")):
+                    pushbroom=None, reference=None, noise="noise_free", sweeps=("u", "v")):
     """Accuracy report of one dataset's products against its ground truth.
 
     Parameters
@@ -361,6 +413,10 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
         ``u``, ``v``, ``valid`` over ``(row, col)``.
     dual_view : xarray.Dataset, optional
         ``dual_view (v, u, channel)``, ``coverage (v, u)``.
+    pushbroom : xarray.Dataset, optional
+        Lab shadow pushbroom (:func:`shadowcam.cameras.pushbroom.pushbroom_from_shadow_time`).
+    reference : (H, W, C) ndarray, optional
+        The pushbroom's colour source (default the sweep's ``lit_image``).
     noise : {"noise_free", "raw12"}, keyword-only
         Noise condition of the capture (selects the shadow-time target).
     sweeps : sequence of str
@@ -370,7 +426,8 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
     -------
     dict
         ``shadow_time`` (per sweep), ``dual_model`` (``model`` and ``why``, from the dual
-        coordinates' attrs), ``dual_coords``, ``dual_image``, ``targets`` (list),
+        coordinates' attrs), ``dual_coords``, ``dual_image``, ``pushbroom`` (with a pushbroom
+        whose sweep has GT times, :func:`pushbroom_errors`), ``targets`` (list),
         ``all_targets_pass``, ``noise``.
     """
     lit = np.asarray(ground_truth["lit"].values, dtype=bool)
@@ -403,6 +460,13 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
             reciprocal, visible = _reciprocal_on_grid(ground_truth, grid_map, image.shape[:2])
             report["dual_image"] = dual_image_errors(
                 image, dual_view["coverage"].values, reciprocal, dual_cam_visible=visible)
+    if pushbroom is not None and f"t_{pushbroom.attrs['sweep']}" in ground_truth:
+        sweep, along = pushbroom.attrs["sweep"], pushbroom.attrs["along"]
+        if reference is None:
+            reference = shadow_time["lit_image"].sel(sweep=sweep).transpose("row", "col", "channel").values
+        report["pushbroom"] = pushbroom_errors(
+            pushbroom["pushbroom"].transpose("time", along, "channel").values,
+            ground_truth[f"t_{sweep}"].transpose("row", "col").values, reference, along=along)
     report["targets"] = check_targets(report, noise=noise)
     report["all_targets_pass"] = bool(report["targets"]) and all(t["pass"] for t in report["targets"])
     return report
@@ -474,6 +538,12 @@ TABLE_ROWS = {
         "rmse_v": ("dual coordinates RMSE of v", "dual px", 1.0),
         "max": ("dual coordinates |error| max", "dual px", 1.0),
         "n_evaluated": ("camera pixels with dual coordinates", "pixel", 1.0),
+    },
+    "pushbroom": {
+        "coverage": ("pushbroom coverage of the GT pushbroom", "%", 100.0),
+        "rel_rmse": ("pushbroom relative RMSE", "%", 100.0),
+        "gain": ("pushbroom gain fitted to the GT pushbroom", "1", 1.0),
+        "n_evaluated": ("pushbroom cells evaluated", "cell", 1.0),
     },
     "dual_image": {
         "coverage_of_visible": ("dual view coverage of what the camera sees", "%", 100.0),

@@ -134,9 +134,22 @@ def test_missing_checksums_raises_before_anything_runs(lab):
         capture_plan(write_capture(lab, lab_doc(), checksums=False))
 
 
-def test_lab_needs_both_scene_sweeps(lab):
-    path = write_capture(lab, lab_doc(sweeps={"u": {"files": "u/*.png"}}))
-    with pytest.raises(ValueError, match=r"key 'sweeps' lacks v"):
+def test_single_sweep_lab_capture_plans_the_pushbroom_only(lab):
+    plan = capture_plan(write_capture(lab, lab_doc(sweeps={"u": {"files": "u/*.png"}})))
+    assert plan.single_sweep and plan.scene_sweeps == ("u",)
+    assert plan.stages == ("pushbroom",) and plan.timed_sweeps == ("u",)
+    assert plan.dual_model is None
+
+
+def test_two_sweep_lab_capture_plans_the_dual_stages(lab):
+    plan = capture_plan(write_capture(lab, lab_doc()))
+    assert not plan.single_sweep and plan.scene_sweeps == ("u", "v")
+    assert plan.stages == ("dual_coords", "dual_view")
+
+
+def test_lab_needs_a_scene_sweep(lab):
+    path = write_capture(lab, lab_doc(sweeps={"w": {"files": "u/*.png"}}))
+    with pytest.raises(ValueError, match=r"key 'sweeps' has no scene sweep"):
         capture_plan(path)
 
 

@@ -207,3 +207,22 @@ def test_noise_condition_explicit_then_declared_then_synthetic_then_default():
     assert noise_condition({"synthetic": {"noise": True}}) == ("raw12", "manifest synthetic.noise")
     assert noise_condition({"synthetic": {"noise": False}}) == ("noise_free", "manifest synthetic.noise")
     assert noise_condition({}) == ("noise_free", "default")
+def test_pushbroom_errors_against_the_exact_time_assembly():
+    from shadowcam.cameras.pushbroom import assemble_pushbroom, edge_from_time_map
+    from shadowcam.lab.accuracy import pushbroom_errors
+
+    rng = np.random.default_rng(5)
+    truth_time = np.tile(0.5 * np.arange(24.0), (10, 1))  # vertical wire: time grows along columns
+    reference = rng.uniform(0.2, 1.0, (10, 24, 3))
+    exact = assemble_pushbroom(reference, edge_from_time_map(truth_time, np.arange(12), along="row"), along="row")
+    perfect = pushbroom_errors(3.0 * exact, truth_time, reference, along="row")
+    assert perfect["rel_rmse"] < 1e-12 and perfect["gain"] == pytest.approx(1 / 3)
+    assert perfect["coverage"] == 1.0 and perfect["n_evaluated"] == np.isfinite(exact[..., 0]).sum()
+    half = exact.copy()
+    half[:, :5] = np.nan
+    assert pushbroom_errors(half, truth_time, reference, along="row")["coverage"] == pytest.approx(0.5)
+    late = assemble_pushbroom(reference, edge_from_time_map(truth_time - 1.0, np.arange(12), along="row"),
+                              along="row")
+    assert pushbroom_errors(late, truth_time, reference, along="row")["rel_rmse"] > 0.1
+    with pytest.raises(ValueError, match="pushbroom must have the shape"):
+        pushbroom_errors(exact[:, :5], truth_time, reference, along="row")

@@ -6,8 +6,8 @@ rule accuracy:
     input:
         capture=get_capture_input,
         shadow_time="results/{ds}/shadow_time.nc",
-        dual_coords="results/{ds}/dual_coords.nc",
-        dual_view="results/{ds}/dual_view.nc",
+        stages=get_accuracy_stages,
+        reference=get_accuracy_reference,
     output:
         json="results/{ds}/accuracy.json",
         # shown in the report as the figure "accuracy" (HTML); a CSV there only downloads
@@ -23,7 +23,8 @@ rule accuracy:
         runtime=15,
     params:
         manifest=get_capture_manifest,
+        stages=get_accuracy_flags,
     shell:
         "shadowcam accuracy --manifest {params.manifest} --shadow-time {input.shadow_time}"
-        " --dual-coords {input.dual_coords} --dual-view {input.dual_view}"
+        " {params.stages}"
         " --out-json {output.json} --out-csv {output.csv} > {log} 2>&1"

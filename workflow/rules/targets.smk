@@ -1,5 +1,6 @@
 # Final outputs of each configured dataset (inputs of `all`); a lab capture ends in shadow
-# times, dual coordinates, the dual view and figures; an outdoor time-lapse in the
+# times, dual coordinates, the dual view and figures (a single-sweep one in shadow times and
+# the shadow pushbroom); an outdoor time-lapse in the
 # arrival-time map, the ridge pushbroom and figures; both add accuracy when the dataset
 # has ground truth. Stages a dataset does not need are not asked for.
 
@@ -18,12 +19,10 @@ def dataset_targets(ds):
             f"results/{ds}/outdoor/accuracy.csv",
         ]
     else:
-        targets = [
-            f"results/{ds}/shadow_time.nc",
-            f"results/{ds}/dual_coords.nc",
-            f"results/{ds}/dual_view.nc",
-            f"results/{ds}/figures",
+        targets = [f"results/{ds}/shadow_time.nc"] + [
+            f"results/{ds}/{stage}.nc" for stage in plan.stages
         ]
+        targets += [] if plan.single_sweep else [f"results/{ds}/figures"]
         accuracy = [f"results/{ds}/accuracy.json", f"results/{ds}/accuracy.csv"]
     return targets + (accuracy if plan.has_ground_truth else [])
 
@@ -31,3 +30,37 @@ def dataset_targets(ds):
 def get_final_targets(wildcards):
     """Input function of `all`: the outputs of every configured dataset."""
     return [t for ds in config["datasets"] for t in dataset_targets(ds)]
+
+
+#: stage outputs the lab accuracy step scores, and the option that passes each
+ACCURACY_STAGE_FLAGS = {
+    "dual_coords": "--dual-coords",
+    "dual_view": "--dual-view",
+    "pushbroom": "--pushbroom",
+}
+
+
+def get_accuracy_stages(wildcards):
+    """Stage outputs the lab accuracy step scores: those the capture plan asks for."""
+    plan = capture(wildcards.ds)
+    return [f"results/{wildcards.ds}/{stage}.nc" for stage in plan.stages]
+
+
+def get_accuracy_reference(wildcards):
+    """Reference store the pushbroom was coloured with (single-sweep captures), else nothing."""
+    return get_reference(wildcards) if capture(wildcards.ds).single_sweep else []
+
+
+def _as_list(paths):
+    return [paths] if isinstance(paths, str) else list(paths)
+
+
+def get_accuracy_flags(wildcards, input):
+    """``--dual-coords F --dual-view F`` or ``--pushbroom F [--reference R]`` of the accuracy step."""
+    stages = capture(wildcards.ds).stages
+    flags = [
+        f"{ACCURACY_STAGE_FLAGS[stage]} {path}"
+        for stage, path in zip(stages, _as_list(input.stages))
+    ]
+    flags += [f"--reference {path}" for path in _as_list(input.reference)]
+    return " ".join(flags)
