@@ -405,12 +405,11 @@ def camera_linear(times, sweeps, *, light="point", dual_shape=None, time_std=Non
     m_aa, m_ab, m_bb = (weight * a * a).sum(0), (weight * a * b).sum(0), (weight * b * b).sum(0)
     r_a, r_b = (weight * a * rhs).sum(0), (weight * b * rhs).sum(0)
     det = m_aa * m_bb - m_ab**2
-    # crossing sine of the best pair of timed sweeps (unit wire normals)
-    unit = rows[:, :2] / np.linalg.norm(rows[:, :2], axis=1, keepdims=True)
+    # crossing sine of the best pair of timed sweeps (the same sines as the refusal above)
     sine = np.zeros(stack.shape[1:])
     for i in range(len(sweeps)):
         for j in range(i + 1, len(sweeps)):
-            s_ij = abs(unit[i, 0] * unit[j, 1] - unit[i, 1] * unit[j, 0])
+            s_ij = _pair_sine(sweeps[i], sweeps[j])
             sine = np.where(have[i] & have[j], np.maximum(sine, s_ij), sine)
     timed = have.sum(0) >= 2
     ok = timed & (sine >= limit) & (det > 0)

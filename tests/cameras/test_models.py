@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from shadowcam.cameras.models import (
@@ -134,6 +134,7 @@ GRID_V, GRID_U = np.mgrid[0:32:4, 0:32:4].astype(np.float64)
 
 @settings(max_examples=40, deadline=None)
 @given(angle=st.floats(0.0, 180.0), speed=st.floats(0.05, 20.0), ratio=st.floats(0.01, 100.0))
+@example(angle=15.0, speed=1.0, ratio=3.0)  # exactly at min_sweep_angle_deg
 def test_exact_times_give_exact_coordinates_or_a_reason(angle, speed, ratio):
     """Any slant (near 0 or 90 deg too) and speeds differing up to 100x: the exact times of
     two sweeps give back (u, v), or the pixels are marked ill_conditioned (never wrong)."""
