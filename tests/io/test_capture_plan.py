@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from shadowcam.cameras.dual_coords import choose_dual_model
 from shadowcam.cli import main
@@ -349,3 +351,48 @@ def test_manifest_sweep_lights_all_or_none(lab):
         capture_plan(write_capture(lab, lab_doc(sweeps=sweeps)))
     sweeps["v"]["light_position"] = [0.1, 0, 1]
     assert capture_plan(write_capture(lab, lab_doc(sweeps=sweeps))).camera_model == "cross_slit"
+
+
+def _plan_or_error(doc):
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        try:
+            return plan_of(Path(folder), doc), None
+        except ValueError as err:
+            return None, str(err)
+
+
+@settings(max_examples=40, deadline=None)
+@given(angle=st.floats(-360, 360), delta=st.floats(0.0, 30.0), speed_a=st.floats(0.01, 100.0),
+       speed_b=st.floats(0.01, 100.0))
+def test_camera_block_geometry_gives_a_camera_or_names_the_key(angle, delta, speed_a, speed_b):
+    """Nearly parallel pairs, slants near 0/90, speeds 100x apart: a model or a clear error."""
+    sweeps = [{"name": "a", "direction_deg": angle, "speed": speed_a},
+              {"name": "b", "direction_deg": angle + delta, "speed": speed_b}]
+    plan, error = _plan_or_error(camera_doc(sweeps))
+    sine = abs(math.sin(math.radians(delta)))
+    if sine < math.sin(math.radians(15.0)) - 1e-9:
+        assert plan is None and "key 'synthetic.camera.sweeps'" in error and "parallel" in error
+        return
+    if sine > math.sin(math.radians(15.0)) + 1e-9:
+        assert error is None, error
+        assert plan.camera_model in ("linear", "perspective")
+        for name, speed, theta in (("a", speed_a, angle), ("b", speed_b, angle + delta)):
+            extent = 16 * (abs(math.cos(math.radians(theta))) + abs(math.sin(math.radians(theta))))
+            assert plan.n_frames(name) == max(2, math.ceil(extent / speed - 1e-9))
+
+
+@settings(max_examples=25, deadline=None)
+@given(delta=st.floats(0.0, 90.0), offset=st.floats(-0.05, 0.05))
+def test_cross_slit_request_is_a_camera_or_a_clear_error(delta, offset):
+    """Degenerate cross-slit set-ups (parallel wires, one light) are refused by key."""
+    sweeps = [{"name": "a"}, {"name": "b", "direction_deg": delta,
+                              "light_offset": [offset, 0.0, 0.0]}]
+    plan, error = _plan_or_error(camera_doc(sweeps, model="cross_slit"))
+    if abs(math.sin(math.radians(delta))) < math.sin(math.radians(15.0)) - 1e-9:
+        assert plan is None and "parallel" in error
+    elif offset == 0.0:
+        assert plan is None and "needs two sweeps, each with its own light" in error
+    elif abs(math.sin(math.radians(delta))) > math.sin(math.radians(15.0)) + 1e-9:
+        assert error is None and plan.camera_model == "cross_slit"
