@@ -7,6 +7,7 @@ flags) override the manifest, which overrides the defaults.
 Offers
 ------
 DEFAULTS : option -> default of every capture.
+OPTIONAL_KEYS : ``synthetic`` keys held only when the manifest gives them (camera, shutter).
 OUTDOOR_OPTIONS : keys of the ``synthetic.outdoor`` block and their defaults.
 FORMATS, BIT_DEPTHS : allowed frame formats and sensor bit depths.
 capture_options : merge defaults, a manifest and overrides into validated options.
@@ -27,6 +28,10 @@ DEFAULTS = {
     "format": "dng", "bit_depth": 12, "noise": True, "calibration": False,
     "light": "point", "supersample": 4, "exposure": 0.8, "outdoor": None,
 }
+#: ``synthetic`` keys without a default that a capture's options hold only when given:
+#: ``camera`` (the shadow camera to render), ``shutter`` (exposure of a lab frame as a
+#: fraction of the frame interval; absent = an instant)
+OPTIONAL_KEYS = ("camera", "shutter")
 #: scenes rendered as outdoor time-lapses
 OUTDOOR_SCENES = ("ridge",)
 FORMATS = ("dng", "tiff")
@@ -55,7 +60,7 @@ def _read_synthetic_block(path):
     if not isinstance(block, dict):
         raise ValueError(f"manifest {path}: key 'synthetic' is missing or not a mapping; "
                          "only synthetic datasets can be rendered")
-    unknown = set(block) - set(DEFAULTS) - {"camera"}
+    unknown = set(block) - set(DEFAULTS) - set(OPTIONAL_KEYS)
     if unknown:
         log.warning("manifest %s: ignoring unknown key(s) in 'synthetic': %s", path,
                     sorted(unknown))

@@ -34,6 +34,7 @@ from shadowcam.io.datasets import write_dataset
 from shadowcam.io.provenance import file_sha256
 from shadowcam.synthetic.capture_options import (
     DEFAULTS,
+    OPTIONAL_KEYS,
     accuracy_condition,
     lab_scene_description,
     outdoor_options,
@@ -187,7 +188,7 @@ def write_lab_capture(options, out_dir):
             folder = f"frames_{name}" if name in ("u", "v") else name
             noise_index = SWEEP_INDEX.get(name, EXTRA_SWEEP_INDEX + index)
             (tmp / folder).mkdir()
-            frames = renderer.frames(name)
+            frames = renderer.frames(name, shutter=float(options.get("shutter", 0.0)))
             n = len(frames)
             progress = Progress(n, f"render sweep {name}")
             for k in range(n):
@@ -200,8 +201,7 @@ def write_lab_capture(options, out_dir):
             del frames
         checksums = {rel: file_sha256(tmp / rel) for rel in written}
         config = {k: options[k] for k in DEFAULTS}
-        if options.get("camera"):
-            config["camera"] = options["camera"]
+        config.update({k: options[k] for k in OPTIONAL_KEYS if options.get(k) is not None})
         write_ground_truth(
             tmp, renderer.ground_truth, sensor=sensor, scale=scale, config=config,
             checksums=checksums, frame_format=ext,
