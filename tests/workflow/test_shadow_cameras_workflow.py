@@ -53,3 +53,9 @@ def test_every_shadow_camera_runs_from_its_manifest_to_accuracy(tmp_path, workfl
     intrinsics = capture_plan(Path(workdir) / "results" / "synthetic_intrinsics" / "capture"
                               / "capture.json")
     assert intrinsics.timed_sweeps == ("u", "v", "s")
+    # the slanted sweep's slant and speed measured from the shadow times alone
+    report = json.loads((Path(workdir) / "results" / "synthetic_intrinsics" / "accuracy.json")
+                        .read_text())
+    rows = {t["target"]: t for t in report["targets"] if t["sweep"] == "s"}
+    assert rows["sweep_angle_error_deg"]["value"] <= 0.5 and rows["sweep_angle_error_deg"]["pass"]
+    assert rows["sweep_speed_rel_error"]["value"] <= 0.01 and rows["sweep_speed_rel_error"]["pass"]
