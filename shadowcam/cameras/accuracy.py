@@ -32,6 +32,7 @@ import math
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.cameras.models import sweep_rows
 from shadowcam.cameras.straightness import edge_straightness
 
 
@@ -213,8 +214,6 @@ def sweep_geometry_errors(times, sweeps, *, dual_shape, min_points=50):
     ValueError
         Fewer than three sweeps, a sweep without times, the first two sweeps parallel.
     """
-    from shadowcam.cameras.models import sweep_rows
-
     if len(sweeps) < 3:
         raise ValueError(f"sweeps: need at least three (two define the dual axes); got {len(sweeps)}")
     missing = [s["name"] for s in sweeps if s["name"] not in times]
