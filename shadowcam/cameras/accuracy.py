@@ -11,6 +11,10 @@ cross-slit camera, against its exact pair of times). Here:
   stay parallel in an orthographic view: the spread of the directions of their fitted lines.
 * redundancy: the dual-coordinate RMSE of the linear camera from all sweeps over that from
   two of them.
+* sweep geometry (virtual intrinsics, Fig. 12): the slant and speed of every sweep beyond the
+  first two, measured from the shadow times alone (their affine relation to the first two
+  sweeps' times, mapped to dual coordinates with the first two sweeps' declared geometry),
+  against the declared ``angle_deg`` and ``speed``.
 
 Offers
 ------
@@ -18,6 +22,9 @@ sample_coordinates : estimated (u, v) maps read at sub-pixel camera positions (b
 straightness_primal_dual : straightness of edges in the primal view and in the estimated dual view.
 line_direction_spread : spread (deg) of the directions of the lines fitted to labelled point sets.
 redundancy_gain : RMSE ratio of the linear camera from a subset of sweeps over all sweeps.
+SWEEP_GEOMETRY_TARGETS : tolerances of the measured sweep slant (deg) and speed (relative).
+sweep_geometry_errors : measured slant and speed of the extra sweeps against their declaration.
+sweep_geometry_targets : target rows (value, threshold, pass) of those errors.
 """
 
 import math
@@ -25,6 +32,7 @@ import math
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.cameras.models import sweep_rows
 from shadowcam.cameras.straightness import edge_straightness
 
 
@@ -148,3 +156,108 @@ def redundancy_gain(errors_subset, errors_all):
         > 1 when the extra sweeps lower the error.
     """
     return float(errors_subset["rmse"] / errors_all["rmse"])
+
+
+#: tolerances of the sweep-geometry check: slant error (deg) and relative speed error
+SWEEP_GEOMETRY_TARGETS = {"angle_error_deg": 0.5, "speed_rel_error": 0.01}
+
+
+def _trimmed_affine(t, t_a, t_b, *, min_points, rounds=3, k=4.0):
+    """Least-squares ``t = alpha t_a + beta t_b + c`` on finite pixels, dropping residuals
+    beyond `k` robust sigmas (1.4826 MAD) in each round."""
+    ok = np.isfinite(t) & np.isfinite(t_a) & np.isfinite(t_b)
+    if ok.sum() < min_points:
+        return None, int(ok.sum())
+    design = np.column_stack([t_a[ok], t_b[ok], np.ones(int(ok.sum()))])
+    target = t[ok]
+    keep = np.ones(len(target), dtype=bool)
+    for _ in range(rounds):
+        coef, *_ = np.linalg.lstsq(design[keep], target[keep], rcond=None)
+        residual = design @ coef - target
+        sigma = 1.4826 * np.median(np.abs(residual[keep])) + 1e-12
+        new = np.abs(residual) <= k * sigma
+        if new.sum() < min_points or np.array_equal(new, keep):
+            break
+        keep = new
+    return coef, int(keep.sum())
+
+
+def sweep_geometry_errors(times, sweeps, *, dual_shape, min_points=50):
+    """Measured slant and speed of every sweep beyond the first two, against the declaration.
+
+    The first two sweeps define the dual coordinates (their declared rows
+    ``t = a u + b v + c``, :func:`shadowcam.cameras.models.sweep_rows`); a further sweep's
+    times are fitted as ``t_k = alpha t_1 + beta t_2 + c`` (trimmed least squares), which in
+    dual coordinates is the row ``(a_k, b_k) = (alpha, beta) M`` with ``M`` the first two
+    rows; slant ``atan2(b_k, a_k)`` and speed ``1 / hypot(a_k, b_k)``.
+
+    Parameters
+    ----------
+    times : mapping of str to (rows, cols) ndarray
+        Measured shadow times per sweep (frames, NaN = none).
+    sweeps : list of dict
+        :func:`shadowcam.cameras.models.declared_sweeps` with ``frames``; at least three.
+    dual_shape : (int, int)
+        ``(N_v, N_u)`` of the dual grid.
+    min_points : int
+        Pixels timed in all three sweeps needed for a fit.
+
+    Returns
+    -------
+    dict
+        Per extra sweep: ``angle_deg`` (declared), ``angle_measured_deg``,
+        ``angle_error_deg`` (wrapped to [-180, 180)), ``speed``, ``speed_measured``,
+        ``speed_rel_error``, ``n_points``; NaN measures when fewer than `min_points`.
+
+    Raises
+    ------
+    ValueError
+        Fewer than three sweeps, a sweep without times, the first two sweeps parallel.
+    """
+    if len(sweeps) < 3:
+        raise ValueError(f"sweeps: need at least three (two define the dual axes); got {len(sweeps)}")
+    missing = [s["name"] for s in sweeps if s["name"] not in times]
+    if missing:
+        raise ValueError(f"times: no shadow times of sweeps {missing}")
+    rows = sweep_rows(sweeps, dual_shape=dual_shape)
+    basis = rows[:2, :2]
+    if abs(np.linalg.det(basis)) < 1e-9 * np.abs(basis).max() ** 2:
+        raise ValueError(f"sweeps: the first two sweeps {[s['name'] for s in sweeps[:2]]} are "
+                         "parallel; they cannot define the dual axes")
+    t_a, t_b = (np.asarray(times[s["name"]], dtype=np.float64) for s in sweeps[:2])
+    out = {}
+    for sweep in sweeps[2:]:
+        coef, n = _trimmed_affine(np.asarray(times[sweep["name"]], dtype=np.float64), t_a, t_b,
+                                  min_points=int(min_points))
+        entry = {"angle_deg": float(sweep["angle_deg"]), "speed": float(sweep["speed"]),
+                 "n_points": n, "angle_measured_deg": math.nan, "angle_error_deg": math.nan,
+                 "speed_measured": math.nan, "speed_rel_error": math.nan}
+        if coef is not None:
+            a_k, b_k = np.asarray(coef[:2]) @ basis
+            measured = math.degrees(math.atan2(b_k, a_k))
+            speed = 1.0 / math.hypot(a_k, b_k)
+            entry.update(angle_measured_deg=measured, speed_measured=speed,
+                         angle_error_deg=(measured - sweep["angle_deg"] + 180.0) % 360.0 - 180.0,
+                         speed_rel_error=speed / sweep["speed"] - 1.0)
+        out[sweep["name"]] = entry
+    return out
+
+
+def sweep_geometry_targets(errors):
+    """Target rows of :func:`sweep_geometry_errors` (``|error| <=`` :data:`SWEEP_GEOMETRY_TARGETS`).
+
+    Returns
+    -------
+    list of dict
+        ``target`` (``sweep_angle_error_deg`` or ``sweep_speed_rel_error``), ``sweep``,
+        ``value`` (absolute error), ``threshold``, ``comparison`` (``<=``), ``pass``
+        (False for a NaN measure).
+    """
+    rows = []
+    for sweep, entry in errors.items():
+        for key, threshold in SWEEP_GEOMETRY_TARGETS.items():
+            value = abs(float(entry[key]))
+            rows.append({"target": f"sweep_{key}", "sweep": sweep, "value": value,
+                         "threshold": threshold, "comparison": "<=",
+                         "pass": bool(value <= threshold)})
+    return rows

@@ -38,6 +38,7 @@ SWEEP_KEYS : keys of a sweep declaration.
 REASON_FLAGS : reason code -> meaning (those of ``dual_coords`` and ``inconsistent``).
 CAMERA_MODELS : model name -> function ``(times, sweeps, **options) -> (u, v, valid, reason, info)``.
 declared_sweeps : normalised sweep declarations of a capture description.
+frames_to_cross : frames a sweep needs to cross the dual field at its speed.
 choose_camera_model : the camera a capture description needs (``auto``) or a checked request.
 sweep_rows : the rows ``(a, b, c)`` of ``t_k = a u + b v + c`` of declared sweeps.
 estimate_sweep : a sweep's angle, speed and offset from its times and the u/v sweeps' times.
@@ -86,6 +87,30 @@ def _light_key(sweep):
             value = tuple(float(x) for x in sweep[key])
             return None if key == "light_offset" and not any(value) else (key, value)
     return ("light", id(sweep["light"])) if sweep.get("light") is not None else None
+
+
+def frames_to_cross(dual_shape, angle_deg, speed):
+    """Frames a sweep needs for its wire to cross the whole dual field.
+
+    Parameters
+    ----------
+    dual_shape : (int, int)
+        ``(N_v, N_u)`` of the dual grid.
+    angle_deg : float
+        Wire angle theta (motion ``cos(theta) e_u + sin(theta) e_v``, perpendicular to the wire).
+    speed : float
+        Perpendicular step per frame, dual pixels (> 0).
+
+    Returns
+    -------
+    int
+        ``max(2, ceil((N_u |cos theta| + N_v |sin theta|) / speed))``.
+    """
+    check_positive(speed, "speed", finite=True)
+    n_v, n_u = (int(n) for n in dual_shape)
+    cos_a, sin_a = _cos_sin(angle_deg)
+    extent = n_u * abs(cos_a) + n_v * abs(sin_a)
+    return max(2, math.ceil(extent / float(speed) - 1e-9))
 
 
 def declared_sweeps(description, *, n_frames=None):

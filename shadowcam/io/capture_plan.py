@@ -9,11 +9,16 @@ workflow plans jobs from: frame counts, the frame shape, the frame times,
 whether there is a reference frame, calibration sweeps and ground truth,
 whether the capture is outdoor or lab, which sweeps are timed, which dual
 coordinate model runs (both scene sweeps) or that the capture is a shadow
-pushbroom (one scene sweep), and the halo of an edge-tracking strip.
+pushbroom (one scene sweep), the shadow camera the lab sweeps make (decided once
+by :func:`shadowcam.cameras.models.choose_camera_model` from the sweep geometry:
+direction, speed and light of each sweep) and the halo of an edge-tracking strip.
 
 A manifest with a ``synthetic:`` block (and no ``sweeps``) describes a capture
 the renderer writes; its plan takes the frame count and shape from that block
-and has no files yet.
+and has no files yet. Its optional ``synthetic.camera`` block declares the
+shadow camera to render (sweeps, primal camera, optics); each sweep's frame
+count is what its wire needs to cross the rendered dual field
+(:func:`shadowcam.cameras.models.frames_to_cross`, the renderer's own rule).
 
 Offers
 ------
@@ -21,7 +26,7 @@ SCENE_SWEEPS : the two perpendicular scene sweeps of a lab capture.
 CALIBRATION_SWEEPS : the calibration-plane sweeps of a lab capture.
 OUTDOOR_SWEEP : preferred name of the time-lapse sweep of an outdoor capture.
 PLANNED_SHIFT_COLUMNS : camera shake (columns) the planned strip halo allows for.
-SweepPlan : one sweep: name, files, frame count, frame times, axis.
+SweepPlan : one sweep: name, files, frame count, frame times, axis, geometry.
 CapturePlan : the plan of one capture (frozen dataclass).
 capture_plan : read a manifest into a :class:`CapturePlan`.
 """
@@ -46,7 +51,8 @@ OUTDOOR_SWEEP = "timelapse"
 #: camera shake (columns) the planned strip halo allows for; a strip job sizes its own
 #: halo from the registration shifts it reads (shadowcam.outdoor.strips.strip_halo)
 PLANNED_SHIFT_COLUMNS = 4
-#: dual-coordinate models that may be requested ("auto" picks one of the other two)
+#: optics of a rendered lab camera (``synthetic.camera.optics``)
+OPTICS = ("none", "mirror", "glass")
 
 
 @dataclass(frozen=True)
@@ -65,6 +71,14 @@ class SweepPlan:
         Frame time of each file in seconds (empty for a capture not rendered yet).
     axis : str or None
         Dual axis the sweep measures (``u`` or ``v``), if the manifest says.
+    direction_deg : float or None
+        Lab scene sweep: wire motion direction in the mask plane (degrees from dual u
+        toward v); None for other sweeps.
+    speed : float or None
+        Lab scene sweep: wire speed relative to the other sweeps (dual pixels per frame).
+    light : tuple of float or None
+        Lab scene sweep with its own light: ``light_offset`` (rendered) or
+        ``light_position`` (manifest sweeps); None = the capture's light.
     """
 
     name: str
@@ -72,6 +86,9 @@ class SweepPlan:
     n_frames: int = 0
     times_s: tuple = ()
     axis: str = None
+    direction_deg: float = None
+    speed: float = None
+    light: tuple = None
 
 
 @dataclass(frozen=True)
@@ -108,6 +125,14 @@ class CapturePlan:
     scene_sweeps : tuple of str
         The scene sweeps of a lab capture: ``u, v``, or the one of a single-sweep capture
         (empty outdoors).
+    camera_model : str or None
+        Lab: the shadow camera the scene sweeps make, a key of
+        :data:`shadowcam.cameras.models.CAMERA_MODELS` (``perspective``, ``orthographic``,
+        ``linear``, ``cross_slit`` or ``pushbroom``).
+    camera : mapping
+        Lab: the capture description the camera models read (``light``, ``sweeps``:
+        declarations ``name, angle_deg, speed, frames`` and ``light_offset`` per scene
+        sweep) plus, for a rendered camera block, ``primal`` and ``optics``.
     stages : tuple of str
         Lab stages after the shadow times that the capture supports: ``dual_coords,
         dual_view`` with both scene sweeps, ``pushbroom`` with one (empty outdoors).
@@ -134,6 +159,8 @@ class CapturePlan:
     has_calibration: bool = False
     dual_model: str = None
     scene_sweeps: tuple = ()
+    camera_model: str = None
+    camera: MappingProxyType = field(default_factory=lambda: MappingProxyType({}))
     stages: tuple = ()
     timed_sweeps: tuple = ()
     outdoor_sweep: str = None
@@ -193,20 +220,99 @@ def _rendered_sweeps(manifest):
         names = (OUTDOOR_SWEEP,)
     else:
         names = SCENE_SWEEPS + (CALIBRATION_SWEEPS if synthetic.get("calibration", False) else ())
-    return {name: SweepPlan(name=name, n_frames=int(synthetic["frames"])) for name in names}
+    direction = {"u": 0.0, "v": 90.0}
+    return {name: SweepPlan(name=name, n_frames=int(synthetic["frames"]),
+                            direction_deg=direction.get(name),
+                            speed=1.0 if name in direction else None)
+            for name in names}
+
+
+def _rendered_camera_sweeps(manifest, path):
+    """Sweeps of a ``synthetic.camera`` block; frame counts cross the rendered dual field."""
+    from shadowcam.cameras.models import frames_to_cross
+
+    synthetic = manifest["synthetic"]
+    n = int(synthetic["frames"])  # the rendered mask plane has a frames x frames dual grid
+    sweeps = {}
+    for index, entry in enumerate(synthetic["camera"]["sweeps"]):
+        name = entry["name"]
+        if name in sweeps:
+            raise ValueError(f"manifest {path}: key 'synthetic.camera.sweeps[{index}].name': "
+                             f"duplicate sweep name {name!r}; give each sweep its own name")
+        offset = entry.get("light_offset")
+        if offset is not None and manifest["light"] == "distant":
+            raise ValueError(f"manifest {path}: key 'synthetic.camera.sweeps[{index}]"
+                             ".light_offset' shifts a point or area light, but 'light' is "
+                             "distant; use light: point (or area) for a cross-slit camera")
+        angle, speed = float(entry.get("direction_deg", 0.0)), float(entry.get("speed", 1.0))
+        sweeps[name] = SweepPlan(
+            name=name, n_frames=frames_to_cross((n, n), angle, speed), direction_deg=angle,
+            speed=speed, light=None if offset is None else tuple(float(x) for x in offset))
+    if synthetic.get("calibration", False):
+        for name in list(sweeps):
+            sweeps[f"cal_{name}"] = SweepPlan(name=f"cal_{name}", n_frames=sweeps[name].n_frames)
+    return sweeps
 
 
 def _user_sweeps(manifest):
-    return {
-        name: SweepPlan(
+    out = {}
+    for name, entry in manifest["sweeps"].items():
+        default = {"u": 0.0, "v": 90.0}.get(name)
+        scene = name in SCENE_SWEEPS or entry.get("direction_deg") is not None
+        light = entry.get("light_position")
+        out[name] = SweepPlan(
             name=name,
             files=tuple(entry["paths"]),
             n_frames=len(entry["paths"]),
             times_s=tuple(float(t) for t in entry["times_s"]),
             axis=entry.get("axis"),
+            direction_deg=float(entry.get("direction_deg", default)) if scene else None,
+            speed=float(entry.get("speed", 1.0)) if scene else None,
+            light=None if light is None else tuple(float(x) for x in light),
         )
-        for name, entry in manifest["sweeps"].items()
-    }
+    return out
+
+
+def _scene_sweep_names(sweeps):
+    """Scene sweeps of a lab capture: u, v, then the others with a direction (manifest order)."""
+    named = tuple(s for s in SCENE_SWEEPS if s in sweeps)
+    others = tuple(n for n, s in sweeps.items() if n not in SCENE_SWEEPS
+                   and s.direction_deg is not None and not n.startswith("cal_"))
+    return named + others
+
+
+def _camera(manifest, sweeps, scene, path):
+    """The capture description of the scene sweeps and the camera model it needs (checked)."""
+    from shadowcam.cameras.models import choose_camera_model
+
+    rendered = "synthetic" in manifest
+    block = manifest["synthetic"].get("camera", {}) if rendered else {}
+    key = "synthetic.camera.sweeps" if block else "sweeps"
+    own = [name for name in scene if sweeps[name].light is not None]
+    if own and len(own) != len(scene) and not rendered:
+        raise ValueError(
+            f"manifest {path}: key 'sweeps.<name>.light_position' is given for sweeps {own} "
+            f"but not for {[n for n in scene if n not in own]}; give every scene sweep its "
+            "light position (cross-slit camera) or none (one light)")
+    declared = []
+    for name in scene:
+        sweep = sweeps[name]
+        declaration = {"name": name, "angle_deg": sweep.direction_deg, "speed": sweep.speed,
+                       "frames": sweep.n_frames}
+        if sweep.light is not None:
+            declaration["light_offset"] = list(sweep.light)
+        declared.append(declaration)
+    description = {"light": manifest["light"], "sweeps": declared}
+    if block:
+        description.update(primal=block.get("primal", "perspective"),
+                           optics=block.get("optics", "none"))
+    try:
+        model = choose_camera_model(description, block.get("model", "auto"))
+    except ValueError as err:
+        text = str(err).replace("description.sweeps", "sweeps").replace(
+            "description.light", "light")
+        raise ValueError(f"manifest {path}: key '{key}': {text}") from None
+    return model, description
 
 
 def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
@@ -232,7 +338,11 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         Naming the manifest and the key when the manifest does not match the
         schema, a file or glob it references is missing, its checksums block
         does not list a file, frame times cannot be resolved, a lab capture lacks
-        a scene sweep (``u`` or ``v``), an outdoor capture has several sweeps and
+        a scene sweep (``u``, ``v`` or one with ``direction_deg``), the sweep geometry is
+        inconsistent (all scene sweeps (nearly) parallel, ``light_position`` on some
+        scene sweeps only, a requested camera model the sweeps cannot give, e.g.
+        ``cross_slit`` without a light per sweep, a ``light_offset`` under a distant
+        light, duplicate sweep names), an outdoor capture has several sweeps and
         none named ``timelapse``, `dual_model` is ``calibration`` without
         calibration sweeps, or the first frames of the sweeps and the reference
         differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`).
@@ -240,7 +350,12 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
     manifest = load_manifest(manifest_path)
     path = manifest["manifest_path"]
     rendered = "synthetic" in manifest
-    sweeps = _rendered_sweeps(manifest) if rendered else _user_sweeps(manifest)
+    if rendered and "camera" in manifest["synthetic"] and manifest["kind"] == "lab":
+        sweeps = _rendered_camera_sweeps(manifest, path)
+    elif rendered:
+        sweeps = _rendered_sweeps(manifest)
+    else:
+        sweeps = _user_sweeps(manifest)
     outdoor = manifest["kind"] == "outdoor"
     facts = {}
     if outdoor:
@@ -253,7 +368,7 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         first = OUTDOOR_SWEEP if OUTDOOR_SWEEP in names else names[0]
         facts.update(outdoor_sweep=first, strip_halo=_planned_halo(edge_margin))
     else:
-        scene = tuple(s for s in SCENE_SWEEPS if s in sweeps)
+        scene = _scene_sweep_names(sweeps)
         if not scene:
             raise ValueError(
                 f"manifest {path}: key 'sweeps' has no scene sweep; a lab capture needs sweep u "
@@ -261,19 +376,23 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
             )
         first = scene[0]
     calibration = all(s in sweeps for s in CALIBRATION_SWEEPS) and (rendered or "calibration_plane" in manifest)
+    if not outdoor:
+        camera_model, description = _camera(manifest, sweeps, scene, path)
+        facts.update(scene_sweeps=scene, camera_model=camera_model,
+                     camera=MappingProxyType(description))
     if not outdoor and len(scene) == 1:
-        facts.update(scene_sweeps=scene, stages=("pushbroom",), timed_sweeps=scene)
+        facts.update(stages=("pushbroom",), timed_sweeps=scene)
     elif not outdoor:
         model = choose_dual_model(
             dual_model,
             calibration_available=calibration,
             missing=f"the calibration sweeps cal_u, cal_v and calibration_plane in manifest {path}",
         )
+        calibration_sweeps = tuple(f"cal_{name}" for name in scene if f"cal_{name}" in sweeps)
         facts.update(
             dual_model=model,
-            scene_sweeps=SCENE_SWEEPS,
             stages=("dual_coords", "dual_view"),
-            timed_sweeps=SCENE_SWEEPS + (CALIBRATION_SWEEPS if model == "calibration" else ()),
+            timed_sweeps=scene + (calibration_sweeps if model == "calibration" else ()),
         )
     if rendered:
         shape = (int(manifest["synthetic"]["height"]), int(manifest["synthetic"]["width"]))

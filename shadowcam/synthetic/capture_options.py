@@ -7,11 +7,14 @@ flags) override the manifest, which overrides the defaults.
 Offers
 ------
 DEFAULTS : option -> default of every capture.
+OPTIONAL_KEYS : ``synthetic`` keys held only when the manifest gives them (camera, shutter).
 OUTDOOR_OPTIONS : keys of the ``synthetic.outdoor`` block and their defaults.
 FORMATS, BIT_DEPTHS : allowed frame formats and sensor bit depths.
 capture_options : merge defaults, a manifest and overrides into validated options.
 outdoor_options : merge the ``outdoor`` block over :data:`OUTDOOR_OPTIONS` (validated).
 accuracy_condition : ``clean`` or ``nuisances`` (which accuracy targets apply) of an outdoor capture.
+lab_scene_description : the scene description (``scene_from_description``) of lab options,
+    with the manifest's ``synthetic.camera`` block (sweeps, primal camera, optics).
 """
 
 import logging
@@ -25,6 +28,10 @@ DEFAULTS = {
     "format": "dng", "bit_depth": 12, "noise": True, "calibration": False,
     "light": "point", "supersample": 4, "exposure": 0.8, "outdoor": None,
 }
+#: ``synthetic`` keys without a default that a capture's options hold only when given:
+#: ``camera`` (the shadow camera to render), ``shutter`` (exposure of a lab frame as a
+#: fraction of the frame interval; absent = an instant)
+OPTIONAL_KEYS = ("camera", "shutter")
 #: scenes rendered as outdoor time-lapses
 OUTDOOR_SCENES = ("ridge",)
 FORMATS = ("dng", "tiff")
@@ -53,7 +60,7 @@ def _read_synthetic_block(path):
     if not isinstance(block, dict):
         raise ValueError(f"manifest {path}: key 'synthetic' is missing or not a mapping; "
                          "only synthetic datasets can be rendered")
-    unknown = set(block) - set(DEFAULTS)
+    unknown = set(block) - set(DEFAULTS) - set(OPTIONAL_KEYS)
     if unknown:
         log.warning("manifest %s: ignoring unknown key(s) in 'synthetic': %s", path,
                     sorted(unknown))
@@ -77,7 +84,8 @@ def capture_options(manifest=None, *, name=None, **overrides):
     Returns
     -------
     options : dict
-        Keys of :data:`DEFAULTS` plus ``name``, ``kind`` (``lab`` or ``outdoor``), ``description``.
+        Keys of :data:`DEFAULTS` plus ``name``, ``kind`` (``lab`` or ``outdoor``), ``description``
+        and, when the manifest has one, ``camera`` (its ``synthetic.camera`` block).
 
     Raises
     ------
@@ -131,3 +139,38 @@ def accuracy_condition(noise, outdoor):
     nuisances = (noise, outdoor["auto_exposure"], outdoor["shake_px"] > 0, outdoor["cloud"],
                  outdoor["irregular_timing"], outdoor["dropped_frames"] > 0)
     return "nuisances" if any(nuisances) else "clean"
+
+
+def lab_scene_description(options):
+    """The lab scene a capture's options ask for, as ``scene_from_description`` reads it.
+
+    Parameters
+    ----------
+    options : dict
+        :func:`capture_options` of a lab capture; its optional ``camera`` block (manifest
+        ``synthetic.camera``: ``primal``, ``optics``, ``sweeps`` of ``{name, direction_deg,
+        speed, light_offset}``) maps to the scene's ``camera``, ``optics`` and
+        ``sweeps`` (wire angle = motion direction, motion perpendicular to the wire).
+
+    Returns
+    -------
+    dict
+        ``scene, seed, height, width, frames, light`` and, with a camera block, ``camera``,
+        ``sweeps`` and ``optics`` (None for ``none``).
+    """
+    description = {key: options[key] for key in ("scene", "seed", "height", "width", "frames",
+                                                  "light")}
+    block = options.get("camera")
+    if not block:
+        return description
+    specs = []
+    for entry in block["sweeps"]:
+        spec = {"name": entry["name"], "angle_deg": float(entry.get("direction_deg", 0.0)),
+                "speed": float(entry.get("speed", 1.0))}
+        if entry.get("light_offset") is not None:
+            spec["light_offset"] = [float(x) for x in entry["light_offset"]]
+        specs.append(spec)
+    optics = block.get("optics", "none")
+    description.update(camera=block.get("primal", "perspective"), sweeps=specs,
+                       optics=None if optics == "none" else {"kind": optics})
+    return description

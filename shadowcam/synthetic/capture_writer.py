@@ -32,12 +32,20 @@ from shadowcam._shared.atomic import atomic_directory
 from shadowcam._shared.progress import Progress
 from shadowcam.io.datasets import write_dataset
 from shadowcam.io.provenance import file_sha256
-from shadowcam.synthetic.capture_options import DEFAULTS, accuracy_condition, outdoor_options
+from shadowcam.synthetic.capture_options import (
+    DEFAULTS,
+    OPTIONAL_KEYS,
+    accuracy_condition,
+    lab_scene_description,
+    outdoor_options,
+)
 
 log = logging.getLogger(__name__)
 
 #: capture start time written into the lab DNGs; frame k of every sweep is k seconds later
 CAPTURE_START = datetime.datetime(2024, 1, 1, 0, 0, 0)
+#: noise seed index of lab sweeps other than u, v, cal_u, cal_v: this plus the sweep's position
+EXTRA_SWEEP_INDEX = 10
 #: outdoor noise seeds are ``[seed, TIMELAPSE_SWEEP_INDEX, frame]``
 TIMELAPSE_SWEEP_INDEX = 5
 #: calendar date written with the apparent solar time of each outdoor frame
@@ -129,16 +137,36 @@ def write_capture(options, out_dir):
     return writer(options, Path(out_dir))
 
 
+def _sweep_geometry(options, scene, name):
+    """capture.json keys of a lab sweep: axis (u, v) and, with a camera block, its geometry."""
+    base = name.removeprefix("cal_")
+    out = {"axis": base} if base in ("u", "v") else {}
+    block = options.get("camera")
+    if not block or name.startswith("cal_"):
+        return out
+    entry = next(e for e in block["sweeps"] if e["name"] == name)
+    out.update(direction_deg=float(entry.get("direction_deg", 0.0)),
+               speed=float(entry.get("speed", 1.0)))
+    if any(e.get("light_offset") is not None for e in block["sweeps"]):
+        light = scene.sweeps[name].light or scene.light
+        out["light_position"] = [float(x) for x in light.position]
+    return out
+
+
 def write_lab_capture(options, out_dir):
     """Render the lab capture described by `options` into `out_dir` (see :func:`write_capture`)."""
     from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
-    from shadowcam.synthetic.lab.scenes import make_scene
+    from shadowcam.synthetic.lab.scenes import scene_from_description
     from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
     started = time.perf_counter()
-    scene = make_scene(options["scene"], seed=options["seed"], height=options["height"],
-                       width=options["width"], frames=options["frames"],
-                       light_kind=options["light"])
+    try:
+        scene = scene_from_description(lab_scene_description(options))
+    except ValueError as err:
+        if not options.get("camera"):
+            raise
+        text = str(err).replace("specs[", "sweeps[")
+        raise ValueError(f"capture {options['name']!r}: key 'synthetic.camera': {text}") from None
     renderer = prepare_capture(scene, supersample=options["supersample"],
                                calibration=options["calibration"])
     log.info("static rays cast in %.2f s", time.perf_counter() - started)
@@ -156,22 +184,24 @@ def write_lab_capture(options, out_dir):
               when=CAPTURE_START)
         written.append(ref_name)
         sweeps = {}
-        for name in renderer.sweep_names:
+        for index, name in enumerate(renderer.sweep_names):
             folder = f"frames_{name}" if name in ("u", "v") else name
+            noise_index = SWEEP_INDEX.get(name, EXTRA_SWEEP_INDEX + index)
             (tmp / folder).mkdir()
-            frames = renderer.frames(name)
+            frames = renderer.frames(name, shutter=float(options.get("shutter", 0.0)))
             n = len(frames)
             progress = Progress(n, f"render sweep {name}")
             for k in range(n):
                 rel = f"{folder}/{k:06d}.{ext}"
-                write(tmp / rel, frames[k], seed=[seed, SWEEP_INDEX[name], k],
+                write(tmp / rel, frames[k], seed=[seed, noise_index, k],
                       when=CAPTURE_START + datetime.timedelta(seconds=k))
                 written.append(rel)
                 progress.update(k + 1)
-            sweeps[name] = {"files": f"{folder}/*.{ext}", "axis": name.removeprefix("cal_")}
+            sweeps[name] = {"files": f"{folder}/*.{ext}", **_sweep_geometry(options, scene, name)}
             del frames
         checksums = {rel: file_sha256(tmp / rel) for rel in written}
         config = {k: options[k] for k in DEFAULTS}
+        config.update({k: options[k] for k in OPTIONAL_KEYS if options.get(k) is not None})
         write_ground_truth(
             tmp, renderer.ground_truth, sensor=sensor, scale=scale, config=config,
             checksums=checksums, frame_format=ext,

@@ -2,6 +2,8 @@
 view and straight in the estimated dual view; parallel edges stay parallel in the
 orthographic camera; a third sweep lowers the dual-coordinate error on a noisy render."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -70,3 +72,45 @@ def test_third_sweep_lowers_the_dual_coordinate_error_on_a_noisy_render(timed_ca
     e2 = dual_coord_errors(two["u"].values, two["v"].values, *truth, valid=common)
     e3 = dual_coord_errors(three["u"].values, three["v"].values, *truth, valid=common)
     assert redundancy_gain(e2, e3) > 1.05, (e2, e3)
+
+
+def _declared(v_speed=0.5):
+    from shadowcam.cameras.models import declared_sweeps
+
+    return declared_sweeps({"sweeps": [
+        {"name": "u", "angle_deg": 0.0, "frames": 48},
+        {"name": "v", "angle_deg": 90.0, "speed": v_speed, "frames": 96},
+        {"name": "s", "angle_deg": 60.0, "speed": 1.0, "frames": 66}]})
+
+
+def _exact_times(sweeps, shape=(48, 48), seed=0):
+    from shadowcam.cameras.models import sweep_rows
+
+    rng = np.random.default_rng(seed)
+    u, v = rng.uniform(0, shape[1] - 1, 4000), rng.uniform(0, shape[0] - 1, 4000)
+    rows = sweep_rows(sweeps, dual_shape=shape)
+    return {s["name"]: (r[0] * u + r[1] * v + r[2]).reshape(40, 100) for s, r in zip(sweeps, rows)}
+
+
+def test_sweep_geometry_from_exact_times_is_the_declaration():
+    from shadowcam.cameras.accuracy import sweep_geometry_errors
+
+    sweeps = _declared()
+    times = _exact_times(sweeps)
+    times["s"].flat[:40] += 7.0  # 1% wrong times (false dips) are trimmed
+    result = sweep_geometry_errors(times, sweeps, dual_shape=(48, 48))["s"]
+    assert abs(result["angle_error_deg"]) < 1e-6 and abs(result["speed_rel_error"]) < 1e-6
+
+
+def test_sweep_geometry_sees_a_wrong_speed_declaration():
+    """Times of v at half speed declared at unit speed: s looks slanted by
+    atan2(sin 60 / 2, cos 60) - 60 = -19.1 deg and faster."""
+    from shadowcam.cameras.accuracy import sweep_geometry_errors
+
+    times = _exact_times(_declared(0.5))
+    wrong = _declared(1.0)
+    result = sweep_geometry_errors(times, wrong, dual_shape=(48, 48))["s"]
+    expected = math.degrees(math.atan2(math.sin(math.radians(60)) / 2, 0.5)) - 60.0
+    assert result["angle_error_deg"] == pytest.approx(expected, abs=1e-6)
+    with pytest.raises(ValueError, match="at least three"):
+        sweep_geometry_errors(times, wrong[:2], dual_shape=(48, 48))

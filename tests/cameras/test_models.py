@@ -11,6 +11,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from shadowcam.cameras.models import (
+    frames_to_cross,
     CAMERA_MODELS,
     REASON_FLAGS,
     camera_coords_from_shadow_time,
@@ -198,3 +199,18 @@ def test_front_function_checks_the_data_against_the_description(timed_capture):
     with pytest.raises(ValueError, match="must match the 32 frames"):
         camera_coords_from_shadow_time(shadow_time, {"sweeps": [{"name": "u", "frames": 30},
                                                                 {"name": "v", "angle_deg": 90}]})
+
+
+@pytest.mark.parametrize(("shape", "angle", "speed", "expected"), [
+    ((48, 48), 0.0, 1.0, 48), ((48, 48), 90.0, 2.0, 24), ((30, 40), 0.0, 3.0, 14),
+    ((30, 40), 90.0, 1.0, 30), ((48, 48), 45.0, 1.0, math.ceil(48 * math.sqrt(2))),
+    ((4, 4), 0.0, 100.0, 2),
+])
+def test_frames_to_cross_the_dual_field(shape, angle, speed, expected):
+    assert frames_to_cross(shape, angle, speed) == expected
+
+
+
+def test_frames_to_cross_needs_a_positive_speed():
+    with pytest.raises(ValueError, match="speed"):
+        frames_to_cross((20, 20), 0.0, 0.0)

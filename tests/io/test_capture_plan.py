@@ -1,12 +1,15 @@
 """Tests of shadowcam.io.capture_plan: the facts the workflow plans jobs from."""
 
 import glob
+import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 import xarray as xr
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from shadowcam.cameras.dual_coords import choose_dual_model
 from shadowcam.cli import main
@@ -236,3 +239,160 @@ def test_repository_manifests_plan(repo, shared_data):
         plan = capture_plan(path)
         assert plan.name == path.stem
         assert all(sweep.n_frames >= 2 for sweep in plan.sweeps.values())
+
+
+def camera_doc(sweeps, *, light="point", frames=16, **camera):
+    return {
+        "name": "cam",
+        "kind": "lab",
+        "light": light,
+        "synthetic": {"scene": "tabletop", "seed": 0, "height": 24, "width": 24,
+                      "frames": frames, "camera": {"sweeps": sweeps, **camera}},
+    }
+
+
+def plan_of(tmp_path, doc):
+    return capture_plan(write_capture(tmp_path, doc, checksums=False))
+
+
+@pytest.mark.parametrize(("light", "primal", "optics", "model"), [
+    ("point", "perspective", "none", "perspective"),
+    ("distant", "perspective", "none", "orthographic"),
+    ("point", "orthographic", "none", "perspective"),
+    ("area", "perspective", "mirror", "perspective"),
+    ("point", "perspective", "glass", "perspective"),
+])
+def test_camera_block_standard_pair_decides_the_projection(tmp_path, light, primal, optics, model):
+    """The light decides the dual projection; primal camera and optics do not (Fig. 7, 8)."""
+    sweeps = [{"name": "u"}, {"name": "v", "direction_deg": 90}]
+    plan = plan_of(tmp_path, camera_doc(sweeps, light=light, primal=primal, optics=optics))
+    assert plan.camera_model == model
+    assert plan.scene_sweeps == ("u", "v") and plan.stages == ("dual_coords", "dual_view")
+    assert {n: s.n_frames for n, s in plan.sweeps.items()} == {"u": 16, "v": 16}
+    assert (plan.sweep("v").direction_deg, plan.sweep("v").speed) == (90.0, 1.0)
+    assert dict(plan.camera)["primal"] == primal and dict(plan.camera)["optics"] == optics
+
+
+def test_camera_block_slanted_stretched_sweeps_are_the_linear_camera(tmp_path):
+    """Frame counts come from the renderer's geometry: enough frames to cross the dual field."""
+    sweeps = [{"name": "u", "speed": 2.0}, {"name": "s", "direction_deg": 60, "speed": 0.5},
+              {"name": "v", "direction_deg": 90}]
+    plan = plan_of(tmp_path, camera_doc(sweeps, frames=16))
+    assert plan.camera_model == "linear"
+    assert plan.scene_sweeps == ("u", "v", "s")  # u, v first, then the others in order
+    n = 16  # mask grid of the tabletop preset = frames
+    expected_s = math.ceil(n * (math.cos(math.radians(60)) + math.sin(math.radians(60))) / 0.5)
+    assert plan.n_frames("u") == n // 2 and plan.n_frames("v") == n
+    assert plan.n_frames("s") == expected_s
+    declared = {d["name"]: d for d in plan.camera["sweeps"]}
+    assert declared["s"] == {"name": "s", "angle_deg": 60.0, "speed": 0.5, "frames": expected_s}
+
+
+def test_camera_block_cross_slit_needs_a_light_per_sweep(tmp_path):
+    sweeps = [{"name": "u", "light_offset": [0.01, 0.0, 0.0]},
+              {"name": "v", "direction_deg": 90, "light_offset": [0.0, 0.02, 0.0]}]
+    plan = plan_of(tmp_path, camera_doc(sweeps, model="cross_slit"))
+    assert plan.camera_model == "cross_slit"
+    assert plan.sweep("v").light == (0.0, 0.02, 0.0)
+    no_lights = [{"name": "u"}, {"name": "v", "direction_deg": 90}]
+    with pytest.raises(ValueError, match=r"key 'synthetic.camera.sweeps': model 'cross_slit' "
+                                         r"needs two sweeps, each with its own light"):
+        plan_of(tmp_path, camera_doc(no_lights, model="cross_slit"))
+
+
+def test_camera_block_parallel_sweeps_are_refused_at_plan_time(tmp_path):
+    sweeps = [{"name": "u"}, {"name": "a", "direction_deg": 180.0}, {"name": "b", "speed": 3.0,
+                                                                      "direction_deg": 5.0}]
+    with pytest.raises(ValueError, match=r"cam.yaml: key 'synthetic.camera.sweeps': sweeps "
+                                         r"\['u', 'a', 'b'\] are all \(nearly\) parallel"):
+        plan_of(tmp_path, camera_doc(sweeps))
+
+
+def test_camera_block_light_offset_needs_a_near_light(tmp_path):
+    sweeps = [{"name": "u"}, {"name": "v", "direction_deg": 90, "light_offset": [0.01, 0, 0]}]
+    with pytest.raises(ValueError, match=r"key 'synthetic.camera.sweeps\[1\].light_offset' "
+                                         r"shifts a point or area light, but 'light' is distant"):
+        plan_of(tmp_path, camera_doc(sweeps, light="distant"))
+    with pytest.raises(ValueError, match=r"sweeps\[1\].name': duplicate sweep name 'u'"):
+        plan_of(tmp_path, camera_doc([{"name": "u"}, {"name": "u", "direction_deg": 90}]))
+
+
+def test_camera_block_schema_names_the_key(tmp_path):
+    with pytest.raises(ValueError, match="optics"):
+        plan_of(tmp_path, camera_doc([{"name": "u"}], optics="prism"))
+    with pytest.raises(ValueError, match="name"):
+        plan_of(tmp_path, camera_doc([{"name": "cal_u"}]))
+
+
+def test_camera_block_single_sweep_is_the_pushbroom(tmp_path):
+    plan = plan_of(tmp_path, camera_doc([{"name": "w", "direction_deg": 90}]))
+    assert plan.camera_model == "pushbroom" and plan.stages == ("pushbroom",)
+    assert plan.scene_sweeps == ("w",)
+
+
+def test_manifest_sweeps_declare_their_geometry(lab, write_frames):
+    write_frames(lab / "data" / "w", [f"f{i}.png" for i in range(5)], seed=4)
+    sweeps = {"u": {"files": "u/*.png"}, "v": {"files": "v/*.png", "speed": 2.0},
+              "w": {"files": "w/*.png", "direction_deg": 45.0}}
+    plan = capture_plan(write_capture(lab, lab_doc(sweeps=sweeps)))
+    assert plan.camera_model == "linear" and plan.scene_sweeps == ("u", "v", "w")
+    assert plan.camera["sweeps"][2] == {"name": "w", "angle_deg": 45.0, "speed": 1.0,
+                                        "frames": 5}
+    assert plan.timed_sweeps == ("u", "v", "w")
+    standard = capture_plan(write_capture(lab, lab_doc(name="std")))
+    assert standard.camera_model == "perspective"
+
+
+def test_manifest_sweep_lights_all_or_none(lab):
+    sweeps = {"u": {"files": "u/*.png", "light_position": [0, 0, 1]},
+              "v": {"files": "v/*.png", "direction_deg": 90.0}}
+    with pytest.raises(ValueError, match=r"key 'sweeps.<name>.light_position' is given for "
+                                         r"sweeps \['u'\] but not for \['v'\]"):
+        capture_plan(write_capture(lab, lab_doc(sweeps=sweeps)))
+    sweeps["v"]["light_position"] = [0.1, 0, 1]
+    assert capture_plan(write_capture(lab, lab_doc(sweeps=sweeps))).camera_model == "cross_slit"
+
+
+def _plan_or_error(doc):
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        try:
+            return plan_of(Path(folder), doc), None
+        except ValueError as err:
+            return None, str(err)
+
+
+@settings(max_examples=40, deadline=None)
+@given(angle=st.floats(-360, 360), delta=st.floats(0.0, 30.0), speed_a=st.floats(0.01, 100.0),
+       speed_b=st.floats(0.01, 100.0))
+def test_camera_block_geometry_gives_a_camera_or_names_the_key(angle, delta, speed_a, speed_b):
+    """Nearly parallel pairs, slants near 0/90, speeds 100x apart: a model or a clear error."""
+    sweeps = [{"name": "a", "direction_deg": angle, "speed": speed_a},
+              {"name": "b", "direction_deg": angle + delta, "speed": speed_b}]
+    plan, error = _plan_or_error(camera_doc(sweeps))
+    sine = abs(math.sin(math.radians(delta)))
+    if sine < math.sin(math.radians(15.0)) - 1e-9:
+        assert plan is None and "key 'synthetic.camera.sweeps'" in error and "parallel" in error
+        return
+    if sine > math.sin(math.radians(15.0)) + 1e-9:
+        assert error is None, error
+        assert plan.camera_model in ("linear", "perspective")
+        for name, speed, theta in (("a", speed_a, angle), ("b", speed_b, angle + delta)):
+            extent = 16 * (abs(math.cos(math.radians(theta))) + abs(math.sin(math.radians(theta))))
+            assert plan.n_frames(name) == max(2, math.ceil(extent / speed - 1e-9))
+
+
+@settings(max_examples=25, deadline=None)
+@given(delta=st.floats(0.0, 90.0), offset=st.floats(-0.05, 0.05))
+def test_cross_slit_request_is_a_camera_or_a_clear_error(delta, offset):
+    """Degenerate cross-slit set-ups (parallel wires, one light) are refused by key."""
+    sweeps = [{"name": "a"}, {"name": "b", "direction_deg": delta,
+                              "light_offset": [offset, 0.0, 0.0]}]
+    plan, error = _plan_or_error(camera_doc(sweeps, model="cross_slit"))
+    if abs(math.sin(math.radians(delta))) < math.sin(math.radians(15.0)) - 1e-9:
+        assert plan is None and "parallel" in error
+    elif offset == 0.0:
+        assert plan is None and "needs two sweeps, each with its own light" in error
+    elif abs(math.sin(math.radians(delta))) > math.sin(math.radians(15.0)) + 1e-9:
+        assert error is None and plan.camera_model == "cross_slit"

@@ -270,3 +270,30 @@ def test_nonplanar_wire_offsets_shift_the_dip_as_central_projection_predicts(cen
     assert np.median(np.abs(centroid - t)[far]) > 1.5  # it really moved
     with pytest.raises(ValueError, match="path_offsets"):
         cap.frames("u", path_offsets=np.zeros(T - 1))
+
+
+def test_open_shutter_makes_the_sampled_dip_centroid_the_shadow_time():
+    """shutter = 1: each frame integrates the moving wire over the whole frame interval, so
+    the sampled dip's deficit-weighted centroid follows the analytic time to < 0.01 frame;
+    an instant exposure samples a hard-edged boxcar and quantises it (errors > 0.1 frame)."""
+    from shadowcam.synthetic.lab.render import prepare_capture, sweep_frames
+    from shadowcam.synthetic.lab.scenes import make_scene
+
+    scene = make_scene("tabletop", seed=0, height=16, width=16, frames=12)
+    capture = prepare_capture(scene, supersample=1, calibration=False)
+    truth = capture.ground_truth
+    reference = capture.reference.astype(np.float64)
+    k = np.arange(12)[:, None, None]
+    for name in ("u", "v"):
+        t = truth[f"t_{name}"].values.astype(np.float64)
+        inner = np.isfinite(t) & (t > 2.5) & (t < 12 - 3.5) & truth["lit"].values.astype(bool)
+        assert inner.sum() > 20
+        errors = {}
+        for shutter in (0.0, 1.0):
+            frames = capture.frames(name, shutter=shutter).astype(np.float64)
+            deficit = (reference[None] - frames).sum(axis=-1)[:, inner]  # (T, n)
+            centroid = (k[:, :, 0] * deficit).sum(axis=0) / deficit.sum(axis=0)
+            errors[shutter] = np.abs(centroid - t[inner]).max()
+        assert errors[1.0] < 0.01 < 0.1 < errors[0.0], errors
+    with pytest.raises(ValueError, match="shutter"):
+        sweep_frames(capture._paths["u"], scene.sweeps["u"], scene.mask, shutter=1.5)

@@ -259,3 +259,15 @@ def test_single_sweep_capture_uses_the_standard_dual_camera():
     t = wire_shadow_time(gt["P"].values[lit].astype(np.float64), sc.sweeps["p"])
     np.testing.assert_allclose(gt["t_p_all"].values[lit], t, rtol=1e-6, atol=1e-4)
     assert cap.frames("p").shape == (sc.sweeps["p"].frames, 16, 16, 3)
+
+
+def test_default_frames_are_the_camera_models_frames_to_cross():
+    """The renderer's default frame count is the one the capture plan predicts."""
+    from shadowcam.cameras.models import frames_to_cross
+    from shadowcam.synthetic.lab.scenes import make_scene
+
+    scene = make_scene("tabletop", height=8, width=8, frames=20,
+                       sweeps=[{"name": "a", "angle_deg": 60.0, "speed": 0.7},
+                               {"name": "b", "angle_deg": 90.0, "speed": 2.0}])
+    assert scene.sweeps["a"].frames == frames_to_cross((20, 20), 60.0, 0.7) == 40
+    assert scene.sweeps["b"].frames == frames_to_cross((20, 20), 90.0, 2.0) == 10

@@ -237,11 +237,39 @@ def _sweep_mask(mask, sweep):
     return replace(mask, origin=sweep.p0)
 
 
-def sweep_frames(paths, sweep, mask, *, path_offsets=None):
+def _exposed_frames(paths, t_c, half, reference, n_frames, shutter):
+    """Frames exposed over ``[k - shutter/2, k + shutter/2]``: each path loses its radiance
+    times the fraction of the exposure the wire blocks it, the overlap of that window with
+    ``(t_c - half, t_c + half)`` over `shutter`."""
+    n_pix = reference.shape[0]
+    ok = np.isfinite(t_c) & np.isfinite(half)
+    t_c, half, pixel, radiance = t_c[ok], half[ok], paths.pixel[ok], paths.radiance[ok]
+    start = np.floor(t_c - half - shutter / 2.0).astype(np.int64)
+    span = int(np.max(np.ceil(t_c + half + shutter / 2.0) - start, initial=0)) + 1
+    deficit = np.zeros((n_frames, n_pix, 3))
+    for j in range(span):
+        k = start + j
+        overlap = (np.minimum(t_c + half, k + shutter / 2.0)
+                   - np.maximum(t_c - half, k - shutter / 2.0))
+        use = (overlap > 0) & (k >= 0) & (k < n_frames)
+        weight = overlap[use] / shutter
+        flat = k[use] * n_pix + pixel[use]
+        for c in range(3):
+            deficit[..., c] += np.bincount(flat, weights=weight * radiance[use, c],
+                                           minlength=n_frames * n_pix).reshape(n_frames, n_pix)
+    frames = np.clip(reference[None] - deficit, 0.0, None).astype(np.float32)
+    return frames.reshape(n_frames, *paths.shape, 3)
+
+
+def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0):
     """Frames of one wire sweep.
 
     Frame k shows the wire at ``p(k) = p0 + k v``; a light path is dark in frame k when the
     wire blocks it, i.e. ``|k - t_c| < half_width`` (``raycast.wire_occlusion_interval``).
+    With an open `shutter` the frame integrates the moving wire over its exposure: the path
+    is dimmed by the fraction of ``[k - shutter/2, k + shutter/2]`` the wire blocks it (a
+    real camera's motion blur: the hard-edged dip gets ramps, so its sampled shape carries
+    the sub-frame shadow time; an instant exposure samples a boxcar).
 
     Parameters
     ----------
@@ -255,12 +283,20 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None):
         (scene units) along the mask normal ``n`` (the light's aim direction), i.e. it
         sits at ``p(k) + path_offsets[k] n``. Exact for an infinite wire (the finite
         wire's coverage is that of the planar path). None = planar motion.
+    shutter : float
+        Exposure of each frame as a fraction of the frame interval, in [0, 1]; 0 = an
+        instant (the wire frozen at ``p(k)``). Not combined with `path_offsets`.
 
     Returns
     -------
     (T, rows, cols, 3) float32 ndarray
         Linear radiance, T = ``sweep.frames``.
     """
+    shutter = float(shutter)
+    if not 0.0 <= shutter <= 1.0:
+        raise ValueError(f"shutter: must be in [0, 1] (fraction of the frame interval), got {shutter}")
+    if shutter > 0 and path_offsets is not None:
+        raise ValueError("shutter: an open shutter is not combined with path_offsets; pass one")
     n_frames = sweep.frames
     n_pix = paths.shape[0] * paths.shape[1]
     mask = _sweep_mask(mask, sweep)
@@ -274,6 +310,8 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None):
                              f"frame), got shape {offsets.shape}")
         return _frames_with_offsets(paths, t_c, half, _offset_rate(paths, sweep, mask),
                                     offsets, reference)
+    if shutter > 0:
+        return _exposed_frames(paths, t_c, half, reference, n_frames, shutter)
     with np.errstate(invalid="ignore"):
         first = np.floor(t_c - half) + 1  # strict inequality: open interval
         last = np.ceil(t_c + half) - 1
@@ -586,14 +624,14 @@ class CaptureRenderer:
         """Names of the sweeps this capture renders."""
         return tuple(self._paths)
 
-    def frames(self, name, *, path_offsets=None):
+    def frames(self, name, *, path_offsets=None, shutter=0.0):
         """(T, rows, cols, 3) float32 frames of sweep `name` (see ``sweep_frames`` for
-        `path_offsets`, the non-planar wire motion)."""
+        `path_offsets`, the non-planar wire motion, and `shutter`, the exposure)."""
         if name not in self._paths:
             raise ValueError(f"name: no sweep {name!r}; available: {self.sweep_names}")
         sweep = self.scene.sweeps[name.removeprefix("cal_")]
         return sweep_frames(self._paths[name], sweep, self.scene.mask,
-                            path_offsets=path_offsets)
+                            path_offsets=path_offsets, shutter=shutter)
 
 
 def _trace_per_light(objects, camera, scene, names, supersample, prefix=""):

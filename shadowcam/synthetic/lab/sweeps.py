@@ -22,6 +22,7 @@ import math
 
 import numpy as np
 
+from shadowcam.cameras.models import frames_to_cross
 from shadowcam.synthetic.lab.scene import (
     AreaLight,
     DistantLight,
@@ -197,8 +198,8 @@ def make_sweeps(mask, specs, *, light=None, radius=None, length=None):
             step = _positive_value(spec.get("speed", 1.0), f"{key}.speed") * mask.delta
         velocity = (step * perpendicular) * across
         if spec.get("frames") is None:
-            extent = (mask.n_u * abs(cos_w) + mask.n_v * abs(sin_w)) * mask.delta
-            frames = max(2, math.ceil(extent / (step * abs(perpendicular)) - 1e-9))
+            frames = frames_to_cross((mask.n_v, mask.n_u), angle,
+                                     step * abs(perpendicular) / mask.delta)
         else:
             frames = spec["frames"]
             if isinstance(frames, bool) or int(frames) != frames or int(frames) < 2:
