@@ -40,8 +40,12 @@ from shadowcam.synthetic.lightfield.capture import capture_from_plan
 def add_parser(subparsers, name):
     """Register ``lightfield-accuracy`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="accuracy of a rendered light field")
-    for option in ("manifest", "capture", "rays", "renders", "table", "json", "csv"):
-        parser.add_argument(f"--{option}", required=True)
+    for option, text in (("manifest", "data_manifest/<ds>.yaml (rendered, kind lightfield)"),
+                         ("capture", "capture folder with capture.json"), ("rays", "rays netCDF of lightfield-rays"),
+                         ("renders", "renders netCDF of lightfield-render (lux)"),
+                         ("table", "candela table netCDF of lightfield-export (cd)"),
+                         ("json", "output JSON of the scores"), ("csv", "output quantity table CSV")):
+        parser.add_argument(f"--{option}", required=True, help=text)
     parser.add_argument("--sweeps", nargs="+", required=True, help="<screen>_<h|v>.nc of lightfield-shadow-times")
     return parser
 

@@ -36,8 +36,11 @@ from shadowcam.synthetic.lightfield.capture import capture_from_plan
 def add_parser(subparsers, name):
     """Register ``lightfield-report`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="figures of a light-field capture")
-    for option in ("manifest", "renders", "table", "outdir"):
-        parser.add_argument(f"--{option}", required=True)
+    for option, text in (("manifest", "data_manifest/<ds>.yaml (kind lightfield)"),
+                         ("renders", "renders netCDF of lightfield-render (lux)"),
+                         ("table", "candela table netCDF of lightfield-export (cd)"),
+                         ("outdir", "output folder of the PNG figures")):
+        parser.add_argument(f"--{option}", required=True, help=text)
     parser.add_argument("--hdr", nargs="+", required=True, help="<screen>_<h|v>.npy of lightfield-hdr")
     parser.add_argument("--sweeps", nargs="+", required=True, help="<screen>_<h|v>.nc of lightfield-shadow-times")
     return parser
