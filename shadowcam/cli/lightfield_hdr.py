@@ -18,9 +18,7 @@ run : merge and write the sweep.
 """
 
 import logging
-from pathlib import Path
-
-from shadowcam.lightfield.stages import SWEEP_AXES, merge_sweep, read_description
+from shadowcam.lightfield.stages import merge_sweep, read_description, sweep_files
 
 log = logging.getLogger(__name__)
 
@@ -37,10 +35,7 @@ def add_parser(subparsers, name):
 def run(args):
     """Merge the sweep's brackets."""
     description = read_description(args.capture)
-    screen, _, suffix = args.sweep.rpartition("_")
-    if suffix not in SWEEP_AXES or screen not in [s["name"] for s in description["screens"]]:
-        raise ValueError(f"--sweep must be <screen>_h or <screen>_v with a screen of {args.capture}; got {args.sweep!r}")
-    files = sorted(Path(args.capture, screen, SWEEP_AXES[suffix]).glob("*.dng"))
+    files = sweep_files(args.capture, description, args.sweep)
     result = merge_sweep(files, args.out, exposure_times=description["exposure_times"], sensor=description["sensor"])
     log.info("%s: %d frames, %d photosites with every bracket saturated", args.sweep, result["n_frames"],
              result["all_saturated"])

@@ -1,6 +1,9 @@
-"""``shadowcam render-lightfield``: render a ``kind: lightfield`` capture from its manifest.
+"""``shadowcam render-lightfield``: the capture folder of a ``kind: lightfield`` manifest.
 
-The manifest's ``synthetic`` block (scene ``reflector``, seed, height, width, frames,
+A captured light field gets its ``capture.json`` only: screens, mask, bracket times
+and the files of each sweep, from the manifest (:func:`shadowcam.lightfield.stages.describe_capture`).
+A rendered one is rendered:
+the manifest's ``synthetic`` block (scene ``reflector``, seed, height, width, frames,
 noise) and ``lightfield`` block (screens with ``position_m`` in metres, bracket
 ``exposure_times_s`` in seconds) give the capture
 (:func:`shadowcam.synthetic.lightfield.capture.capture_from_plan`). Writes
@@ -18,22 +21,31 @@ add_parser : register the step and its options.
 run : render and write the capture.
 """
 
+import json
+
+from shadowcam._shared.atomic import atomic_directory
 from shadowcam.io.capture_plan import capture_plan
+from shadowcam.lightfield.stages import DESCRIPTION_FILE, describe_capture
 from shadowcam.io.manifest import load_manifest
 from shadowcam.synthetic.lightfield.capture import capture_from_plan, write_capture
 
 
 def add_parser(subparsers, name):
     """Register ``render-lightfield`` on `subparsers`; return its parser."""
-    parser = subparsers.add_parser(name, help="render a synthetic light-field capture")
+    parser = subparsers.add_parser(name, help="render or describe a light-field capture")
     parser.add_argument("--manifest", required=True, help="data_manifest/<ds>.yaml (kind lightfield, synthetic)")
     parser.add_argument("--out", required=True, help="output capture folder")
     return parser
 
 
 def run(args):
-    """Render the capture the manifest describes."""
-    manifest = load_manifest(args.manifest)
-    if "synthetic" not in manifest or manifest["kind"] != "lightfield":
-        raise ValueError(f"manifest {args.manifest}: needs kind: lightfield and a 'synthetic' block to be rendered")
-    write_capture(args.out, capture_from_plan(capture_plan(args.manifest), manifest["synthetic"]))
+    """Render or describe the capture the manifest gives."""
+    manifest, plan = load_manifest(args.manifest), capture_plan(args.manifest)
+    if not plan.is_lightfield:
+        raise ValueError(f"manifest {args.manifest}: key 'kind' must be lightfield; got {plan.kind!r}")
+    if plan.rendered:
+        write_capture(args.out, capture_from_plan(plan, manifest["synthetic"]))
+        return
+    description = describe_capture(plan)
+    with atomic_directory(args.out) as tmp:
+        (tmp / DESCRIPTION_FILE).write_text(json.dumps(description, indent=1))

@@ -12,6 +12,8 @@ Offers
 DESCRIPTION_FILE : name of the capture description inside a capture folder.
 SWEEP_AXES : sweep suffix -> mask axis of its wire.
 read_description : a capture folder's description, validated.
+describe_capture : the description of a captured (not rendered) light field, from its capture plan.
+sweep_files : the RAW files of one sweep of a capture folder.
 bracket_files : the DN brackets of each frame from a sweep's files (a generator).
 merge_sweep : merge a sweep's brackets into an HDR ``.npy`` stack, one frame at a time.
 hdr_blocks : the HDR stack in time blocks for the dip tracker (a generator).
@@ -30,12 +32,13 @@ import xarray as xr
 
 from shadowcam._shared.atomic import atomic_path
 from shadowcam._shared.validation import check_positive
+from shadowcam.io.decode import header_metadata
 from shadowcam.io.manifest import natural_key
 from shadowcam.io.raw_mosaic import read_mosaic
 from shadowcam.lightfield import hdr, rays
 from shadowcam.lightfield.photometry_export import far_field_table
 from shadowcam.lightfield.render import irradiance_on_plane
-from shadowcam.lightfield.screen import screen_coordinates, screen_positions
+from shadowcam.lightfield.screen import homography_from_markers, screen_coordinates, screen_positions
 
 DESCRIPTION_FILE = "capture.json"
 #: sweep suffix -> mask axis its wire moves along (as :data:`shadowcam.io.capture_plan.LIGHTFIELD_SWEEPS`)
@@ -50,6 +53,65 @@ def read_description(folder):
     description = json.loads(path.read_text())
     description["screens"] = screen_positions(description)
     return description
+
+
+def describe_capture(plan):
+    """The ``capture.json`` description of a captured light field.
+
+    A captured camera's gain and read noise are not in the manifest: the merge takes
+    1 DN per electron and 1 DN of read noise, and its output is DN per second
+    (``responsivity`` 1), proportional to the screen irradiance. Black and white levels
+    are the first file's (the lowest white level of its CFA sites).
+
+    Parameters
+    ----------
+    plan : shadowcam.io.capture_plan.CapturePlan
+        Plan of a ``kind: lightfield`` manifest with files (not rendered).
+
+    Returns
+    -------
+    dict
+        As :func:`shadowcam.synthetic.lightfield.capture.capture_description`, plus ``files``
+        (sweep name -> RAW files in natural order).
+    """
+    facts = plan.lightfield
+    if facts is None or plan.rendered:
+        raise ValueError(f"plan must be of a captured kind: lightfield manifest; got {plan.manifest_path}")
+    first = plan.sweeps[facts["screens"][0]["sweeps"]["h"]].files
+    times = list(facts["screens"][0]["exposure_times_s"])
+    if times[0] is None:
+        times = [header_metadata(p)["exposure_s"] for p in first[:facts["brackets"]]]
+        if any(t is None or not t > 0 for t in times):
+            raise ValueError(f"manifest {plan.manifest_path}: key 'lightfield.exposure' is source metadata but "
+                             f"{first[0]} and its bracket carry no ExposureTime ({times}); list "
+                             "lightfield.exposure_times_s in the manifest")
+    _, levels = read_mosaic(first[0])
+    screens = []
+    for screen in facts["screens"]:
+        h = screen["homography"]
+        if h is None:
+            h = homography_from_markers(screen["markers"]["pixels"], screen["markers"]["points"]).tolist()
+        screens.append({"name": screen["id"], "position_mm": screen["position_mm"], "homography": h})
+    mask = facts["mask"]
+    return {
+        "kind": "lightfield", "screens": screens,
+        "mask": {**mask, "n_frames": plan.sweeps[facts["screens"][0]["sweeps"]["h"]].n_frames},
+        "exposure_times": [float(t) for t in times],
+        "sensor": {"black_level": float(np.mean(levels["black_sites"])), "white_level": float(np.min(levels["white_sites"])),
+                   "gain": 1.0, "read_noise": 1.0, "responsivity": 1.0},
+        "files": {name: list(sweep.files) for name, sweep in plan.sweeps.items()},
+    }
+
+
+def sweep_files(folder, description, sweep):
+    """RAW files of `sweep` (``<screen>_h`` or ``<screen>_v``): the description's ``files``, else the
+    rendered layout ``<folder>/<screen>/<x|y>/*.dng``."""
+    screen, _, suffix = sweep.rpartition("_")
+    if suffix not in SWEEP_AXES or screen not in [s["name"] for s in description["screens"]]:
+        raise ValueError(f"sweep must be <screen>_h or <screen>_v with a screen of {folder}; got {sweep!r}")
+    if "files" in description:
+        return description["files"][sweep]
+    return sorted(Path(folder, screen, SWEEP_AXES[suffix]).glob("*.dng"))
 
 
 def bracket_files(paths, *, brackets):

@@ -1,13 +1,13 @@
 # Stage: light-field captures (manifest kind lightfield, paper VI, Fig. 17): render the
-# capture (synthetic), merge each sweep's exposure brackets to HDR, the wire's shadow
-# times per screen and sweep, the rays, renders at config lightfield.render_positions_m,
+# capture (synthetic) or describe it from the manifest (captured), merge each sweep's
+# exposure brackets to HDR, the wire's shadow times per screen and sweep, the rays, renders at config lightfield.render_positions_m,
 # the IES / EULUMDAT candela files, accuracy (with ground truth) and the report figures.
 # Outputs live under results/{ds}/lightfield/; input functions in lightfield_inputs.smk.
 
 
 rule render_lightfield:
     input:
-        "data_manifest/{ds}.yaml",
+        get_lightfield_sources,
     output:
         directory("results/{ds}/lightfield/capture"),
     log:
@@ -19,8 +19,10 @@ rule render_lightfield:
     resources:
         mem_mb=get_lightfield_mem_mb,
         runtime=30,
+    params:
+        manifest="data_manifest/{ds}.yaml",
     shell:
-        "shadowcam render-lightfield --manifest {input} --out {output} > {log} 2>&1"
+        "shadowcam render-lightfield --manifest {params.manifest} --out {output} > {log} 2>&1"
 
 
 rule lightfield_hdr:

@@ -6,13 +6,14 @@ def _lightfield_plan(ds):
     plan = capture(ds)
     if not plan.is_lightfield:
         raise ValueError(f"dataset {ds!r} is not a light-field capture (manifest kind)")
-    if not plan.rendered:
-        raise ValueError(
-            f"dataset {ds!r} ({manifest_path(ds)}): captured (not rendered) light fields are "
-            "checked by the capture plan but not processed by the workflow yet; render a "
-            "synthetic one (manifest 'synthetic' block) or run the shadowcam lightfield-* steps"
-        )
     return plan
+
+
+def get_lightfield_sources(wildcards):
+    """What the capture folder is made from: the manifest, and a captured light field's files."""
+    plan = _lightfield_plan(wildcards.ds)
+    files = [f for sweep in plan.sweeps.values() for f in sweep.files]
+    return [manifest_path(wildcards.ds)] + relative(files)
 
 
 def get_lightfield_capture(wildcards):
