@@ -60,3 +60,23 @@ def test_lightfield_manifest_runs_end_to_end_with_exports_and_report(tmp_path, w
     assert "far-field intensity median |error|" in table_csv and "<= 5" in table_csv
     assert sorted(p.name for p in (out / "figures").glob("*.png")) == [
         "far_field.png", "inputs.png", "renders.png", "time_maps.png"]
+
+
+def test_captured_lightfield_manifest_runs_with_bracket_times_from_the_files(
+        tmp_path, workflow_copy, snakemake, make_lightfield_manifest):
+    workdir = workflow_copy(tmp_path / "wf")
+    _, rendered = make_lightfield_manifest(workdir / "data_manifest", name="captured_lf", shape=(48, 48),
+                                           n_frames=24, quadrature=600, noise=True, exposure="metadata")
+    result = snakemake(["--cores", "2", "--config", "datasets=[captured_lf]"], workdir)
+    assert result.returncode == 0, result.stdout
+    out = workdir / "results" / "captured_lf" / "lightfield"
+    description = json.loads((out / "capture" / "capture.json").read_text())
+    # DNG ExposureTime is a rational: the times read back within 1 %
+    assert np.allclose(description["exposure_times"], rendered["exposure_times"], rtol=0.01)
+    assert {k: len(v) for k, v in description["files"].items()} == {
+        "near_h": 72, "near_v": 72, "far_h": 72, "far_v": 72}
+    with xr.open_dataset(out / "rays.nc") as ray_set:
+        assert (ray_set["flag"].values == 0).mean() >= 0.4
+    for name in ("renders.nc", "source.ies", "source.ldt", "figures/inputs.png", "figures/time_maps.png"):
+        assert (out / name).is_file(), name
+    assert not (out / "accuracy.json").exists()  # no ground truth in a captured manifest
