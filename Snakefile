@@ -2,7 +2,8 @@
 # Run:    snakemake --profile profiles/local [--config datasets=[NAME]]
 # Report: snakemake --report results/report.html
 # Stages live in workflow/rules/*.smk; the configuration in config.smk, helpers in
-# common.smk (capture plans, inputs), parts.smk (time parts, spans, strips), resources.smk (job sizes), targets.smk.
+# common.smk (capture plans, inputs), parts.smk (time parts, spans, strips), resources.smk (job sizes), targets.smk,
+# lightfield_inputs.smk (light-field inputs and targets).
 from snakemake.utils import min_version
 
 min_version("9.0")
@@ -19,6 +20,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/parts.smk"
 include: "workflow/rules/resources.smk"
 include: "workflow/rules/targets.smk"
+include: "workflow/rules/lightfield_inputs.smk"
 include: "workflow/rules/render.smk"
 include: "workflow/rules/decode.smk"
 include: "workflow/rules/shadow_time.smk"
@@ -29,6 +31,7 @@ include: "workflow/rules/report.smk"
 include: "workflow/rules/evaluate.smk"
 include: "workflow/rules/outdoor.smk"
 include: "workflow/rules/methods.smk"
+include: "workflow/rules/lightfield.smk"
 
 
 localrules:

@@ -22,6 +22,7 @@ make_capture(tmp_path, ...) : a capture folder and its manifest; rewrite(path, d
 sweep_manifest(folder, rate_hz=...) : a lab manifest for the TIFF sweep ``folder/data/u``.
 wire_sweep(...) : the seeded synthetic shadow sweep with its exact shadow times.
 make_timelapse(...) : the seeded synthetic outdoor time-lapse with its exact arrival times.
+make_lightfield_manifest(folder, ...) : a captured kind: lightfield manifest of rendered DNG brackets.
 """
 
 import os
@@ -398,3 +399,46 @@ def _make_timelapse(*, height=64, width=64, n_frames=40, interval=60.0, speed=0.
 def make_timelapse():
     """The seeded synthetic outdoor time-lapse factory: ``make_timelapse(**options) -> dict``."""
     return _make_timelapse
+
+
+def _make_lightfield_manifest(folder, *, name="captured_lf", shape=(32, 32), n_frames=12, quadrature=300,
+                              noise=False, exposure="manifest"):
+    """Render a light field's DNG brackets into ``folder/data`` and write a captured manifest of them.
+
+    Screens ``near`` and ``far``; ``exposure="metadata"`` reads the bracket times from the
+    files. Returns ``(manifest path, the renderer's description)``.
+    """
+    import hashlib
+
+    from shadowcam.synthetic.lightfield.capture import LightFieldCapture, write_capture
+
+    folder = Path(folder)
+    root = folder / "data"
+    rendered = write_capture(root, LightFieldCapture(shape=shape, n_frames=n_frames, quadrature=quadrature,
+                                                     noise=noise, screen_names=("near", "far")))
+    block = {"screens": [{"id": s["name"], "position_m": s["position_mm"] / 1e3, "homography": s["homography"]}
+                         for s in rendered["screens"]],
+             "mask": {"position_m": rendered["mask"]["position_mm"] / 1e3,
+                      "start_m": rendered["mask"]["start_mm"] / 1e3, "step_m": rendered["mask"]["step_mm"] / 1e3}}
+    if exposure == "metadata":
+        block["exposure"] = {"source": "metadata", "brackets": len(rendered["exposure_times"])}
+    else:
+        block["exposure_times_s"] = rendered["exposure_times"]
+    manifest = {
+        "name": name, "kind": "lightfield", "light": "area", "root": os.path.relpath(root, folder),
+        "sweeps": {f"{s}_{suffix}": {"files": f"{s}/{axis}/*.dng"}
+                   for s in ("near", "far") for suffix, axis in (("h", "x"), ("v", "y"))},
+        "timing": {"source": "rate", "rate_hz": 3.0},
+        "checksums": {p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+                      for p in root.rglob("*.dng")},
+        "lightfield": block,
+    }
+    path = folder / f"{name}.yaml"
+    path.write_text(yaml.safe_dump(manifest))
+    return path, rendered
+
+
+@pytest.fixture(scope="session")
+def make_lightfield_manifest():
+    """Factory of captured light-field manifests: ``make_lightfield_manifest(folder, ...) -> (path, description)``."""
+    return _make_lightfield_manifest

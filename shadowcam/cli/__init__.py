@@ -39,8 +39,8 @@ STEPS = {
     "bench": "bench",
     "methods-comparison": "methods_comparison",
     "outdoor-sample": "outdoor_sample",
-    "bench-report": "bench_report",
-}
+    "bench-report": "bench_report", "render-lightfield": "render_lightfield",  # light field: and lightfield-<stage>
+    **{f"lightfield-{s}": f"lightfield_{s.replace('-', '_')}" for s in "hdr shadow-times rays render export accuracy report".split()}}
 
 
 def build_parser(steps=None):

@@ -13,6 +13,10 @@ pushbroom (one scene sweep), the shadow camera the lab sweeps make (decided once
 by :func:`shadowcam.cameras.models.choose_camera_model` from the sweep geometry:
 direction, speed and light of each sweep) and the halo of an edge-tracking strip.
 
+A ``kind: lightfield`` manifest has screens (id, position, homography or markers),
+a horizontal and a vertical sweep per screen and exposure brackets; its plan carries
+them in :attr:`CapturePlan.lightfield` (:func:`lightfield_facts`).
+
 A manifest with a ``synthetic:`` block (and no ``sweeps``) describes a capture
 the renderer writes; its plan takes the frame count and shape from that block
 and has no files yet. Its optional ``synthetic.camera`` block declares the
@@ -28,6 +32,8 @@ OUTDOOR_SWEEP : preferred name of the time-lapse sweep of an outdoor capture.
 PLANNED_SHIFT_COLUMNS : camera shake (columns) the planned strip halo allows for.
 SweepPlan : one sweep: name, files, frame count, frame times, axis, geometry.
 CapturePlan : the plan of one capture (frozen dataclass).
+LIGHTFIELD_SWEEPS : sweep suffix -> mask axis the wire moves along, of a light-field screen.
+lightfield_facts : the screens, sweeps and brackets of a ``kind: lightfield`` manifest.
 capture_plan : read a manifest into a :class:`CapturePlan`.
 """
 
@@ -53,6 +59,9 @@ OUTDOOR_SWEEP = "timelapse"
 PLANNED_SHIFT_COLUMNS = 4
 #: optics of a rendered lab camera (``synthetic.camera.optics``)
 OPTICS = ("none", "mirror", "glass")
+#: sweep suffix of a light-field screen -> mask axis its wire moves along (h: a vertical
+#: wire moving along x; v: a horizontal wire moving along y)
+LIGHTFIELD_SWEEPS = {"h": "x", "v": "y"}
 
 
 @dataclass(frozen=True)
@@ -144,6 +153,8 @@ class CapturePlan:
     strip_halo : int
         Halo columns each side of an edge-tracking strip, for
         :data:`PLANNED_SHIFT_COLUMNS` of camera shake (outdoor only; 0 for lab).
+    lightfield : mapping or None
+        :func:`lightfield_facts` of a ``kind: lightfield`` capture (else None).
     """
 
     name: str
@@ -165,6 +176,12 @@ class CapturePlan:
     timed_sweeps: tuple = ()
     outdoor_sweep: str = None
     strip_halo: int = 0
+    lightfield: MappingProxyType = None
+
+    @property
+    def is_lightfield(self):
+        """True for a light-field capture (manifest ``kind: lightfield``)."""
+        return self.kind == "lightfield"
 
     @property
     def is_outdoor(self):
@@ -315,6 +332,140 @@ def _camera(manifest, sweeps, scene, path):
     return model, description
 
 
+def _lightfield_error(path, key, problem, fix):
+    return ValueError(f"manifest {path}: key {key} {problem}; {fix}")
+
+
+def _bracket_times(entry, default, exposure, *, path, key):
+    times = entry.get("exposure_times_s", default)
+    if times is not None:
+        return tuple(float(t) for t in times)
+    if exposure.get("source") == "metadata" and "brackets" in exposure:
+        return (None,) * int(exposure["brackets"])
+    raise _lightfield_error(
+        path, f"'{key}.exposure_times_s'", "is missing: the bracket exposure times are not known",
+        "list them in seconds (lightfield.exposure_times_s), or set lightfield.exposure: "
+        "{source: metadata, brackets: N} to read them from the files",
+    )
+
+
+def lightfield_facts(manifest):
+    """The screens, sweeps and brackets of a ``kind: lightfield`` manifest.
+
+    Parameters
+    ----------
+    manifest : dict
+        As :func:`shadowcam.io.manifest.load_manifest` returns it.
+
+    Returns
+    -------
+    sweeps : dict of str to SweepPlan
+        ``<screen id>_h`` and ``<screen id>_v`` of every screen, nearest screen first.
+    facts : dict
+        ``screens`` (tuple of dicts: ``id``, ``position_mm``, ``homography`` (3x3 list or
+        None), ``markers`` (or None), ``sweeps`` (suffix -> sweep name), ``exposure_times_s``),
+        ``brackets`` (exposures per frame), ``exposure_source`` (``manifest`` or
+        ``metadata``; times None for the latter) and ``mask`` (``position_mm``,
+        ``start_mm``, ``step_mm``; None for a rendered capture).
+
+    Raises
+    ------
+    ValueError
+        Naming the manifest and the key, with the fix: fewer than two screens, a screen
+        without ``position_m`` (or a duplicate one) or, captured, without ``homography``
+        or ``markers`` or without its two sweeps; no exposure times; brackets of
+        different sizes (screens with different bracket counts, or a sweep whose file
+        count is not a multiple of the bracket size); a captured light field without ``mask``.
+    """
+    path = manifest["manifest_path"]
+    rendered = "synthetic" in manifest
+    block = manifest.get("lightfield") or {}
+    entries = block.get("screens") or []
+    if len(entries) < 2:
+        raise _lightfield_error(path, "'lightfield.screens'", f"lists {len(entries)} screen(s)",
+                                "a light field needs two screen positions: add an entry "
+                                "{id, position_m, homography} per screen")
+    exposure = dict(block.get("exposure") or {})
+    screens = []
+    for i, entry in enumerate(entries):
+        key = f"lightfield.screens[{i}]"
+        sid = entry.get("id", f"screen{i}")
+        if "position_m" not in entry:
+            raise _lightfield_error(path, f"'{key}.position_m'", f"is missing (screen {sid!r})",
+                                    "add the screen's distance from the source along the axis, in metres")
+        if not entry["position_m"] > 0:
+            raise _lightfield_error(path, f"'{key}.position_m'", f"is {entry['position_m']!r}",
+                                    "give the screen's distance from the source in metres (> 0)")
+        if not rendered and "homography" not in entry and "markers" not in entry:
+            raise _lightfield_error(path, f"'{key}'", "has neither 'homography' nor 'markers'",
+                                    "give the camera-pixel -> screen-mm homography or four screen markers")
+        times = _bracket_times(entry, block.get("exposure_times_s"), exposure, path=path, key=key)
+        screens.append({"id": sid, "position_mm": 1e3 * float(entry["position_m"]),
+                        "homography": entry.get("homography"), "markers": entry.get("markers"),
+                        "sweeps": {suffix: f"{sid}_{suffix}" for suffix in LIGHTFIELD_SWEEPS},
+                        "exposure_times_s": times})
+    positions = [s["position_mm"] for s in screens]
+    if len(set(positions)) != len(positions):
+        raise _lightfield_error(path, "'lightfield.screens[*].position_m'", f"repeats a position ({positions} mm)",
+                                "each screen needs its own distance from the source")
+    sizes = {s["id"]: len(s["exposure_times_s"]) for s in screens}
+    if len(set(sizes.values())) != 1:
+        raise _lightfield_error(path, "'lightfield.screens[*].exposure_times_s'",
+                                f"gives brackets of different sizes {sizes}",
+                                "expose every frame of every screen with the same number of brackets")
+    brackets = next(iter(sizes.values()))
+    screens.sort(key=lambda s: s["position_mm"])
+    sweeps = {}
+    for screen in screens:
+        for name in screen["sweeps"].values():
+            if rendered:
+                sweeps[name] = SweepPlan(name=name, n_frames=int(manifest["synthetic"]["frames"]))
+                continue
+            if name not in manifest["sweeps"]:
+                raise _lightfield_error(path, "'sweeps'", f"has no sweep {name!r} (screen {screen['id']!r})",
+                                        f"add sweeps {name}: {{files: ...}} with the screen's frames")
+            entry = manifest["sweeps"][name]
+            n_files = len(entry["paths"])
+            if n_files == 0 or n_files % brackets:
+                raise _lightfield_error(path, f"'sweeps.{name}'", f"has {n_files} files, not a multiple of the "
+                                        f"{brackets} brackets per frame (brackets of different sizes)",
+                                        "give every frame the same brackets, or fix the glob")
+            sweeps[name] = SweepPlan(name=name, files=tuple(entry["paths"]), n_frames=n_files // brackets,
+                                     times_s=tuple(float(t) for t in entry["times_s"][::brackets]))
+    mask = block.get("mask")
+    if not rendered and mask is None:
+        raise _lightfield_error(path, "'lightfield.mask'", "is missing",
+                                "give the mask plane's position_m and the wire's start_m and step_m")
+    facts = {
+        "screens": tuple(screens),
+        "brackets": brackets,
+        "exposure_source": "metadata" if screens[0]["exposure_times_s"][0] is None else "manifest",
+        "mask": None if mask is None else {k.replace("_m", "_mm"): 1e3 * float(v) for k, v in mask.items()},
+    }
+    return sweeps, facts
+
+
+def _lightfield_plan(manifest):
+    sweeps, facts = lightfield_facts(manifest)
+    if "synthetic" in manifest:
+        shape = (int(manifest["synthetic"]["height"]), int(manifest["synthetic"]["width"]))
+    else:
+        shape = check_capture_frames(manifest)
+    return CapturePlan(
+        name=manifest["name"],
+        manifest_path=manifest["manifest_path"],
+        kind="lightfield",
+        rendered="synthetic" in manifest,
+        sweeps=MappingProxyType(sweeps),
+        frame_shape=shape,
+        timing=MappingProxyType(dict(manifest.get("timing") or {})),
+        has_ground_truth="synthetic" in manifest,
+        stages=("hdr", "shadow_times", "rays", "renders", "exports"),
+        timed_sweeps=tuple(sweeps),
+        lightfield=MappingProxyType(facts),
+    )
+
+
 def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
     """Read a manifest into the plan of its capture.
 
@@ -348,6 +499,8 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`).
     """
     manifest = load_manifest(manifest_path)
+    if manifest["kind"] == "lightfield":
+        return _lightfield_plan(manifest)
     path = manifest["manifest_path"]
     rendered = "synthetic" in manifest
     if rendered and "camera" in manifest["synthetic"] and manifest["kind"] == "lab":

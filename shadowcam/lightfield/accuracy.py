@@ -6,6 +6,9 @@ naive_baseline : the nearest captured screen image rescaled by inverse square an
 relative_rmse_gain : relative RMSE after the one least-squares gain.
 bandpass_correlation : correlation of difference-of-Gaussians band-passed images.
 far_field_error : median relative intensity error over the directions of the beam.
+TARGETS : the accuracy targets.
+lightfield_accuracy : renders, far field and coverage of a capture scored against ground truth.
+accuracy_rows : the scores as quantity-table rows.
 """
 
 import numpy as np
@@ -81,3 +84,79 @@ def far_field_error(estimate, truth, *, floor=0.05):
     check_same_shape({"estimate": estimate, "truth": truth})
     keep = truth > floor * truth.max()
     return float(np.median(np.abs(estimate[keep] - truth[keep]) / truth[keep]))
+
+
+#: targets of the light-field accuracy (issue figures): render/baseline error ratio, band-passed
+#: correlation, far-field median error
+TARGETS = {"render_ratio": 0.5, "bandpass_correlation": 0.9, "far_field_error": 0.05}
+
+
+def _target(value, threshold, comparison):
+    ok = value <= threshold if comparison == "<=" else value >= threshold
+    return {"threshold": threshold, "comparison": comparison, "pass": bool(ok)}
+
+
+def lightfield_accuracy(renders, table, screens, truth, *, far_truth, flags):
+    """Scores of a light-field capture against ground truth.
+
+    Parameters
+    ----------
+    renders : xarray.Dataset
+        :func:`shadowcam.lightfield.stages.render_positions` (``irradiance (position, row, col)``).
+    table : xarray.DataArray
+        Estimated candela table ``(C, gamma)``.
+    screens : list of dict
+        Captured screens nearest first: ``position_mm``, ``irradiance`` (H, W) lux, ``xy`` (H, W, 2) mm.
+    truth : callable
+        ``truth(position_mm, shape, pixel_size)`` -> (rows, cols) true irradiance on the render grid.
+    far_truth : (C, gamma) ndarray, keyword-only
+        True candela table on the same angles.
+    flags : (H, W) ndarray, keyword-only
+        Ray flags (:data:`shadowcam.lightfield.rays.REASONS`), for the coverage.
+
+    Returns
+    -------
+    dict
+        ``renders``: per position ``rmse_render``, ``rmse_baseline`` (relative, one gain fit),
+        ``ratio``, ``bandpass_render``, ``bandpass_baseline`` and their ``targets``;
+        ``far_field``: ``median_error`` with target; ``coverage``: fraction of pixels with a ray.
+    """
+    positions = [s["position_mm"] for s in screens]
+    out = {"renders": {}, "coverage": float(np.mean(np.asarray(flags) == 0))}
+    for k, z in enumerate(renders["position"].values):
+        image = renders["irradiance"].values[k]
+        pitch = float(renders["pixel_size"].values[k])
+        expected = truth(float(z), image.shape, pitch)
+        nearest = screens[int(np.argmin(np.abs(np.asarray(positions) - z)))]
+        baseline = naive_baseline(nearest["irradiance"], nearest["xy"], position_mm=nearest["position_mm"],
+                                  target_position_mm=float(z), target_shape=image.shape, pixel_size=pitch)
+        rmse, base = relative_rmse_gain(image, expected), relative_rmse_gain(baseline, expected)
+        corr = bandpass_correlation(image, expected)
+        out["renders"][f"{z:g}"] = {
+            "position_mm": float(z), "pixel_size_mm": pitch, "rmse_render": rmse, "rmse_baseline": base,
+            "ratio": rmse / base, "bandpass_render": corr, "bandpass_baseline": bandpass_correlation(baseline, expected),
+            "targets": {"ratio": _target(rmse / base, TARGETS["render_ratio"], "<="),
+                        "bandpass_render": _target(corr, TARGETS["bandpass_correlation"], ">=")},
+        }
+    error = far_field_error(np.asarray(table), far_truth)
+    out["far_field"] = {"median_error": error,
+                        "targets": {"median_error": _target(error, TARGETS["far_field_error"], "<=")}}
+    return out
+
+
+def accuracy_rows(scores):
+    """Quantity-table rows (:func:`shadowcam._shared.quantity_table.quantity_row`) of :func:`lightfield_accuracy`."""
+    from shadowcam._shared.quantity_table import quantity_row
+
+    rows = []
+    for key, r in scores["renders"].items():
+        rows += [quantity_row(f"render at {key} mm: rel. RMSE (one gain)", r["rmse_render"]),
+                 quantity_row(f"naive baseline at {key} mm: rel. RMSE (one gain)", r["rmse_baseline"]),
+                 quantity_row(f"render / baseline error at {key} mm", r["ratio"], target=r["targets"]["ratio"]),
+                 quantity_row(f"band-passed correlation DoG(1, 4 px) at {key} mm", r["bandpass_render"],
+                              target=r["targets"]["bandpass_render"])]
+    far = scores["far_field"]
+    rows.append(quantity_row("far-field intensity median |error|", far["median_error"], "%", scale=100.0,
+                             target=far["targets"]["median_error"]))
+    rows.append(quantity_row("pixels with a ray", scores["coverage"], "%", scale=100.0))
+    return rows

@@ -99,7 +99,7 @@ def far_field_table(rays, *, vertical_angles, horizontal_angles, bin_deg=1.0):
     table = tangent_grid_intensity(flux, pitch, gamma[None, :], c[:, None])
     return xr.DataArray(table, dims=("C", "gamma"), coords={"C": c, "gamma": gamma},
                         attrs={"units": "cd", "long_name": "luminous intensity",
-                               "photometric_type": "C (nadir = optical axis +z)"})
+                               "photometric_type": "C (nadir = optical axis +z)", "bin_deg": float(bin_deg)})
 
 
 def _numbers(values, per_line=10, fmt="{:.6g}"):

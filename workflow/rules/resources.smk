@@ -39,6 +39,15 @@ OUTDOOR_S_PER_MP_FRAME = {
     "track_strip": 0.35,
     "per_pixel": 0.05,
 }
+#: bytes per camera pixel of a light-field step on one frame's brackets or on per-pixel
+#: maps (HDR merge: E uint16 brackets + float64 merge temporaries; shadow times: the
+#: tracker's sums; rays, renders, accuracy, report: ray and render maps), with margin
+#: (benchmarks/<ds>/lightfield_*.tsv max_rss, docs/benchmarks.md "Light field")
+LIGHTFIELD_BYTES_PER_PIXEL = 3000
+#: MB of the candela-table step beyond the base: its tangent-plane grid of directions
+#: depends on the beam's width and the gamma step, not on the camera
+#: (benchmarks/<ds>/lightfield_export.tsv max_rss at 1 degree, with margin)
+LIGHTFIELD_FAR_FIELD_MB = 600
 #: frames assumed for an outdoor job whose frame count is known only once rendered
 OUTDOOR_UNKNOWN_FRAMES = 1000
 
@@ -189,9 +198,26 @@ class _PlanningWildcards(dict):
     __getattr__ = dict.__getitem__
 
 
+def get_lightfield_mem_mb(wildcards, attempt):
+    """A light-field step on one frame or per-pixel maps (memory independent of the frames)."""
+    maps = _pixels(wildcards.ds) * LIGHTFIELD_BYTES_PER_PIXEL / 2**20
+    return attempt * math.ceil(BASE_MEM_MB + maps)
+
+
+def get_lightfield_export_mem_mb(wildcards, attempt):
+    """lightfield_export: the rays and the far-field direction grid."""
+    return get_lightfield_mem_mb(wildcards, attempt) + attempt * LIGHTFIELD_FAR_FIELD_MB
+
+
 def planned_mem_mb(ds):
     """Memory (MB, first attempt) of the largest job of each kind of dataset `ds`."""
     plan = capture(ds)
+    if plan.is_lightfield:
+        wildcards = _PlanningWildcards(ds=ds)
+        return {
+            "lightfield steps": get_lightfield_mem_mb(wildcards, 1),
+            "lightfield_export": get_lightfield_export_mem_mb(wildcards, 1),
+        }
     sweep = plan.outdoor_sweep if plan.is_outdoor else plan.timed_sweeps[0]
     wildcards = _PlanningWildcards(
         ds=ds, sweep=sweep, part="0000", span="0-end", strip="0"

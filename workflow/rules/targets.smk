@@ -1,6 +1,7 @@
 # Final outputs of each configured dataset (inputs of `all`); a lab capture ends in shadow
 # times, dual coordinates, the dual view and figures (a single-sweep one in shadow times and
-# the shadow pushbroom); an outdoor time-lapse in the
+# the shadow pushbroom); a light field in its rays, renders, IES/LDT files and figures
+# (lightfield.smk); an outdoor time-lapse in the
 # arrival-time map, the ridge pushbroom and figures; both add accuracy when the dataset
 # has ground truth. Stages a dataset does not need are not asked for.
 
@@ -8,6 +9,8 @@
 def dataset_targets(ds):
     """Return the final output files of dataset `ds` (list of str)."""
     plan = capture(ds)
+    if plan.is_lightfield:
+        return lightfield_targets(ds)  # workflow/rules/lightfield.smk
     if plan.is_outdoor:
         targets = [
             f"results/{ds}/outdoor/arrival.nc",

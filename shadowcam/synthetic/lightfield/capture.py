@@ -17,6 +17,7 @@ Offers
 LightFieldCapture : the set-up (source, screens, camera, sweeps, exposures, sensor).
 sweep_frames : the brackets of every frame of one sweep (a generator: memory independent of frames).
 capture_description : the ``kind: lightfield`` description (screens, sweeps, exposures, sensor).
+capture_from_plan : the set-up a ``kind: lightfield`` manifest's ``synthetic`` block describes.
 write_capture : DNG brackets of every frame and the description, written atomically into a directory.
 """
 
@@ -62,6 +63,8 @@ class LightFieldCapture:
         Rays per side of the flux quadrature.
     seed : int
     noise : bool
+    screen_names : tuple of str, optional
+        Name of each screen (default ``screen<i>``): its folder and description entry.
     """
 
     source: ReflectorSource = field(default_factory=ReflectorSource)
@@ -76,6 +79,11 @@ class LightFieldCapture:
     quadrature: int = 1200
     seed: int = 0
     noise: bool = True
+    screen_names: tuple = None
+
+    def screen_name(self, screen):
+        """Name of screen index `screen`."""
+        return self.screen_names[screen] if self.screen_names else f"screen{screen}"
 
     @property
     def mask_half(self):
@@ -186,7 +194,7 @@ def capture_description(capture, *, responsivity):
     sensor = capture.sensor
     return {
         "kind": "lightfield",
-        "screens": [{"name": f"screen{i}", "position_mm": float(z), "homography": capture.homography(i).tolist()}
+        "screens": [{"name": capture.screen_name(i), "position_mm": float(z), "homography": capture.homography(i).tolist()}
                     for i, z in enumerate(capture.positions_mm)],
         "mask": {"position_mm": capture.source.z_mask, "start_mm": capture.mask_start, "step_mm": capture.step,
                  "n_frames": capture.n_frames},
@@ -199,7 +207,7 @@ def capture_description(capture, *, responsivity):
 def write_capture(directory, capture, *, compression="none"):
     """Write every bracket of every frame as a DNG and ``capture.json``, atomically.
 
-    Files are ``screen<i>/<axis>/frame<t>_b<e>.dng`` with the bracket's ``ExposureTime``.
+    Files are ``<screen name>/<axis>/frame<t>_b<e>.dng`` with the bracket's ``ExposureTime``.
 
     Returns
     -------
@@ -213,11 +221,36 @@ def write_capture(directory, capture, *, compression="none"):
         for screen in range(len(capture.positions_mm)):
             for axis in ("x", "y"):
                 for t, brackets in enumerate(sweep_frames(capture, screen, axis, responsivity=q)):
-                    (tmp / f"screen{screen}" / axis).mkdir(parents=True, exist_ok=True)
+                    folder = tmp / capture.screen_name(screen) / axis
+                    folder.mkdir(parents=True, exist_ok=True)
                     for e, (raw, exposure) in enumerate(zip(brackets, capture.exposure_times)):
-                        write_dng(tmp / f"screen{screen}" / axis / f"frame{t:04d}_b{e}.dng", raw,
+                        write_dng(folder / f"frame{t:04d}_b{e}.dng", raw,
                                   bit_depth=capture.sensor.bit_depth, black_level=capture.sensor.black_level,
                                   capture_time=start + datetime.timedelta(seconds=t), exposure_time=exposure,
                                   compression=compression)
         (tmp / "capture.json").write_text(json.dumps(description, indent=1))
     return description
+
+
+#: scenes of a rendered light field (manifest ``synthetic.scene``)
+SCENES = {"reflector": ReflectorSource}
+
+
+def capture_from_plan(plan, synthetic):
+    """The :class:`LightFieldCapture` a rendered ``kind: lightfield`` manifest describes.
+
+    Parameters
+    ----------
+    plan : shadowcam.io.capture_plan.CapturePlan
+        Plan of the manifest (screens nearest first, bracket times).
+    synthetic : mapping
+        The manifest's ``synthetic`` block (``scene``, ``seed``, ``frames``, ``noise``).
+    """
+    if synthetic["scene"] not in SCENES:
+        raise ValueError(f"manifest {plan.manifest_path}: key 'synthetic.scene' must be one of {list(SCENES)} "
+                         f"for kind lightfield; got {synthetic['scene']!r}")
+    screens = plan.lightfield["screens"]
+    return LightFieldCapture(source=SCENES[synthetic["scene"]](), positions_mm=tuple(s["position_mm"] for s in screens),
+                             shape=tuple(plan.frame_shape), n_frames=int(synthetic["frames"]),
+                             exposure_times=tuple(screens[0]["exposure_times_s"]), seed=int(synthetic["seed"]),
+                             noise=bool(synthetic.get("noise", True)), screen_names=tuple(s["id"] for s in screens))
