@@ -316,10 +316,8 @@ def sun_lit(geometry, sun, t_s, *, offset_rad=0.0):
 
     Parameters
     ----------
-    geometry : SampleGeometry
-    sun : shadowcam.synthetic.outdoor.sun.SunPath
-    t_s : float or (N,) ndarray
-        One time for all samples, or one time per sample (seconds since frame 0).
+    geometry, sun, t_s
+        As :func:`horizon_clearance`.
     offset_rad : float, keyword-only
         Lit iff the clearance (:func:`horizon_clearance`) exceeds this: 0 is the centre of
         a disc sun's penumbra, ``+radius`` its start (first loss of light), ``-radius`` its
