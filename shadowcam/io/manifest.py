@@ -145,6 +145,28 @@ def _check_time_order(paths, times, *, root, source):
         )
 
 
+#: longest interval between two frames of an outdoor time-lapse accepted by default (s): in an
+#: hour the sun moves 15 deg, the shadow crosses the view unseen, and a longer pause is
+#: usually another session (the next day) whose shadows start over
+MAX_FRAME_GAP_S = 3600.0
+
+
+def _check_sessions(paths, times, *, root, max_gap_s):
+    """Raise ValueError naming the frames around intervals longer than `max_gap_s`."""
+    gaps = [k for k in range(1, len(times)) if times[k] - times[k - 1] > max_gap_s]
+    if not gaps:
+        return
+    shown = "; ".join(f"{_rel(root, paths[k - 1])} -> {_rel(root, paths[k])} "
+                      f"({(times[k] - times[k - 1]) / 3600.0:.2f} h)" for k in gaps[:3])
+    raise ValueError(
+        f"{len(gaps)} interval(s) between frames longer than max_frame_gap_s {max_gap_s:g} s: {shown}"
+        f"{' and more' if len(gaps) > 3 else ''}; the sequence looks like separate sessions whose "
+        f"shadows start over: split it into one dataset per session at "
+        f"{_rel(root, paths[gaps[0]])}, or set max_frame_gap_s in the manifest above the longest "
+        "interval if it is one session"
+    )
+
+
 def frame_times(paths, timing, *, root, sweep, sidecar=None):
     """Return frame times in seconds for the files of one sweep, checked to increase.
 
@@ -228,15 +250,15 @@ def _source_times(paths, timing, *, root, sweep, sidecar):
     if source == "metadata":
         from shadowcam.io.decode import header_metadata
 
-        stamps = []
-        for path in paths:
-            stamp = header_metadata(path)["capture_time"]
-            if stamp is None:
-                raise ValueError(
-                    f"file {path} has no EXIF DateTimeOriginal (timing.source metadata); "
-                    "use timing source rate, filename or sidecar instead"
-                )
-            stamps.append(_epoch_seconds(stamp))
+        stamps = [header_metadata(path)["capture_time"] for path in paths]
+        missing = [_rel(root, path) for path, stamp in zip(paths, stamps) if stamp is None]
+        if missing:
+            raise ValueError(
+                f"{len(missing)} of {len(paths)} files have no EXIF DateTimeOriginal ({_shown(missing)}; "
+                "timing.source metadata needs it on every file); give the times of all files with timing "
+                "source sidecar (timing.file, timing.key) or filename (timing.regex), or rate"
+            )
+        stamps = [_epoch_seconds(stamp) for stamp in stamps]
         return [s - stamps[0] for s in stamps]
     if source == "sidecar":
         value = sidecar
@@ -414,6 +436,9 @@ def _resolve(path, *, strict):
             sweep["times_s"] = frame_times(
                 [Path(p) for p in sweep["paths"]], timing, root=root, sweep=name, sidecar=sidecar
             )
+            if manifest.get("kind") == "outdoor":
+                _check_sessions(sweep["paths"], sweep["times_s"], root=root,
+                                max_gap_s=float(manifest.get("max_frame_gap_s", MAX_FRAME_GAP_S)))
         except ValueError as exc:
             raise ValueError(f"manifest {path}, sweep {name!r}: {exc}") from None
     return manifest

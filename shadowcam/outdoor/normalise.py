@@ -70,11 +70,10 @@ class SequenceNormaliser:
         frame's is recovered; fewer levels on small frames.
     registration_margin : int, optional
         Pixels of the reduced frames left out around the moving shadow edge
-        (:func:`shadowcam.outdoor.registration.static_weight` ``margin``): the band-pass
-        response of a moved edge reaches about twice its outer scale (6) beyond
-        the edge's own width, so a soft edge (penumbra, optics blur, upsampling)
-        needs 6 plus its width in reduced pixels, or the shift is biased
-        along the edge's motion.
+        (:func:`shadowcam.outdoor.registration.static_weight` ``margin``) beyond the
+        shadow's soft edge, whose width (penumbra, optics blur, upsampling) is measured
+        in each frame (:func:`shadowcam.outdoor.registration.soft_shadow`): the band-pass
+        response of a moved edge reaches about twice its outer scale (6) beyond it.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).

@@ -23,6 +23,7 @@ Offers
 ------
 REGISTRATION_METHODS : method name -> estimator.
 bandpass_log : band-passed log luminance used for matching.
+soft_shadow : the shadow reached since the reference grown through its measured soft edge.
 static_weight : weight mask of pixels whose illumination state did not change.
 shift_lucas_kanade_LucasKanade1981 : translation by iterative least squares.
 shift_coarse_to_fine : the same on a pyramid of block means, coarse levels first (large shifts).
@@ -61,6 +62,58 @@ def bandpass_log(luma, *, inner_sigma=0.7, outer_sigma=3.0):
     return smooth - cv2.GaussianBlur(logl, (0, 0), outer_sigma)
 
 
+def soft_shadow(luma, reference_luma, *, lit_reference, gain, valid=None, max_ratio=0.5):
+    """The shadow reached since the reference, with its soft edge, measured from the data.
+
+    A shadow cast by a disc sun has a penumbra ``L x 0.53 deg / sin(incidence)`` wide
+    (``L`` the distance to the occluder), which varies along the edge and over the
+    sequence. The core (ratio ``luma / (gain reference)`` below `max_ratio`) is grown
+    through the connected pixels whose ratio is below the lit pixels' own spread
+    (``1 - 3 sigma``, ``sigma`` the median absolute deviation of the ratio over the lit
+    pixels, x 1.4826), so the band excluded follows the edge's measured width.
+
+    Parameters
+    ----------
+    luma, reference_luma : (H, W) ndarray
+    lit_reference : (H, W) bool ndarray
+    gain : float
+        Lit gain of the frame relative to the reference.
+    valid : (H, W) bool ndarray, optional
+    max_ratio : float, optional
+
+    Returns
+    -------
+    shadow : (H, W) bool ndarray
+        Core plus the soft edge connected to it (8-neighbourhood).
+    width_px : float
+        Mean width of the soft edge: soft pixels per core boundary pixel (NaN without a
+        core).
+    """
+    luma = np.asarray(luma, dtype=np.float32)
+    ref = np.asarray(reference_luma, dtype=np.float32)
+    lit = np.asarray(lit_reference, dtype=bool)
+    if not (luma.shape == ref.shape == lit.shape) or luma.ndim != 2:
+        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and lit_reference {lit.shape} "
+                         "must be the same (H, W) shape")
+    check_positive(gain, "gain")
+    if valid is not None:
+        lit = lit & np.asarray(valid, dtype=bool)
+    ratio = luma / (gain * np.maximum(ref, _EPS))
+    core = lit & (ratio < max_ratio)
+    if not core.any():
+        return core, float("nan")
+    rest = ratio[lit & ~core]
+    spread = 1.4826 * float(np.median(np.abs(rest - np.median(rest)))) if rest.size else 0.0
+    candidate = (core | (lit & (ratio < 1.0 - 3.0 * spread))).astype(np.uint8)
+    count, labels = cv2.connectedComponents(candidate, connectivity=8)
+    touching = np.zeros(count, dtype=bool)
+    touching[np.unique(labels[core])] = True
+    touching[0] = False
+    shadow = touching[labels]
+    boundary = core & (cv2.dilate((~core).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
+    return shadow, float((shadow & ~core).sum() / max(int(boundary.sum()), 1))
+
+
 def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_ratio=0.5, margin=6):
     """Weights of the pixels whose illumination state did not change since the reference.
 
@@ -78,27 +131,25 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_
         band-pass response changes) are excluded with the same margin.
     max_ratio : float, optional
         A pixel lit in the reference whose ``luma / reference`` fell below
-        ``max_ratio * gain`` has been reached by the shadow.
+        ``max_ratio * gain`` has been reached by the shadow; the soft edge connected
+        to it is measured and left out with it (:func:`soft_shadow`).
     margin : int, optional
-        Changed pixels are dilated by this many pixels (about twice the outer
-        scale of :func:`bandpass_log`, whose response to the moved edge
-        spreads that far); the image border too.
+        Changed pixels are dilated by this many pixels: the reach of
+        :func:`bandpass_log`'s response to a moved edge beyond the edge itself,
+        about twice its outer scale; the image border too. The edge's own width
+        is measured, not part of the margin.
 
     Returns
     -------
     (H, W) float32 ndarray of 0 / 1
-        Zero on changed pixels (the moving shadow edge), on the reference's
-        lit / shadow boundary, on invalid pixels and the border, each widened
-        by `margin`; static shadows and static lit parts are kept.
+        Zero on changed pixels (the moving shadow edge with its penumbra), on the
+        reference's lit / shadow boundary, on invalid pixels and the border, each
+        widened by `margin`; static shadows and static lit parts are kept.
     """
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
     lit = np.asarray(lit_reference, dtype=bool)
-    if not (luma.shape == ref.shape == lit.shape) or luma.ndim != 2:
-        raise ValueError(f"luma {luma.shape}, reference_luma {ref.shape} and lit_reference {lit.shape} "
-                         "must be the same (H, W) shape")
-    check_positive(gain, "gain")
-    changed = lit & (luma < max_ratio * gain * ref)
+    changed, _ = soft_shadow(luma, ref, lit_reference=lit, gain=gain, max_ratio=max_ratio)
     # the reference's own shadow edge: a small move of it changes pixels less than max_ratio
     changed |= lit & (cv2.dilate((~lit).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
     if valid is not None:

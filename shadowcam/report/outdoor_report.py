@@ -5,6 +5,7 @@ Offers
 accuracy_html : an HTML page of an outdoor accuracy report against its targets.
 outdoor_summary : counts of arrival reasons, keyframes and interpolated edges.
 arrival_in_truth_camera : the arrival map and its ground truth on the ground truth's pixel grid.
+transient_events_of : the transient-events figure of an arrival dataset's event table.
 write_outdoor_figures : write the figures, ``summary.json`` and ``accuracy.html`` into a directory.
 """
 
@@ -22,6 +23,7 @@ from shadowcam.report.dataset_report import table_html
 from shadowcam.report.figures import save_png
 from shadowcam.report.outdoor_figures import (
     arrival_map_figure, display_step, edge_over_time_figure, keyframes_figure, pushbroom_figure,
+    transient_events_figure,
 )
 
 #: frames shown in the keyframes figure
@@ -84,6 +86,30 @@ def arrival_in_truth_camera(arrival_s, truth):
     return map_to_truth_camera(arrival_s, **shift), truth["arrival_time_s"].values, sky
 
 
+def transient_events_of(arrival, *, sky):
+    """The transient-events figure of an arrival dataset's event table (None without one).
+
+    Parameters
+    ----------
+    arrival : xarray.Dataset
+        With ``event_row``, ``event_col``, ``event_start_s`` and ``event_kind`` (CF flags:
+        ``flag_values``, ``flag_meanings``) over ``event``.
+    sky : (H, W) bool ndarray
+
+    Returns
+    -------
+    matplotlib.figure.Figure or None
+    """
+    if "event_kind" not in arrival:
+        return None
+    kind = arrival["event_kind"]
+    codes = dict(zip(str(kind.attrs.get("flag_meanings", "")).split(),
+                     np.atleast_1d(kind.attrs.get("flag_values", []))))
+    transient = (kind.values == codes["transient"]) if "transient" in codes else np.zeros(kind.shape, bool)
+    return transient_events_figure(arrival["event_row"].values, arrival["event_col"].values,
+                                   arrival["event_start_s"].values, transient, sky=sky)
+
+
 def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbroom, report=None, truth=None):
     """Write the outdoor figures, ``summary.json`` and (with `report`) ``accuracy.html``.
 
@@ -105,6 +131,12 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
     -------
     dict
         The summary written.
+
+    Notes
+    -----
+    Files: ``keyframes.png``, ``edge_over_time.png``, ``arrival_map.png``,
+    ``transient_events.png`` (when the arrival dataset has an event table),
+    ``pushbroom.png``, ``summary.json``, ``accuracy.html`` (with `report`).
     """
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -129,6 +161,9 @@ def write_outdoor_figures(outdir, *, frames, photometry, edges, arrival, pushbro
     else:
         figure = arrival_map_figure(arrival["arrival_time_s"].values, sky=sky)
     save_png(figure, outdir / "arrival_map.png")
+    events = transient_events_of(arrival, sky=sky)
+    if events is not None:
+        save_png(events, outdir / "transient_events.png")
     uniform_t, uniform = resample_uniform_time(pushbroom["pushbroom"].values, time_s,
                                                step_s=median_interval(time_s))
     save_png(pushbroom_figure(reference, uniform, uniform_t, sky=sky), outdir / "pushbroom.png")

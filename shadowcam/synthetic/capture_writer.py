@@ -267,7 +267,8 @@ def write_outdoor_capture(options, out_dir):
         end_elevation_deg=outdoor["end_elevation_deg"])
     capture = render_outdoor_capture(
         scene, frames=int(options["frames"]), supersample=int(options["supersample"]),
-        seed=seed, **{k: outdoor[k] for k in NUISANCES})
+        seed=seed, sun_diameter_deg=outdoor["sun_diameter_deg"],
+        **{k: outdoor[k] for k in NUISANCES})
     gt = capture.ground_truth
     log.info("scene, frames and ground truth rendered in %.2f s", time.perf_counter() - started)
     sensor = SensorModel(bit_depth=options["bit_depth"])

@@ -98,3 +98,43 @@ def test_pyramid_levels_stop_at_the_minimum_size():
         pyramid_levels((100, 100), levels=-1)
     with pytest.raises(ValueError, match="weight"):
         shift_coarse_to_fine(np.ones((80, 80)), np.ones((80, 80)), weight=np.ones((8, 8)))
+
+
+def _penumbra_frame(ref, *, top_row, width_px, shadow=0.15, noise=0.01, seed=5):
+    """`ref` with a shadow below `top_row` whose soft edge is a disc sun's penumbra `width_px`
+    rows wide (lit fraction of a uniform disc), times gain 1.3, with multiplicative noise."""
+    from shadowcam.synthetic.outdoor.render import disc_fraction_above
+
+    rows = np.arange(ref.shape[0])[:, None] + 0.5
+    lit_fraction = disc_fraction_above((top_row - rows) / (0.5 * width_px))
+    rng = np.random.default_rng(seed)
+    frame = ref * (shadow + (1 - shadow) * lit_fraction) * 1.3
+    return (frame * (1 + noise * rng.standard_normal(ref.shape))).astype(np.float32)
+
+
+@pytest.mark.parametrize("width_px", [4.0, 10.0, 16.0])
+def test_soft_shadow_measures_the_penumbra_width(width_px):
+    from shadowcam.outdoor.registration import soft_shadow
+
+    ref = _multiscale_texture()
+    frame = _penumbra_frame(ref, top_row=120.0, width_px=width_px)
+    lit = np.ones(ref.shape, bool)
+    shadow, width = soft_shadow(frame, ref, lit_reference=lit, gain=1.3)
+    # ratio from 0.15 (core below 0.5) to 1 within noise: the core starts where the disc
+    # fraction is (0.5 - 0.15) / 0.85 = 0.41, the soft band ends within 3 sigma of 1
+    assert width == pytest.approx(width_px * 0.5 * (1 - 0.14), abs=1.5)
+    assert shadow[int(120 + width_px / 2) + 1:].all()
+    assert not shadow[:int(120 - width_px / 2) - 2].any()
+
+
+@pytest.mark.parametrize("width_px", [6.0, 14.0])
+def test_soft_edge_does_not_bias_the_shift(width_px):
+    ref = _multiscale_texture()
+    true = (0.4, -0.3)
+    frame = _penumbra_frame(ref, top_row=110.0, width_px=width_px, noise=0.002)
+    frame = translate(frame, (-true[0], -true[1]), method="opencv_cubic")
+    lit = np.ones(ref.shape, bool)
+    weight = static_weight(frame, ref, lit_reference=lit, gain=1.3)
+    assert weight[110 - int(width_px / 2) - 5:].sum() == 0  # penumbra + band-pass reach out
+    estimate, _ = shift_lucas_kanade_LucasKanade1981(frame, ref, weight=weight)
+    np.testing.assert_allclose(estimate, true, atol=0.03)

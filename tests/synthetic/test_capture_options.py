@@ -43,3 +43,17 @@ def test_invalid_options_name_the_key(tmp_path):
     with pytest.raises(ValueError, match="cloudy"):
         outdoor_options({"cloudy": True})
     assert outdoor_options({"cloud": False})["cloud"] is False
+
+
+def test_sun_diameter_defaults_to_the_point_sun_and_the_manifest_schema_bounds_it(tmp_path):
+    from shadowcam.io.manifest import load_manifest
+
+    assert outdoor_options(None)["sun_diameter_deg"] == 0.0  # existing renders stay as they were
+    assert outdoor_options({"sun_diameter_deg": 0.53})["sun_diameter_deg"] == 0.53
+    doc = {"name": "r", "kind": "outdoor", "light": "distant",
+           "synthetic": {"scene": "ridge", "seed": 0, "height": 32, "width": 48, "frames": 10,
+                         "outdoor": {"sun_diameter_deg": 0.53}}}
+    assert load_manifest(_manifest(tmp_path, doc))["synthetic"]["outdoor"]["sun_diameter_deg"] == 0.53
+    doc["synthetic"]["outdoor"]["sun_diameter_deg"] = 2.0
+    with pytest.raises(ValueError, match="sun_diameter_deg"):
+        load_manifest(_manifest(tmp_path, doc))

@@ -150,6 +150,7 @@ FIGURE_ORDER = (
     "keyframes",
     "edge_over_time",
     "arrival_map",
+    "transient_events",
     "pushbroom",
     "accuracy",
     "error_histogram",

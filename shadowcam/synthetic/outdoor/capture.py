@@ -25,11 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from shadowcam._shared.progress import Progress
+from shadowcam._shared.validation import check_in_interval
 from shadowcam.io.frame_times import time_to_frame
 from shadowcam.synthetic.outdoor import nuisance as nz
 from shadowcam.synthetic.outdoor import truth as gt
 from shadowcam.synthetic.outdoor.clouds import CLOUD_SCENARIOS, cloud_shadows
-from shadowcam.synthetic.outdoor.render import frame_radiance, sample_grid, sky_colour, trace_samples
+from shadowcam.synthetic.outdoor.render import (frame_radiance, sample_grid, sky_colour, sun_lit_fraction,
+                                                trace_samples)
 from shadowcam.synthetic.outdoor.sun import elevation_azimuth, sun_colour
 
 log = logging.getLogger(__name__)
@@ -74,7 +76,8 @@ def _pixel_mean(values, shape, s2):
     return values.reshape(shape[0], shape[1], s2, *values.shape[1:]).mean(axis=2)
 
 
-def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances):
+def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter_deg=0.0,
+                           **nuisances):
     """Render the frames and the ground truth of a sunset time-lapse.
 
     Parameters
@@ -86,6 +89,12 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         Samples per pixel side (the ``subpixel`` GT uses the same samples).
     seed : int, keyword-only
         Seed of the nuisances.
+    sun_diameter_deg : float, keyword-only
+        0: a point sun (hard shadow edges); the real sun is
+        :data:`shadowcam.synthetic.outdoor.render.SUN_DIAMETER_DEG` across and casts a
+        penumbra (:func:`shadowcam.synthetic.outdoor.render.sun_lit_fraction`). Arrival times
+        are those of the disc's centre; the disc adds ``penumbra_start_time_s`` and
+        ``penumbra_end_time_s``.
     **nuisances
         Keys of :data:`NUISANCES`. ``cloud``: False, True (the ``"drifting"`` cloud) or a
         scenario of :data:`shadowcam.synthetic.outdoor.clouds.CLOUD_SCENARIOS`.
@@ -105,6 +114,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         raise ValueError(f"cloud: must be true, false or one of {list(CLOUD_SCENARIOS)}; got {cloud!r}")
     if int(supersample) < 1:
         raise ValueError(f"supersample must be >= 1; got {supersample}")
+    check_in_interval(sun_diameter_deg, "sun_diameter_deg", 0.0, 1.0, closed="both")
     rows, cols = scene.camera.height, scene.camera.width
     s = int(supersample)
     s2 = s * s
@@ -125,6 +135,13 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
     cls = classes["shadow_class"]
     arrival = np.where(cls == 3, t_centre, np.nan)
     T_img = t_centre.reshape(rows, cols)
+    penumbra = {}
+    if sun_diameter_deg > 0:
+        radius = np.radians(0.5 * sun_diameter_deg)
+        for key, offset, keep in (("penumbra_start_time_s", radius, cls == 3),
+                                  ("penumbra_end_time_s", -radius, cls >= 2)):
+            t_edge = gt.arrival_times(centres, scene.sun, times, offset_rad=offset)[0]
+            penumbra[key] = np.where(keep & np.isfinite(t_edge), t_edge, np.nan)
     sky_img = centres.sky.reshape(rows, cols)
 
     # frames
@@ -146,8 +163,10 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         trans = np.ones(len(samples.sky))
         for spec in clouds:
             trans[hit] *= nz.cloud_transmittance(samples.position[hit, :2], t, **spec)
+        lit = (lit_sub[k] if sun_diameter_deg == 0 else
+               sun_lit_fraction(samples, scene.sun, t, diameter_deg=sun_diameter_deg))
         L, L_clear = frame_radiance(samples, scene, t, shape=(rows, cols), supersample=s,
-                                    lit=lit_sub[k], cloud=trans if cloud_on else None)
+                                    lit=lit, cloud=trans if cloud_on else None)
         radiance.append(L)
         clean.append(L_clear)
         cloud_att.append(_pixel_mean(trans, (rows, cols), s2).astype(np.float32))
@@ -246,6 +265,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
         "pb_bin": var(tcc, pb_bin, "1", "mean reference radiance of pixels swept between frames"),
         "pb_bin_count": var(tc, pb_count, "1", "pixels in pb_bin"),
     }
+    for key, values in penumbra.items():
+        data[key] = var(rc, values.reshape(img), "s", gt.DEFINITIONS[key])
     camera = scene.camera
     ds = xr.Dataset(data, coords={"time": np.arange(len(times)), "channel": ["R", "G", "B"]})
     ds.attrs.update({
@@ -265,6 +286,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, **nuisances)
                                    | {"relit_after_arrival": int(classes["relit_after_arrival"].sum()),
                                       "always_shadowed": int(classes["always_shadowed"].sum())}),
         "supersample": s,
+        "sun_diameter_deg": float(sun_diameter_deg),
     })
     return OutdoorCapture(frames=sensor_frames, ground_truth=ds)
 

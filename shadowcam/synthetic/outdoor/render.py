@@ -11,7 +11,10 @@ Sun visibility (the one test used by the frames and the ground truth)::
 
 with ``H`` the terrain horizon of :func:`shadowcam.synthetic.outdoor.terrain.horizon_angles` tabulated at
 azimuth nodes ``HORIZON_FINE_DEG`` apart over the sun's path (probed where the sun crosses
-it, see :func:`trace_samples`) and linearly interpolated in azimuth. Radiance of a terrain sample (Lambertian, sun irradiance pi so a white surface
+it, see :func:`trace_samples`) and linearly interpolated in azimuth. A disc sun (the real one, 0.53 deg across, uniform
+disc: no limb darkening) is partly hidden where its centre is within its radius of the
+horizon's tangent line: the lit indicator becomes the visible disc fraction
+(:func:`sun_lit_fraction`), the penumbra, whose centre is the point sun's edge. Radiance of a terrain sample (Lambertian, sun irradiance pi so a white surface
 facing the sun has radiance 1)::
 
     L = albedo (lit cloud max(n.l, 0) sun_rgb(t) + (1 + n_z) / 2 sky_rgb(t))
@@ -27,7 +30,10 @@ OUTDOOR_SCENES : scene name -> factory.
 SampleGeometry : per-sample terrain hits, normals, albedo, view directions, horizons.
 trace_samples : intersect view rays through image points and compute their horizons.
 sample_grid : image points of the supersample grid (pixel-major) or of pixel centres.
-sun_lit : lit(p, t) of samples at one time or at per-sample times.
+horizon_clearance : angle of the sun's centre above the local horizon line of samples.
+sun_lit : lit(p, t) of samples (point sun, or the penumbra's centre/start/end of a disc sun).
+disc_fraction_above : fraction of a uniform disc above a line at a signed distance.
+sun_lit_fraction : visible fraction of the 0.53 deg sun disc (the penumbra).
 sky_colour : colour of the uniform sky light at sun elevations (fades and warms).
 frame_radiance : noise-free linear radiance of one frame, (rows, cols, 3), with and
     without a cloud shadow.
@@ -37,7 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shadowcam._shared.validation import check_in
+from shadowcam._shared.validation import check_in, check_in_interval
 from shadowcam.synthetic.lab.scene import camera_rays, look_at_camera
 from shadowcam.synthetic.outdoor.sun import SunPath, sun_colour
 from shadowcam.synthetic.outdoor.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
@@ -47,6 +53,8 @@ HORIZON_NODE_DEG = 2.0
 HORIZON_FINE_DEG = 0.25
 #: fine nodes are probed where the coarse horizon is within this of the sun's elevation (deg)
 HORIZON_REFINE_MARGIN_DEG = 0.75
+#: apparent angular diameter of the sun (deg)
+SUN_DIAMETER_DEG = 0.53
 #: sky light (uniform dome) colour at the start elevation, linear RGB
 SKY_RGB_START = (0.12, 0.1425, 0.1875)
 #: exponents of the sky dimming factor per channel (red fades least: the sky warms)
@@ -258,8 +266,13 @@ def trace_samples(scene, x, y, *, node_deg=HORIZON_NODE_DEG, fine_deg=HORIZON_FI
                           view_dir=dirs, depth_z=depth, horizon=horizon, node_azimuth=fine)
 
 
-def sun_lit(geometry, sun, t_s):
-    """Sun visibility of samples.
+def horizon_clearance(geometry, sun, t_s):
+    """Angle of the sun's centre above the local terrain horizon, and whether the surface faces it.
+
+    The horizon near the sun is its tangent line in the sky: with ``H(a)`` the tabulated
+    horizon (piecewise linear in azimuth ``a``) and ``m = H'(a) / cos(e)`` its slope in
+    angle units on the sky at sun elevation ``e``, the perpendicular angular distance of the
+    sun's centre from the line is ``(e - H(a)) / sqrt(1 + m**2)`` (positive above it).
 
     Parameters
     ----------
@@ -270,8 +283,10 @@ def sun_lit(geometry, sun, t_s):
 
     Returns
     -------
-    (N,) bool ndarray
-        False for sky samples (their normal is 0).
+    clearance : (N,) ndarray
+        Radians (NaN for sky samples).
+    facing : (N,) bool ndarray
+        ``n . l > 0`` toward the sun's centre (False for sky samples).
     """
     t = np.asarray(t_s, dtype=np.float64)
     n = len(geometry.sky)
@@ -284,14 +299,77 @@ def sun_lit(geometry, sun, t_s):
     j = np.clip((azimuth - nodes[0]) / step, 0.0, len(nodes) - 1.000001)
     j0 = j.astype(np.intp)
     f = j - j0
+    rows = slice(None) if t.ndim == 0 else np.arange(n)
+    h0, h1 = geometry.horizon[rows, j0], geometry.horizon[rows, j0 + 1]
     if t.ndim == 0:
-        h = geometry.horizon[:, j0] * (1.0 - f) + geometry.horizon[:, j0 + 1] * f
         facing = geometry.normal @ sun.direction(t) > 0
     else:
-        rows = np.arange(n)
-        h = geometry.horizon[rows, j0] * (1.0 - f) + geometry.horizon[rows, j0 + 1] * f
         facing = np.einsum("ij,ij->i", geometry.normal, sun.direction(t)) > 0
-    return facing & (elevation > h)
+    with np.errstate(invalid="ignore"):
+        slope = (h1 - h0) / step / np.cos(elevation)
+        clearance = (elevation - (h0 * (1.0 - f) + h1 * f)) / np.sqrt(1.0 + slope * slope)
+    return clearance, facing
+
+
+def sun_lit(geometry, sun, t_s, *, offset_rad=0.0):
+    """Sun visibility of samples: the sun's centre is above the horizon (a point sun).
+
+    Parameters
+    ----------
+    geometry, sun, t_s
+        As :func:`horizon_clearance`.
+    offset_rad : float, keyword-only
+        Lit iff the clearance (:func:`horizon_clearance`) exceeds this: 0 is the centre of
+        a disc sun's penumbra, ``+radius`` its start (first loss of light), ``-radius`` its
+        end (the whole disc hidden).
+
+    Returns
+    -------
+    (N,) bool ndarray
+        False for sky samples (their normal is 0).
+    """
+    clearance, facing = horizon_clearance(geometry, sun, t_s)
+    with np.errstate(invalid="ignore"):
+        return facing & (clearance > offset_rad)
+
+
+def disc_fraction_above(distance):
+    """Fraction of a uniform disc on the positive side of a line.
+
+    Parameters
+    ----------
+    distance : float or ndarray
+        Signed distance of the disc's centre from the line, in disc radii.
+
+    Returns
+    -------
+    ndarray
+        ``1/2 + (d sqrt(1 - d**2) + arcsin d) / pi`` with ``d`` clipped to [-1, 1]: 0 at
+        ``d <= -1``, 1/2 at 0, 1 at ``d >= 1``.
+    """
+    d = np.clip(np.asarray(distance, dtype=np.float64), -1.0, 1.0)
+    return 0.5 + (d * np.sqrt(1.0 - d * d) + np.arcsin(d)) / np.pi
+
+
+def sun_lit_fraction(geometry, sun, t_s, *, diameter_deg=SUN_DIAMETER_DEG):
+    """Visible fraction of a uniform sun disc (no limb darkening) above the terrain horizon.
+
+    The fraction of the disc of angular radius ``r`` above the horizon's tangent line at
+    clearance ``c`` (:func:`horizon_clearance`) is :func:`disc_fraction_above` ``(c / r)``;
+    a surface turned away from the sun's centre gets 0 (the attached shadow keeps the
+    centre's ``n . l``). ``diameter_deg = 0`` is the point sun of :func:`sun_lit`.
+
+    Returns
+    -------
+    (N,) ndarray
+        In [0, 1]; 0 for sky samples.
+    """
+    check_in_interval(diameter_deg, "diameter_deg", 0.0, 1.0, closed="both")
+    if diameter_deg == 0:
+        return sun_lit(geometry, sun, t_s).astype(np.float64)
+    clearance, facing = horizon_clearance(geometry, sun, t_s)
+    radius = np.radians(0.5 * diameter_deg)
+    return np.where(facing, disc_fraction_above(np.nan_to_num(clearance / radius, nan=-1.0)), 0.0)
 
 
 def sky_colour(elevation_deg, *, start_elevation_deg):
@@ -330,8 +408,9 @@ def frame_radiance(geometry, scene, t_s, *, shape, supersample, lit=None, cloud=
         Frame time (s since frame 0).
     shape : (rows, cols), keyword-only
     supersample : int, keyword-only
-    lit : (N,) bool ndarray, optional
-        Sun visibility of the samples at `t_s` (default: :func:`sun_lit`).
+    lit : (N,) bool or float ndarray, optional
+        Sun visibility of the samples at `t_s` (default: :func:`sun_lit`), or the visible
+        fraction of a disc sun (:func:`sun_lit_fraction`).
     cloud : (N,) ndarray, optional
         Cloud transmittance of the sun term per sample (default: no cloud).
 

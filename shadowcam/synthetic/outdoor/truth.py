@@ -28,6 +28,15 @@ DEFINITIONS = {
            "exceeds the terrain horizon H(p, azimuth(t)) (shadowcam.synthetic.outdoor.terrain.horizon_angles, "
            "0.5 m origin offset, interpolated linearly between azimuth nodes) - the test the "
            "renderer applies to every sample, so frames and ground truth agree by construction",
+    "sun": "point sun (sun_diameter_deg 0) or a uniform disc of sun_diameter_deg: the frames "
+           "use the visible disc fraction above the horizon's tangent line (the penumbra); "
+           "'lit' and every arrival time below refer to the disc's centre, i.e. the middle of "
+           "the penumbra (visible fraction 1/2)",
+    "penumbra_start_time_s": "disc sun: first time the disc's centre is within one sun radius "
+                             "of the horizon (light starts to fade), same scan and bisection; "
+                             "NaN unless shadow_class==3 or when shadowed from the start",
+    "penumbra_end_time_s": "disc sun: first time the whole disc is below the horizon (sun "
+                           "fully hidden); NaN if it never happens in the sequence",
     "arrival_time_s": "pixel-centre point: first time it is not lit. Frames are scanned; for the "
                       "first unlit frame k (k>=1) the time is bisected (30 steps) in "
                       "(t[k-1], t[k]] with the continuous sun model; NaN unless shadow_class==3",
@@ -71,7 +80,7 @@ DEFINITIONS = {
 
 
 
-def arrival_times(geometry, sun, frame_times, *, bisect_steps=30):
+def arrival_times(geometry, sun, frame_times, *, bisect_steps=30, offset_rad=0.0):
     """First unlit time of every sample.
 
     Parameters
@@ -81,6 +90,10 @@ def arrival_times(geometry, sun, frame_times, *, bisect_steps=30):
     frame_times : (K,) ndarray
         Frame times (s), increasing.
     bisect_steps : int, keyword-only
+    offset_rad : float, keyword-only
+        Unlit means the sun's centre is at most this far above the horizon
+        (:func:`shadowcam.synthetic.outdoor.render.sun_lit`): 0 the penumbra's centre (and
+        the point sun), ``+radius`` the penumbra's start, ``-radius`` its end.
 
     Returns
     -------
@@ -94,7 +107,7 @@ def arrival_times(geometry, sun, frame_times, *, bisect_steps=30):
     frame_times = np.asarray(frame_times, dtype=np.float64)
     if frame_times.ndim != 1 or np.any(np.diff(frame_times) <= 0):
         raise ValueError("frame_times: expected increasing 1-D times")
-    lit = np.stack([sun_lit(geometry, sun, t) for t in frame_times])
+    lit = np.stack([sun_lit(geometry, sun, t, offset_rad=offset_rad) for t in frame_times])
     unlit = ~lit
     any_unlit = unlit.any(axis=0)
     first = np.where(any_unlit, np.argmax(unlit, axis=0), -1)
@@ -107,7 +120,7 @@ def arrival_times(geometry, sun, frame_times, *, bisect_steps=30):
         sub = _subset(geometry, todo)
         for _ in range(bisect_steps):
             mid = 0.5 * (lo + hi)
-            lit_mid = sun_lit(sub, sun, mid)
+            lit_mid = sun_lit(sub, sun, mid, offset_rad=offset_rad)
             lo = np.where(lit_mid, mid, lo)
             hi = np.where(lit_mid, hi, mid)
         arrival[todo] = 0.5 * (lo + hi)
