@@ -62,6 +62,7 @@ def run(args):
         growth = (memory_growth(stages, before, frames=n_frames, before_frames=args.compare_frames)
                   if before and args.compare_frames else None)
         decode = time_decode(sorted(p for p in Path(args.raw).iterdir() if p.is_file()))
-        print("\n".join(scale_targets(stages, n_frames=n_frames, store_bytes=store_bytes, decode=decode, growth=growth)))
+        print("\n".join(scale_targets(stages, n_frames=n_frames, store_bytes=store_bytes, decode=decode, growth=growth,
+                                        before=before, before_frames=args.compare_frames)))
     if args.photometry and args.shake:
         print(registration_line(open_dataset(args.photometry), json.loads(Path(args.shake).read_text()), shape=shape))

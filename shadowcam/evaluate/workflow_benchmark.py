@@ -193,7 +193,8 @@ def memory_growth(stages, before, *, frames, before_frames, low=100, high=1000):
     """Per-stage peak RSS of the largest job, extrapolated linearly to `low` and `high` frames.
 
     Each stage's peak is taken as ``a + b * frames`` through the two runs
-    (the line through two noisy points: a small run's slope is mostly noise).
+    (the line through two noisy points: a small run's slope is mostly noise;
+    a negative slope, the longer run peaking lower, is taken as 0).
 
     Parameters
     ----------
@@ -219,13 +220,18 @@ def memory_growth(stages, before, *, frames, before_frames, low=100, high=1000):
         peak, old = max(r for _, r in jobs), max(r for _, r in before[stage])
         if not (math.isfinite(peak) and math.isfinite(old)):
             continue
-        slope = (peak - old) / (frames - before_frames)
+        # a peak cannot shrink as frames are added: a smaller peak of the longer run is noise (slope 0)
+        slope = max(0.0, (peak - old) / (frames - before_frames))
         at_low, at_high = peak + slope * (low - frames), peak + slope * (high - frames)
         out[stage] = (at_low, at_high, at_high / at_low if at_low > 0 else float("inf"))
     return out
 
 
-def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None):
+def _job_seconds(stages, prefix=""):
+    return sum(s for stage, jobs in stages.items() if stage.startswith(prefix) for s, _ in jobs)
+
+
+def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None, before=None, before_frames=None):
     """The scale ratios of an outdoor run against :data:`SCALE_TARGETS`, as text lines.
 
     Parameters
@@ -240,6 +246,13 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None):
         :func:`time_decode` of the run's RAW frames.
     growth : mapping, optional
         :func:`memory_growth` of the run against a shorter one.
+    before, before_frames : mapping and int, optional
+        :func:`read_benchmarks` of a shorter run and its frames: the time
+        ratios are also given per added frame (the run's time minus the
+        shorter run's over the frames added, against the decode time per
+        frame), which leaves out the fixed costs of the jobs (start-up, DAG)
+        that dominate small runs; parted stages add jobs as frames grow, so
+        their per-job costs stay in.
 
     Returns
     -------
@@ -248,8 +261,6 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None):
     """
     if decode["frames"] != n_frames:
         raise ValueError(f"decode must time the run's {n_frames} frames; got {decode['frames']}")
-    total = sum(s for jobs in stages.values() for s, _ in jobs)
-    pass1 = sum(s for stage, jobs in stages.items() if stage.startswith("outdoor_normalise") for s, _ in jobs)
     peaks = {stage: max(r for _, r in jobs) for stage, jobs in stages.items()}
     largest = max(peaks, key=lambda stage: peaks[stage] if math.isfinite(peaks[stage]) else -1.0)
     per = decode["mosaic_s"] / n_frames
@@ -264,10 +275,15 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None):
         return f"{name:52s} {value:10.2f} {limit:8.2f}  {verdict}"
 
     lines.append(row("frame store / RAW bytes", store_bytes / decode["raw_bytes"], SCALE_TARGETS["store"]))
-    lines.append(row("end-to-end (all jobs) / decode-only time", total / decode["mosaic_s"],
-                     SCALE_TARGETS["end_to_end"]))
-    lines.append(row("pass 1 (registration, gains) / decode-only", pass1 / decode["mosaic_s"],
-                     SCALE_TARGETS["pass1"]))
+    marginal = bool(before and before_frames and before_frames != n_frames)
+    for name, prefix, limit in (("end-to-end (all jobs)", "", "end_to_end"),
+                                ("pass 1 (registration, gains)", "outdoor_normalise", "pass1")):
+        spent = _job_seconds(stages, prefix)
+        lines.append(row(f"{name} / decode-only time", spent / decode["mosaic_s"], SCALE_TARGETS[limit]))
+        if marginal:
+            added = (spent - _job_seconds(before, prefix)) / (n_frames - before_frames)
+            lines.append(row(f"  the same per added frame ({before_frames} -> {n_frames})", added / per,
+                             SCALE_TARGETS[limit]))
     lines.append(row(f"peak RSS per job, MB ({largest})", peaks[largest], SCALE_TARGETS["peak_mb"]))
     if growth:
         worst = max(growth, key=lambda stage: growth[stage][2])

@@ -46,6 +46,8 @@ def test_memory_growth_is_the_line_through_the_two_runs():
     assert low == pytest.approx(684.0) and high == pytest.approx(2484.0) and ratio == pytest.approx(2484 / 684)
     flat = memory_growth({"a": [(1.0, 300.0), (1.0, 400.0)]}, {"a": [(1.0, 400.0)]}, frames=16, before_frames=8)
     assert flat["a"] == pytest.approx((400.0, 400.0, 1.0))
+    shrinking = memory_growth({"a": [(1.0, 380.0)]}, {"a": [(1.0, 400.0)]}, frames=16, before_frames=8)
+    assert shrinking["a"] == pytest.approx((380.0, 380.0, 1.0))  # a lower peak of the longer run is noise
     with pytest.raises(ValueError, match="different"):
         memory_growth({}, {}, frames=8, before_frames=8)
 
@@ -54,13 +56,19 @@ def test_scale_targets_are_the_ratios_of_one_run():
     stages = {"decode_timelapse_parts": [(4.0, 900.0), (4.0, 800.0)], "outdoor_normalise_parts": [(3.0, 5000.0)],
               "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
     decode = {"frames": 10, "raw_bytes": 1000, "mosaic_s": 5.0, "rgb_s": 7.0, "direct": True}
-    lines = scale_targets(stages, n_frames=10, store_bytes=2000, decode=decode,
+    # the 5-frame run: 6 s less, 2 of them in pass 1
+    before = {"decode_timelapse_parts": [(4.0, 900.0)], "outdoor_normalise_parts": [(1.0, 5000.0)],
+              "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
+    lines = scale_targets(stages, n_frames=10, store_bytes=2000, decode=decode, before=before, before_frames=5,
                           growth={"arrival": (100.0, 110.0, 1.1), "a": (100.0, 150.0, 1.5)})
-    rows = {name: rest for name, *rest in (line.rsplit(None, 3) for line in lines[2:] if not line.startswith("  "))}
+    rows = {name: rest for name, *rest in (line.rsplit(None, 3) for line in lines[2:] if not line.startswith("  ("))}
     assert "0.500 s/frame mosaic, 0.700 s/frame to float RGB" in lines[0] and "direct mosaic reader" in lines[0]
     assert rows["frame store / RAW bytes"] == ["2.00", "1.50", "MISSED"]
     assert rows["end-to-end (all jobs) / decode-only time"] == ["4.00", "3.00", "MISSED"]  # 20 s / 5 s
-    assert rows["pass 1 (registration, gains) / decode-only"] == ["0.80", "1.00", "ok"]  # 4 s / 5 s
+    assert rows["pass 1 (registration, gains) / decode-only time"] == ["0.80", "1.00", "ok"]  # 4 s / 5 s
+    # per added frame: 6 s / 5 frames = 1.2 s against 0.5 s decode; pass 1 2 s / 5 frames = 0.4 s
+    added = [rest for name, *rest in (line.rsplit(None, 3) for line in lines) if "per added frame (5 -> 10)" in name]
+    assert added == [["2.40", "3.00", "ok"], ["0.80", "1.00", "ok"]]
     assert rows["peak RSS per job, MB (outdoor_normalise_parts)"] == ["5000.00", "4096.00", "MISSED"]
     assert rows["peak RSS 1000 / 100 frames (a)"] == ["1.50", "1.20", "MISSED"]
     with pytest.raises(ValueError, match="10 frames"):
