@@ -245,7 +245,9 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None, before=
     decode : mapping
         :func:`time_decode` of the run's RAW frames.
     growth : mapping, optional
-        :func:`memory_growth` of the run against a shorter one.
+        :func:`memory_growth` of the run against a shorter one; the worst
+        stage whose jobs read the whole sweep is shown (a parted stage's jobs
+        read a fixed number of frames whatever the sweep's length).
     before, before_frames : mapping and int, optional
         :func:`read_benchmarks` of a shorter run and its frames: the time
         ratios are also given per added frame (the run's time minus the
@@ -285,9 +287,13 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None, before=
             lines.append(row(f"  the same per added frame ({before_frames} -> {n_frames})", added / per,
                              SCALE_TARGETS[limit]))
     lines.append(row(f"peak RSS per job, MB ({largest})", peaks[largest], SCALE_TARGETS["peak_mb"]))
-    if growth:
-        worst = max(growth, key=lambda stage: growth[stage][2])
-        low, high, ratio = growth[worst]
+    # a parted stage's jobs read a fixed number of frames whatever the sweep's length: only the
+    # stages whose jobs read the whole sweep can grow with it
+    whole = {stage: value for stage, value in (growth or {}).items() if not stage.endswith("_parts")}
+    if whole:
+        worst = max(whole, key=lambda stage: whole[stage][2])
+        low, high, ratio = whole[worst]
         lines.append(row(f"peak RSS 1000 / 100 frames ({worst})", ratio, SCALE_TARGETS["growth"]))
-        lines.append(f"  (linear through the two runs: {low:.0f} MB at 100 frames, {high:.0f} MB at 1000)")
+        lines.append(f"  (linear through the two runs: {low:.0f} MB at 100 frames, {high:.0f} MB at 1000; "
+                     "parted stages: jobs of a fixed number of frames)")
     return lines

@@ -60,7 +60,8 @@ def test_scale_targets_are_the_ratios_of_one_run():
     before = {"decode_timelapse_parts": [(4.0, 900.0)], "outdoor_normalise_parts": [(1.0, 5000.0)],
               "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
     lines = scale_targets(stages, n_frames=10, store_bytes=2000, decode=decode, before=before, before_frames=5,
-                          growth={"arrival": (100.0, 110.0, 1.1), "a": (100.0, 150.0, 1.5)})
+                          growth={"arrival": (100.0, 110.0, 1.1), "a": (100.0, 150.0, 1.5),
+                                  "decode_timelapse_parts": (100.0, 900.0, 9.0)})
     rows = {name: rest for name, *rest in (line.rsplit(None, 3) for line in lines[2:] if not line.startswith("  ("))}
     assert "0.500 s/frame mosaic, 0.700 s/frame to float RGB" in lines[0] and "direct mosaic reader" in lines[0]
     assert rows["frame store / RAW bytes"] == ["2.00", "1.50", "MISSED"]
@@ -70,7 +71,7 @@ def test_scale_targets_are_the_ratios_of_one_run():
     added = [rest for name, *rest in (line.rsplit(None, 3) for line in lines) if "per added frame (5 -> 10)" in name]
     assert added == [["2.40", "3.00", "ok"], ["0.80", "1.00", "ok"]]
     assert rows["peak RSS per job, MB (outdoor_normalise_parts)"] == ["5000.00", "4096.00", "MISSED"]
-    assert rows["peak RSS 1000 / 100 frames (a)"] == ["1.50", "1.20", "MISSED"]
+    assert rows["peak RSS 1000 / 100 frames (a)"] == ["1.50", "1.20", "MISSED"]  # parted jobs: fixed frames
     with pytest.raises(ValueError, match="10 frames"):
         scale_targets(stages, n_frames=10, store_bytes=1, decode=dict(decode, frames=9))
 
