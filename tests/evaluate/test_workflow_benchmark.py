@@ -28,6 +28,14 @@ def test_parted_stage_jobs_are_grouped_and_the_extrapolation_divides_by_the_core
     assert "0.3 h" in lines[-1] and "peak memory 0.6 GB" in lines[-1] and "(1 MB/frame)" in lines[-1]
 
 
+def test_cpu_clock_reads_the_cpu_time_column(tmp_path):
+    (tmp_path / "arrival.tsv").write_text("s\th:m:s\tmax_rss\tcpu_time\n9.5\t0:00:09\t120\t2.25\n")
+    assert read_benchmarks(tmp_path, clock="cpu") == {"arrival": [(2.25, 120.0)]}
+    assert read_benchmarks(tmp_path) == {"arrival": [(9.5, 120.0)]}
+    with pytest.raises(ValueError, match="clock"):
+        read_benchmarks(tmp_path, clock="sun")
+
+
 def test_missing_benchmarks_and_store_size(tmp_path):
     with pytest.raises(ValueError, match="no benchmark files"):
         read_benchmarks(tmp_path)
@@ -55,7 +63,7 @@ def test_memory_growth_is_the_line_through_the_two_runs():
 def test_scale_targets_are_the_ratios_of_one_run():
     stages = {"decode_timelapse_parts": [(4.0, 900.0), (4.0, 800.0)], "outdoor_normalise_parts": [(3.0, 5000.0)],
               "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
-    decode = {"frames": 10, "raw_bytes": 1000, "mosaic_s": 5.0, "rgb_s": 7.0, "direct": True}
+    decode = {"frames": 10, "raw_bytes": 1000, "mosaic_s": 5.0, "mosaic_cpu_s": 2.5, "rgb_s": 7.0, "direct": True}
     # the 5-frame run: 6 s less, 2 of them in pass 1
     before = {"decode_timelapse_parts": [(4.0, 900.0)], "outdoor_normalise_parts": [(1.0, 5000.0)],
               "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
@@ -72,6 +80,11 @@ def test_scale_targets_are_the_ratios_of_one_run():
     assert added == [["2.40", "3.00", "ok"], ["0.80", "1.00", "ok"]]
     assert rows["peak RSS per job, MB (outdoor_normalise_parts)"] == ["5000.00", "4096.00", "MISSED"]
     assert rows["peak RSS 1000 / 100 frames (a)"] == ["1.50", "1.20", "MISSED"]  # parted jobs: fixed frames
+    cpu = scale_targets(stages, n_frames=10, store_bytes=2000, decode=decode, clock="cpu")
+    assert cpu[0].startswith("cpu time") and "0.250 s/frame mosaic" in cpu[0]
+    assert [line.split()[-3] for line in cpu if "/ decode-only time" in line] == ["8.00", "1.60"]  # against 2.5 s
+    with pytest.raises(ValueError, match="clock"):
+        scale_targets(stages, n_frames=10, store_bytes=1, decode=decode, clock="gpu")
     with pytest.raises(ValueError, match="10 frames"):
         scale_targets(stages, n_frames=10, store_bytes=1, decode=dict(decode, frames=9))
 
@@ -86,7 +99,7 @@ def test_time_decode_reads_every_frame_with_the_pipeline_reader(tmp_path):
         paths.append(write_dng(tmp_path / f"{k}.dng", mosaic, bit_depth=14, black_level=512, compression="ljpeg"))
     decode = time_decode(paths)
     assert decode["frames"] == 3 and decode["raw_bytes"] == sum(p.stat().st_size for p in paths)
-    assert decode["mosaic_s"] > 0 and decode["rgb_s"] > 0
+    assert decode["mosaic_s"] > 0 and decode["mosaic_cpu_s"] > 0 and decode["rgb_s"] > 0
     assert decode["direct"]  # lossless-JPEG DNGs the writer makes are read directly, as the pipeline does
     with pytest.raises(ValueError, match="at least one"):
         time_decode([])
