@@ -21,8 +21,9 @@ OUTDOOR ?= dev_ridge
 BENCH_ARGS ?=
 # DNG compressions benchmarked: lossless JPEG (what cameras write), none (rawpy's cheapest decode)
 BENCH_COMPRESSION ?= ljpeg none
-# bench-outdoor-size: real-size sample (COLSxROWS), frames, frames per first-pass job, scratch dir
-BENCH_SIZE ?= 6000x4000
+# bench-outdoor-size: sample size (COLSxROWS; the small default finishes in a few minutes on
+# 2 shared cores; a 24 MP camera is BENCH_SIZE=6000x4000), frames, frames per first-pass job, scratch dir
+BENCH_SIZE ?= 1536x1024
 BENCH_FRAMES ?= 16
 BENCH_PART ?= 8
 BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
@@ -84,7 +85,9 @@ bench: $(STAMP)
 # The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of dev_ridge
 # upsampled to BENCH_SIZE (14-bit DNG, full-resolution noise) run in a scratch copy of the
 # workflow (2 cores, first pass in parts of BENCH_PART frames); prints per stage s/frame,
-# frames/s, MP/s, peak RSS (and its growth from the half run), and the 1000-frame extrapolation.
+# frames/s, MP/s, peak RSS (and its growth from the half run), the 1000-frame extrapolation, and
+# the scale targets side by side (store / RAW bytes, end-to-end and first pass / decode-only time
+# of the same frames timed in this run, peak RSS per job and its 1000 / 100 frames ratio).
 bench-outdoor-size: $(STAMP)
 	rm -rf $(BENCH_DIR) && mkdir -p $(BENCH_DIR)/data_manifest
 	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
@@ -100,7 +103,8 @@ bench-outdoor-size: $(STAMP)
 	  --frames $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/frames/timelapse.zarr \
 	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 )) \
 	  --photometry $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/outdoor/photometry.nc \
-	  --shake $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/timestamps.json
+	  --shake $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/timestamps.json \
+	  --raw $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/frames
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint

@@ -10,7 +10,12 @@ jobs divide by the cores, and memory is the peak per job (it does not grow with 
 number of frames: compare two runs with ``--compare``) times the jobs that run at
 once. Disk: the decoded frame store per frame. With ``--photometry`` and ``--shake``
 (a sample's sidecar, ``shadowcam outdoor-sample``) it also prints the registration
-error at that size against the applied shake.
+error at that size against the applied shake. With ``--raw`` (the run's RAW
+frames) it times decoding them with the pipeline's reader and prints the scale
+targets side by side: frame store / RAW bytes, end-to-end / decode-only time,
+first pass / decode-only (in CPU time, a job's cost whatever else loads a shared
+machine, and in wall time), the largest job's peak RSS and (with ``--compare``)
+its growth from 100 to 1000 frames, extrapolated linearly through the two runs.
 
 Example::
 
@@ -26,7 +31,8 @@ run : print the table.
 import json
 from pathlib import Path
 
-from shadowcam.evaluate.workflow_benchmark import benchmark_table, directory_bytes, read_benchmarks, registration_line
+from shadowcam.evaluate.workflow_benchmark import (benchmark_table, directory_bytes, memory_growth, read_benchmarks,
+                                                  registration_line, scale_targets, time_decode)
 from shadowcam.io.datasets import open_dataset
 from shadowcam.io.frame_store import open_frames
 
@@ -42,18 +48,26 @@ def add_parser(subparsers, name):
     parser.add_argument("--cores", type=int, default=2, help="cores (jobs side by side) of the target machine")
     parser.add_argument("--photometry", default=None, help="the run's results/<ds>/outdoor/photometry.nc (estimated shifts)")
     parser.add_argument("--shake", default=None, help="sidecar JSON with the applied shake_dx_px, shake_dy_px")
+    parser.add_argument("--raw", default=None, help="directory of the run's RAW frames (decode-only time, sizes)")
     return parser
-
 
 
 def run(args):
     """Print the per-stage table and the extrapolation."""
     frames = open_frames(args.frames)
-    shape = (frames.sizes["row"], frames.sizes["col"])
-    lines = benchmark_table(read_benchmarks(args.benchmarks), n_frames=frames.sizes["time"], shape=shape,
-                            store_bytes=directory_bytes(args.frames),
-                            before=read_benchmarks(args.compare) if args.compare else None,
-                            before_frames=args.compare_frames, extrapolate=args.extrapolate, cores=args.cores)
-    print("\n".join(lines))
+    shape, n_frames, store_bytes = (frames.sizes["row"], frames.sizes["col"]), frames.sizes["time"], directory_bytes(args.frames)
+    stages, before = read_benchmarks(args.benchmarks), read_benchmarks(args.compare) if args.compare else None
+    print("\n".join(benchmark_table(stages, n_frames=n_frames, shape=shape, store_bytes=store_bytes, before=before,
+                                    before_frames=args.compare_frames, extrapolate=args.extrapolate, cores=args.cores)))
+    if args.raw:
+        growth = (memory_growth(stages, before, frames=n_frames, before_frames=args.compare_frames)
+                  if before and args.compare_frames else None)
+        decode = time_decode(sorted(p for p in Path(args.raw).iterdir() if p.is_file()))
+        for clock in ("cpu", "wall"):  # CPU: a job's cost whatever else loads a shared machine
+            timed = stages if clock == "wall" else read_benchmarks(args.benchmarks, clock=clock)
+            shorter = read_benchmarks(args.compare, clock=clock) if args.compare else None
+            print("\n".join(scale_targets(timed, n_frames=n_frames, store_bytes=store_bytes, decode=decode,
+                                          growth=growth, before=shorter, before_frames=args.compare_frames,
+                                          clock=clock)))
     if args.photometry and args.shake:
         print(registration_line(open_dataset(args.photometry), json.loads(Path(args.shake).read_text()), shape=shape))

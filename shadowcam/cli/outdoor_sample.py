@@ -38,6 +38,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--seed", type=int, default=0, help="noise and shake seed")
     parser.add_argument("--shake-px", type=float, default=2.0,
                         help="largest camera shake of the sample, pixels (0: none; default 2)")
+    parser.add_argument("--compression", choices=("ljpeg", "none"), default="ljpeg",
+                        help="DNG compression: lossless JPEG as cameras write (default) or none")
     parser.add_argument("--name", required=True, help="dataset name")
     parser.add_argument("--outdir", required=True, help="directory of the frames (root of the new dataset)")
     parser.add_argument("--manifest-out", required=True, help="manifest to write, e.g. <workdir>/data_manifest/<name>.yaml")
@@ -48,5 +50,6 @@ def run(args):
     """Write the sample frames, timestamps and manifest."""
     write_sample(load_manifest(args.source), args.outdir, args.manifest_out, name=args.name, size=args.size,
                  frames=args.frames, first=args.first, bit_depth=args.bit_depth, seed=args.seed,
-                 shake_px=args.shake_px, source_label=str(args.source))
+                 shake_px=args.shake_px, source_label=str(args.source),
+                 compression=args.compression)
     print(Path(args.manifest_out))

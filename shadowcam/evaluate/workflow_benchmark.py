@@ -10,23 +10,44 @@ as several jobs divide by the cores, and memory is the peak per job (it does
 not grow with the number of frames: compare two runs) times the jobs that run
 at once. Disk: the decoded frame store per frame.
 
+The scale targets of an outdoor time-lapse are ratios measured in one run:
+the frame store's size over the RAW files' size, the end-to-end time (sum of
+every job's wall time) and the first pass (registration and gains) over the
+decode-only time of the same frames (the pipeline's own mosaic reader, timed
+in the same run), the largest job's peak RSS, and the growth of each stage's
+peak RSS from 100 to 1000 frames, extrapolated linearly through two runs of
+different lengths.
+
 Offers
 ------
 read_benchmarks : stage -> list of (seconds, max RSS MB) per job.
 directory_bytes : total size of the files under a directory.
 benchmark_table : the per-stage table and the extrapolation, as text lines.
 registration_line : the registration error at a sample's size against its applied shake, as text.
+time_decode : decode-only time and size of RAW frames, with the pipeline's reader.
+memory_growth : per-stage peak RSS extrapolated linearly to two frame counts, and their ratio.
+scale_targets : the four scale ratios of a run against their targets, as text lines.
 """
 
 import csv
+import math
 import re
+import time
 from pathlib import Path
 
+from shadowcam._shared.validation import check_in
 from shadowcam.outdoor.accuracy import registration_errors
 
 
-def read_benchmarks(directory):
-    """Return ``{stage: [(seconds, max_rss_mb), ...]}`` from the benchmark TSVs in `directory`."""
+def read_benchmarks(directory, *, clock="wall"):
+    """Return ``{stage: [(seconds, max_rss_mb), ...]}`` from the benchmark TSVs in `directory`.
+
+    `clock` ``"wall"`` reads the wall time (column ``s``), ``"cpu"`` the CPU time of
+    the job's processes (``cpu_time``: what a job costs whatever else loads the machine).
+    """
+    column = {"wall": "s", "cpu": "cpu_time"}.get(clock)
+    if column is None:
+        raise ValueError(f"clock must be 'wall' or 'cpu'; got {clock!r}")
     directory = Path(directory)
     files = sorted(directory.glob("*.tsv"))
     if not files:
@@ -38,7 +59,7 @@ def read_benchmarks(directory):
         stage = re.sub(r"_part[^_]*$", "_parts", path.stem)
         for row in rows[-1:]:
             rss = float(row["max_rss"]) if row["max_rss"] not in ("", "NA", "-") else float("nan")
-            stages.setdefault(stage, []).append((float(row["s"]), rss))
+            stages.setdefault(stage, []).append((float(row[column]), rss))
     return stages
 
 
@@ -127,3 +148,166 @@ def registration_line(photometry, shake, *, shape):
     return (f"registration at {shape[1]}x{shape[0]} against the applied shake "
             f"(up to {errors['true_max_px']:.2f} px from frame 0): rms {errors['rms_px']:.3f} px "
             f"(rows {errors['rms_row_px']:.3f}, cols {errors['rms_col_px']:.3f}), max {errors['max_abs_px']:.3f} px")
+
+
+#: scale targets of an outdoor time-lapse: store / RAW bytes, end-to-end / decode,
+#: first pass / decode, largest job's peak RSS (MB), peak RSS at 1000 / 100 frames
+SCALE_TARGETS = {"store": 1.5, "end_to_end": 3.0, "pass1": 1.0, "peak_mb": 4096.0, "growth": 1.2}
+
+
+def time_decode(paths):
+    """Decode-only time and total size of a sweep's RAW frames, read as the pipeline reads them.
+
+    The mosaics are read through one :class:`shadowcam.io.mosaic_reader.MosaicReader`
+    (directly from the DNG data where verified equal to rawpy, else rawpy);
+    building the reader (its rawpy check of the first frame) is not timed, and
+    every frame, the first included, is read again timed. Then every frame is
+    decoded to linear float32 RGB (:func:`shadowcam.io.decode.read_frame`:
+    mosaic, bilinear demosaic, levels), timed separately.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        RAW frame files of one sweep (at least one).
+
+    Returns
+    -------
+    dict
+        ``frames``, ``raw_bytes`` (sum of the file sizes), ``mosaic_s`` (total
+        seconds of the mosaic reads), ``mosaic_cpu_s`` (their CPU seconds), ``rgb_s`` (total seconds of the decodes
+        to float RGB), ``direct`` (whether the direct reader was used).
+    """
+    from shadowcam.io.decode import read_frame
+    from shadowcam.io.mosaic_reader import MosaicReader
+
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise ValueError("paths must list at least one RAW frame")
+    reader = MosaicReader(paths[0])
+    reader.read(paths[0])  # hands out the cached first mosaic: later reads of it decode again
+    started, cpu = time.perf_counter(), time.process_time()
+    for path in paths:
+        reader.read(path)
+    mosaic_s, mosaic_cpu_s = time.perf_counter() - started, time.process_time() - cpu
+    started = time.perf_counter()
+    for path in paths:
+        read_frame(path, mosaics=reader)
+    rgb_s = time.perf_counter() - started
+    return {"frames": len(paths), "raw_bytes": sum(p.stat().st_size for p in paths), "mosaic_s": mosaic_s,
+            "mosaic_cpu_s": mosaic_cpu_s, "rgb_s": rgb_s, "direct": reader.direct}
+
+
+def memory_growth(stages, before, *, frames, before_frames, low=100, high=1000):
+    """Per-stage peak RSS of the largest job, extrapolated linearly to `low` and `high` frames.
+
+    Each stage's peak is taken as ``a + b * frames`` through the two runs
+    (the line through two noisy points: a small run's slope is mostly noise;
+    a negative slope, the longer run peaking lower, is taken as 0).
+
+    Parameters
+    ----------
+    stages, before : mapping
+        :func:`read_benchmarks` of a run of `frames` frames and of one of `before_frames`.
+    frames, before_frames : int
+        Their numbers of frames (different).
+    low, high : int
+        Frame counts to extrapolate to.
+
+    Returns
+    -------
+    dict
+        ``{stage: (peak_mb_at_low, peak_mb_at_high, ratio)}`` for the stages in both runs
+        with a finite peak.
+    """
+    if frames == before_frames or min(frames, before_frames, low, high) < 1:
+        raise ValueError(f"frames and before_frames must be different and >= 1; got {frames}, {before_frames}")
+    out = {}
+    for stage, jobs in stages.items():
+        if stage not in before:
+            continue
+        peak, old = max(r for _, r in jobs), max(r for _, r in before[stage])
+        if not (math.isfinite(peak) and math.isfinite(old)):
+            continue
+        # a peak cannot shrink as frames are added: a smaller peak of the longer run is noise (slope 0)
+        slope = max(0.0, (peak - old) / (frames - before_frames))
+        at_low, at_high = peak + slope * (low - frames), peak + slope * (high - frames)
+        out[stage] = (at_low, at_high, at_high / at_low if at_low > 0 else float("inf"))
+    return out
+
+
+def _job_seconds(stages, prefix=""):
+    return sum(s for stage, jobs in stages.items() if stage.startswith(prefix) for s, _ in jobs)
+
+
+def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None, before=None, before_frames=None,
+                  clock="wall"):
+    """The scale ratios of an outdoor run against :data:`SCALE_TARGETS`, as text lines.
+
+    Parameters
+    ----------
+    stages : mapping
+        :func:`read_benchmarks` of the run.
+    n_frames : int
+        Frames of the run (those timed by `decode`).
+    store_bytes : int
+        Size of the run's frame store.
+    decode : mapping
+        :func:`time_decode` of the run's RAW frames.
+    growth : mapping, optional
+        :func:`memory_growth` of the run against a shorter one; the worst
+        stage whose jobs read the whole sweep is shown (a parted stage's jobs
+        read a fixed number of frames whatever the sweep's length).
+    before, before_frames : mapping and int, optional
+        :func:`read_benchmarks` of a shorter run and its frames: the time
+        ratios are also given per added frame (the run's time minus the
+        shorter run's over the frames added, against the decode time per
+        frame), which leaves out the fixed costs of the jobs (start-up, DAG)
+        that dominate small runs; parted stages add jobs as frames grow, so
+        their per-job costs stay in.
+    clock : {"wall", "cpu"}
+        The clock of `stages` and `before` (:func:`read_benchmarks`); the
+        decode time compared is ``mosaic_s`` or ``mosaic_cpu_s`` to match.
+
+    Returns
+    -------
+    list of str
+        One line per target: quantity, measured, target, ``ok`` or ``MISSED``.
+    """
+    if decode["frames"] != n_frames:
+        raise ValueError(f"decode must time the run's {n_frames} frames; got {decode['frames']}")
+    peaks = {stage: max(r for _, r in jobs) for stage, jobs in stages.items()}
+    largest = max(peaks, key=lambda stage: peaks[stage] if math.isfinite(peaks[stage]) else -1.0)
+    check_in(clock, "clock", ("wall", "cpu"))
+    decode_s = decode["mosaic_s" if clock == "wall" else "mosaic_cpu_s"]
+    per = decode_s / n_frames
+    reader = "direct mosaic reader" if decode["direct"] else "rawpy"
+    lines = [f"{clock} time; decode-only ({reader}, same frames, this run): {per:.3f} s/frame mosaic, "
+             f"{decode['rgb_s'] / n_frames:.3f} s/frame to float RGB (wall); RAW {decode['raw_bytes'] / n_frames / 1e6:.1f} "
+             f"MB/frame",
+             f"{'target':52s} {'measured':>10s} {'target':>8s}"]
+
+    def row(name, value, limit):
+        verdict = "ok" if value <= limit else "MISSED"
+        return f"{name:52s} {value:10.2f} {limit:8.2f}  {verdict}"
+
+    lines.append(row("frame store / RAW bytes", store_bytes / decode["raw_bytes"], SCALE_TARGETS["store"]))
+    marginal = bool(before and before_frames and before_frames != n_frames)
+    for name, prefix, limit in (("end-to-end (all jobs)", "", "end_to_end"),
+                                ("pass 1 (registration, gains)", "outdoor_normalise", "pass1")):
+        spent = _job_seconds(stages, prefix)
+        lines.append(row(f"{name} / decode-only time", spent / decode_s, SCALE_TARGETS[limit]))
+        if marginal:
+            added = (spent - _job_seconds(before, prefix)) / (n_frames - before_frames)
+            lines.append(row(f"  the same per added frame ({before_frames} -> {n_frames})", added / per,
+                             SCALE_TARGETS[limit]))
+    lines.append(row(f"peak RSS per job, MB ({largest})", peaks[largest], SCALE_TARGETS["peak_mb"]))
+    # a parted stage's jobs read a fixed number of frames whatever the sweep's length: only the
+    # stages whose jobs read the whole sweep can grow with it
+    whole = {stage: value for stage, value in (growth or {}).items() if not stage.endswith("_parts")}
+    if whole:
+        worst = max(whole, key=lambda stage: whole[stage][2])
+        low, high, ratio = whole[worst]
+        lines.append(row(f"peak RSS 1000 / 100 frames ({worst})", ratio, SCALE_TARGETS["growth"]))
+        lines.append(f"  (linear through the two runs: {low:.0f} MB at 100 frames, {high:.0f} MB at 1000; "
+                     "parted stages: jobs of a fixed number of frames)")
+    return lines

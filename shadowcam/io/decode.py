@@ -21,6 +21,8 @@ header_metadata : exposure and capture time from the file header only.
 frame_info : size, bit depth, black/white levels, white balance, exposure and
     capture time of a frame, without decoding more than needed.
 iter_frames : decode several frames one at a time, checking they share a size.
+mosaic_image : linear float32 RGB of a Bayer mosaic and its levels (demosaic + levels).
+iter_mosaics : read several RAW frames' mosaics one at a time, checking they share a size and CFA.
 
 The Bayer maths are in :mod:`shadowcam.io.cfa`, the rawpy mosaic read in
 :mod:`shadowcam.io.raw_mosaic`.
@@ -132,21 +134,46 @@ def _normalise_in_place(image, black, span):
 
 
 
-def _decode_raw(path, mosaics=None):
-    mosaic, levels = read_mosaic(path) if mosaics is None else mosaics.read(path)
-    shape = mosaic.shape
-    pattern, black_sites, white_sites = levels["cfa_pattern"], levels["black_sites"], levels["white_sites"]
+def mosaic_image(mosaic, *, cfa_pattern, black_sites, white_sites):
+    """Linear float32 RGB of a Bayer mosaic: bilinear demosaic, then black = 0, white level = 1.
+
+    Parameters
+    ----------
+    mosaic : (M, N) ndarray of unsigned int
+        Raw mosaic in DN (M, N >= 3), its top-left 2x2 block of pattern `cfa_pattern`.
+    cfa_pattern : {"RGGB", "BGGR", "GRBG", "GBRG"}
+    black_sites, white_sites : (2, 2) array_like
+        Black and white levels of the top-left 2x2 block's sites, DN.
+
+    Returns
+    -------
+    (M, N, 3) float32 ndarray
+        ``(DN - black) / (white - black)`` at each CFA site's own channel (exact:
+        integers below 2**24), bilinear in between. Each output pixel depends
+        only on the mosaic's 3x3 neighbourhood, so a window of the mosaic that
+        starts on even rows and cols and extends one pixel beyond the pixels
+        wanted (or reaches the mosaic's border) gives them exactly.
+    """
+    black_sites = np.asarray(black_sites, dtype=np.float64).reshape(2, 2)
+    white_sites = np.asarray(white_sites, dtype=np.float64).reshape(2, 2)
     vmax = int(white_sites.max())
-    rgb, k = demosaic_scaled(mosaic, pattern=pattern, max_value=vmax)
+    rgb, k = demosaic_scaled(mosaic, pattern=cfa_pattern, max_value=vmax)
     # (k * DN - k * black) / (k * (white - black)): exact at each CFA site's own
     # channel (integers below 2**24), computed in place on one float32 buffer
-    black = site_map(black_sites, shape, pattern, vmax) * np.float32(k)
-    span = site_map(white_sites, shape, pattern, vmax) * np.float32(k) - black
+    shape = mosaic.shape
+    black = site_map(black_sites, shape, cfa_pattern, vmax) * np.float32(k)
+    span = site_map(white_sites, shape, cfa_pattern, vmax) * np.float32(k) - black
     image = rgb.astype(np.float32)
     _normalise_in_place(image, black, span)
+    return image
+
+
+def _raw_info(path, shape, levels):
+    """Metadata of a RAW frame (as :func:`frame_info`) from its mosaic shape and levels."""
+    pattern, black_sites, white_sites = levels["cfa_pattern"], levels["black_sites"], levels["white_sites"]
     header = header_metadata(path)
     bits = header["bits_per_sample"] or int(math.ceil(math.log2(white_sites.max() + 1)))
-    info = {
+    return {
         "path": str(path),
         "decoder": f"{levels['decoder']} + OpenCV bilinear demosaic (linear, no white balance)",
         "height": int(shape[0]),
@@ -159,7 +186,13 @@ def _decode_raw(path, mosaics=None):
         "exposure_s": header["exposure_s"],
         "capture_time": header["capture_time"],
     }
-    return image, info
+
+
+def _decode_raw(path, mosaics=None):
+    mosaic, levels = read_mosaic(path) if mosaics is None else mosaics.read(path)
+    image = mosaic_image(mosaic, cfa_pattern=levels["cfa_pattern"], black_sites=levels["black_sites"],
+                         white_sites=levels["white_sites"])
+    return image, _raw_info(path, mosaic.shape, levels)
 
 
 def _oiio_info(path, spec):
@@ -312,3 +345,36 @@ def iter_frames(paths):
                 "must have the same size (remove or crop the odd file)"
             )
         yield Path(path), image, info
+
+
+def iter_mosaics(paths):
+    """Read RAW frames' mosaics one at a time (as :func:`iter_frames` reads them), without demosaicing.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        Camera RAW frames of one sweep.
+
+    Yields
+    ------
+    path : Path
+    mosaic : (M, N) uint16 ndarray
+    levels : dict
+        ``cfa_pattern``, ``black_sites``, ``white_sites`` (2x2, DN) ... of
+        :func:`shadowcam.io.raw_mosaic.read_mosaic`.
+    info : dict
+        As :func:`frame_info`.
+
+    Raises
+    ------
+    ValueError
+        If a file is not a camera RAW, or its mosaic's size or CFA pattern differs from the first frame's.
+    """
+    mosaics = None
+    for path in paths:
+        path = check_frame_path(path)
+        if not is_raw(path):
+            raise ValueError(f"frame {path} is not a camera RAW file; a mosaic store needs RAW frames")
+        mosaics = mosaics or MosaicReader(path)
+        mosaic, levels = mosaics.read(path)
+        yield path, mosaic, levels, _raw_info(path, mosaic.shape, levels)

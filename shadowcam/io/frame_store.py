@@ -1,11 +1,19 @@
 """Time-chunked frame stores (zarr v3): write decoded frames, open and stream them.
 
-A sweep store holds variable ``image (time, row, col, channel)`` float32
+A sweep store reads as variable ``image (time, row, col, channel)`` float32
 (linear, black = 0, white level = 1) with coords ``time`` (frame index,
 float64, units ``frame``), ``time_s`` and ``exposure_s`` (seconds, NaN where
-unknown) and ``channel`` (``R``, ``G``, ``B``), chunked along time only and
-compressed with zstd level 1. A reference store holds ``image (row, col,
-channel)`` (the mean of the reference frames). Stores are written to a hidden
+unknown) and ``channel`` (``R``, ``G``, ``B``), chunked along time only. A
+sweep of camera RAW frames is stored as its Bayer mosaics: ``mosaic (time,
+row, col)`` uint16 DN (Blosc zstd level 1, bit-shuffled: about the size of the
+lossless-JPEG RAW files) with the per-frame levels ``black_sites`` and
+``white_sites (time, cfa_row, cfa_col)``; :func:`open_frames` presents it as
+the lazy ``image`` above, demosaiced on indexing
+(:func:`shadowcam.io.decode.mosaic_image`: the values a float store of the
+same frames holds, bit for bit), reading only the window of the mosaic the
+index needs. Other frames (TIFF, PNG, EXR ...) are stored as the float32
+``image`` itself, compressed with zstd level 1. A reference store holds
+``image (row, col, channel)`` (the mean of the reference frames). Stores are written to a hidden
 temporary directory beside the store and renamed when complete
 (:func:`shadowcam._shared.atomic.atomic_directory`), so an interrupted job never
 leaves a store that looks finished, and a killed job's leftovers are removed by
@@ -39,11 +47,14 @@ from pathlib import Path
 
 import numpy as np
 import xarray as xr
-from zarr.codecs import ZstdCodec
+from xarray.backends import BackendArray
+from xarray.core import indexing
+from zarr.codecs import BloscCodec, ZstdCodec
 
 from shadowcam._shared.atomic import atomic_directory
 from shadowcam._shared.progress import Progress
-from shadowcam.io.decode import iter_frames
+from shadowcam.io.decode import iter_frames, iter_mosaics, mosaic_image
+from shadowcam.io.raw_mosaic import is_raw
 
 log = logging.getLogger(__name__)
 
@@ -51,6 +62,9 @@ log = logging.getLogger(__name__)
 CHUNK_BYTES = 64 * 2**20
 CHANNELS = ("R", "G", "B")
 _COMPRESSORS = (ZstdCodec(level=1),)
+_MOSAIC_COMPRESSORS = (BloscCodec(cname="zstd", clevel=1, shuffle="bitshuffle", typesize=2),)
+#: mosaic pixels read beyond an indexed window (bilinear demosaic: 3x3 neighbourhoods)
+_WINDOW_MARGIN = 2
 
 
 def default_chunk_frames(frame_shape, *, itemsize=4, target_bytes=CHUNK_BYTES):
@@ -97,10 +111,11 @@ def _image_attrs():
 
 
 def _block_dataset(block, start, times_s, exposure_s, *, first_frame=0):
-    stop = start + block.shape[0]
+    """Dataset of a block of frames: `block` maps a variable name to ``(dims, array, attrs)``."""
+    stop = start + next(iter(block.values()))[1].shape[0]
     frames = np.arange(first_frame + start, first_frame + stop, dtype=np.float64)
     return xr.Dataset(
-        {"image": (("time", "row", "col", "channel"), block, _image_attrs())},
+        block,
         coords={
             "time": ("time", frames, {"units": "frame", "long_name": "frame index"}),
             "time_s": ("time", np.asarray(times_s[start:stop], dtype=np.float64), {"units": "s", "long_name": "frame time"}),
@@ -112,6 +127,19 @@ def _block_dataset(block, start, times_s, exposure_s, *, first_frame=0):
             "channel": ("channel", np.array(CHANNELS, dtype=object)),
         },
     )
+
+
+def _frame_source(paths):
+    """Frames of `paths` as ``(info, {variable: (dims, array, attrs)})``: mosaics of RAW sweeps, else float RGB."""
+    if all(is_raw(p) for p in paths):
+        mosaic_attrs = {"long_name": "Bayer mosaic", "units": "DN"}
+        for _, mosaic, levels, info in iter_mosaics(paths):
+            yield info, {"mosaic": (("time", "row", "col"), mosaic, mosaic_attrs),
+                         "black_sites": (("time", "cfa_row", "cfa_col"), levels["black_sites"], {"units": "DN"}),
+                         "white_sites": (("time", "cfa_row", "cfa_col"), levels["white_sites"], {"units": "DN"})}
+    else:
+        for _, image, info in iter_frames(paths):
+            yield info, {"image": (("time", "row", "col", "channel"), image, _image_attrs())}
 
 
 def _atomic_store(out_path):
@@ -126,6 +154,8 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
                  first_frame=0):
     """Decode frames one at a time into a time-chunked zarr v3 store.
 
+    A sweep of camera RAW frames is stored as its mosaics and levels (read
+    back demosaiced by :func:`open_frames`), other frames as float32 RGB.
     Memory stays bounded by one time chunk whatever the number of frames.
     Progress (frames done, rate, time left) is logged about every 5 s.
 
@@ -180,24 +210,27 @@ def write_frames(paths, out_path, *, times_s, exposure_s=None, attrs=None, chunk
     progress = Progress(n, f"decode {Path(out_path).stem}")
     with _atomic_store(out_path) as tmp:
         block, start, written = None, 0, 0
-        for k, (path, image, info) in enumerate(iter_frames(paths)):
+        for k, (info, frame) in enumerate(_frame_source(paths)):
             if block is None:
-                chunk = int(chunk_frames) if chunk_frames else min(n, default_chunk_frames(image.shape))
-                block = np.empty((min(n, chunk),) + image.shape, dtype=np.float32)
+                shape = next(iter(frame.values()))[1].shape
+                chunk = int(chunk_frames) if chunk_frames else min(n, default_chunk_frames(shape + (3,)))
+                block = {name: (dims, np.empty((min(n, chunk),) + np.shape(data), dtype=np.asarray(data).dtype), attrs)
+                         for name, (dims, data, attrs) in frame.items()}
                 store_attrs = {**_decoder_attrs(info), **_json_safe(attrs), "n_frames": n}
             if not exposure_given and info["exposure_s"] is not None:
                 exposure[k] = info["exposure_s"]
-            block[k - start] = image
-            if k - start + 1 == block.shape[0] or k == n - 1:
-                ds = _block_dataset(block[: k - start + 1], start, times_s, exposure, first_frame=first_frame)
+            for name, (_, data, _) in frame.items():
+                block[name][1][k - start] = data
+            size = next(iter(block.values()))[1].shape[0]
+            if k - start + 1 == size or k == n - 1:
+                filled = {name: (dims, data[: k - start + 1], a) for name, (dims, data, a) in block.items()}
+                ds = _block_dataset(filled, start, times_s, exposure, first_frame=first_frame)
                 ds.attrs.update(store_attrs)  # appends rewrite the group attrs
                 if start == 0:
-                    encoding = {
-                        "image": {"chunks": (chunk,) + block.shape[1:], "compressors": _COMPRESSORS},
-                        "time": {"chunks": (chunk,)},
-                        "time_s": {"chunks": (chunk,)},
-                        "exposure_s": {"chunks": (chunk,)},
-                    }
+                    encoding = {name: {"chunks": (chunk,) + data.shape[1:],
+                                       "compressors": _MOSAIC_COMPRESSORS if name == "mosaic" else _COMPRESSORS}
+                                for name, (_, data, _) in block.items()}
+                    encoding.update({name: {"chunks": (chunk,)} for name in ("time", "time_s", "exposure_s")})
                     ds.to_zarr(tmp, mode="w-", zarr_format=3, encoding=encoding, consolidated=False)
                 else:
                     ds.to_zarr(tmp, append_dim="time", zarr_format=3, consolidated=False)
@@ -359,7 +392,8 @@ def open_frames(path):
     Returns
     -------
     xarray.Dataset
-        ``image (time, row, col, channel)`` (or ``(row, col, channel)`` for a reference).
+        ``image (time, row, col, channel)`` (or ``(row, col, channel)`` for a reference);
+        a mosaic store's ``image`` is demosaiced when indexed.
     """
     path = Path(path)
     if not path.is_dir():
@@ -369,7 +403,69 @@ def open_frames(path):
     with warnings.catch_warnings():
         # Snakemake marks directory outputs with a .snakemake_timestamp file, which zarr warns about
         warnings.filterwarnings("ignore", message=r"Object at \.snakemake_timestamp is not recognized")
-        return xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
+        dataset = xr.open_zarr(path, chunks=None, zarr_format=3, consolidated=False)
+    if "mosaic" not in dataset:
+        return dataset
+    mosaic = dataset["mosaic"]
+    image = _MosaicImage(mosaic.variable, dataset["black_sites"].values, dataset["white_sites"].values,
+                         dataset.attrs["cfa_pattern"])
+    chunks = (mosaic.encoding["chunks"][0],) + image.shape[1:]
+    variable = xr.Variable(("time", "row", "col", "channel"), indexing.LazilyIndexedArray(image),
+                           attrs=_image_attrs(), encoding={"chunks": chunks})
+    return dataset.drop_vars(["mosaic", "black_sites", "white_sites"]).assign(image=variable)
+
+
+def _local_index(index, origin):
+    """`index` (1-D ints) relative to `origin`, as a slice where it is an increasing progression."""
+    step = int(index[1] - index[0]) if index.size > 1 else 1
+    if step > 0 and np.array_equal(index, index[0] + step * np.arange(index.size)):
+        return slice(int(index[0] - origin), int(index[-1] - origin + 1), step)
+    return index - origin
+
+
+class _MosaicImage(BackendArray):
+    """``image (time, row, col, channel)`` float32 of a mosaic store, demosaiced on indexing.
+
+    An index reads the mosaic window of the indexed rows and cols, widened by
+    :data:`_WINDOW_MARGIN` pixels and started on even rows and cols (the CFA
+    phase), demosaics it (:func:`shadowcam.io.decode.mosaic_image`) and crops it:
+    the values of the whole frame's decode, bit for bit.
+    """
+
+    def __init__(self, mosaic, black_sites, white_sites, cfa_pattern):
+        self._mosaic, self._black, self._white, self._pattern = mosaic, black_sites, white_sites, cfa_pattern
+        self.shape = tuple(mosaic.shape) + (len(CHANNELS),)
+        self.dtype = np.dtype(np.float32)
+
+    def __getitem__(self, key):
+        return indexing.explicit_indexing_adapter(key, self.shape, indexing.IndexingSupport.BASIC, self._getitem)
+
+    def _getitem(self, key):
+        picks = [np.arange(n)[k] for n, k in zip(self.shape, key)]
+        out_shape = tuple(p.shape for p in picks)
+        times, rows, cols, channels = (np.atleast_1d(p) for p in picks)
+        out_shape = sum(out_shape, ())
+        if min(times.size, rows.size, cols.size, channels.size) == 0:
+            return np.empty(out_shape, dtype=np.float32)
+        height, width = self.shape[1:3]
+        r0, c0 = (max(0, int(p.min()) - _WINDOW_MARGIN) // 2 * 2 for p in (rows, cols))
+        r1, c1 = min(height, int(rows.max()) + 1 + _WINDOW_MARGIN), min(width, int(cols.max()) + 1 + _WINDOW_MARGIN)
+        t0 = int(times.min())
+        mosaics = np.asarray(self._mosaic[t0:int(times.max()) + 1, r0:r1, c0:c1].values)
+        local_rows, local_cols = _local_index(rows, r0), _local_index(cols, c0)
+        whole = (isinstance(local_rows, slice) and isinstance(local_cols, slice)
+                 and local_rows == slice(0, r1 - r0, 1) and local_cols == slice(0, c1 - c0, 1)
+                 and channels.size == len(CHANNELS) and np.array_equal(channels, np.arange(len(CHANNELS))))
+        out = None
+        for k, t in enumerate(times):
+            image = mosaic_image(mosaics[t - t0], cfa_pattern=self._pattern, black_sites=self._black[t],
+                                 white_sites=self._white[t])
+            if whole and times.size == 1:
+                return image.reshape(out_shape)
+            if out is None:
+                out = np.empty((times.size, rows.size, cols.size, channels.size), dtype=np.float32)
+            out[k] = image if whole else image[local_rows][:, local_cols][:, :, channels]
+        return out.reshape(out_shape)
 
 
 def iter_frame_chunks(dataset, *, chunk_frames=None, start=0, stop=None):

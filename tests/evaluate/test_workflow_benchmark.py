@@ -1,8 +1,10 @@
 """Tests of shadowcam.evaluate.workflow_benchmark: benchmark files, stage sums and the extrapolation."""
 
+import numpy as np
 import pytest
 
-from shadowcam.evaluate.workflow_benchmark import benchmark_table, directory_bytes, read_benchmarks
+from shadowcam.evaluate.workflow_benchmark import (benchmark_table, directory_bytes, memory_growth, read_benchmarks,
+                                                  scale_targets, time_decode)
 
 HEADER = "s\th:m:s\tmax_rss\tmax_vms\n"
 
@@ -26,6 +28,14 @@ def test_parted_stage_jobs_are_grouped_and_the_extrapolation_divides_by_the_core
     assert "0.3 h" in lines[-1] and "peak memory 0.6 GB" in lines[-1] and "(1 MB/frame)" in lines[-1]
 
 
+def test_cpu_clock_reads_the_cpu_time_column(tmp_path):
+    (tmp_path / "arrival.tsv").write_text("s\th:m:s\tmax_rss\tcpu_time\n9.5\t0:00:09\t120\t2.25\n")
+    assert read_benchmarks(tmp_path, clock="cpu") == {"arrival": [(2.25, 120.0)]}
+    assert read_benchmarks(tmp_path) == {"arrival": [(9.5, 120.0)]}
+    with pytest.raises(ValueError, match="clock"):
+        read_benchmarks(tmp_path, clock="sun")
+
+
 def test_missing_benchmarks_and_store_size(tmp_path):
     with pytest.raises(ValueError, match="no benchmark files"):
         read_benchmarks(tmp_path)
@@ -33,3 +43,63 @@ def test_missing_benchmarks_and_store_size(tmp_path):
     (tmp_path / "a" / "x.bin").write_bytes(b"12345")
     (tmp_path / "y.bin").write_bytes(b"123")
     assert directory_bytes(tmp_path) == 8
+
+
+def test_memory_growth_is_the_line_through_the_two_runs():
+    # 500 MB at 8 frames, 516 MB at 16: 2 MB/frame -> 684 MB at 100, 2484 MB at 1000
+    growth = memory_growth({"arrival": [(1.0, 516.0)], "solo": [(1.0, 9.0)]}, {"arrival": [(1.0, 500.0)]},
+                           frames=16, before_frames=8)
+    assert set(growth) == {"arrival"}
+    low, high, ratio = growth["arrival"]
+    assert low == pytest.approx(684.0) and high == pytest.approx(2484.0) and ratio == pytest.approx(2484 / 684)
+    flat = memory_growth({"a": [(1.0, 300.0), (1.0, 400.0)]}, {"a": [(1.0, 400.0)]}, frames=16, before_frames=8)
+    assert flat["a"] == pytest.approx((400.0, 400.0, 1.0))
+    shrinking = memory_growth({"a": [(1.0, 380.0)]}, {"a": [(1.0, 400.0)]}, frames=16, before_frames=8)
+    assert shrinking["a"] == pytest.approx((380.0, 380.0, 1.0))  # a lower peak of the longer run is noise
+    with pytest.raises(ValueError, match="different"):
+        memory_growth({}, {}, frames=8, before_frames=8)
+
+
+def test_scale_targets_are_the_ratios_of_one_run():
+    stages = {"decode_timelapse_parts": [(4.0, 900.0), (4.0, 800.0)], "outdoor_normalise_parts": [(3.0, 5000.0)],
+              "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
+    decode = {"frames": 10, "raw_bytes": 1000, "mosaic_s": 5.0, "mosaic_cpu_s": 2.5, "rgb_s": 7.0, "direct": True}
+    # the 5-frame run: 6 s less, 2 of them in pass 1
+    before = {"decode_timelapse_parts": [(4.0, 900.0)], "outdoor_normalise_parts": [(1.0, 5000.0)],
+              "outdoor_normalise": [(1.0, 100.0)], "arrival": [(8.0, float("nan"))]}
+    lines = scale_targets(stages, n_frames=10, store_bytes=2000, decode=decode, before=before, before_frames=5,
+                          growth={"arrival": (100.0, 110.0, 1.1), "a": (100.0, 150.0, 1.5),
+                                  "decode_timelapse_parts": (100.0, 900.0, 9.0)})
+    rows = {name: rest for name, *rest in (line.rsplit(None, 3) for line in lines[2:] if not line.startswith("  ("))}
+    assert "0.500 s/frame mosaic, 0.700 s/frame to float RGB" in lines[0] and "direct mosaic reader" in lines[0]
+    assert rows["frame store / RAW bytes"] == ["2.00", "1.50", "MISSED"]
+    assert rows["end-to-end (all jobs) / decode-only time"] == ["4.00", "3.00", "MISSED"]  # 20 s / 5 s
+    assert rows["pass 1 (registration, gains) / decode-only time"] == ["0.80", "1.00", "ok"]  # 4 s / 5 s
+    # per added frame: 6 s / 5 frames = 1.2 s against 0.5 s decode; pass 1 2 s / 5 frames = 0.4 s
+    added = [rest for name, *rest in (line.rsplit(None, 3) for line in lines) if "per added frame (5 -> 10)" in name]
+    assert added == [["2.40", "3.00", "ok"], ["0.80", "1.00", "ok"]]
+    assert rows["peak RSS per job, MB (outdoor_normalise_parts)"] == ["5000.00", "4096.00", "MISSED"]
+    assert rows["peak RSS 1000 / 100 frames (a)"] == ["1.50", "1.20", "MISSED"]  # parted jobs: fixed frames
+    cpu = scale_targets(stages, n_frames=10, store_bytes=2000, decode=decode, clock="cpu")
+    assert cpu[0].startswith("cpu time") and "0.250 s/frame mosaic" in cpu[0]
+    assert [line.split()[-3] for line in cpu if "/ decode-only time" in line] == ["8.00", "1.60"]  # against 2.5 s
+    with pytest.raises(ValueError, match="clock"):
+        scale_targets(stages, n_frames=10, store_bytes=1, decode=decode, clock="gpu")
+    with pytest.raises(ValueError, match="10 frames"):
+        scale_targets(stages, n_frames=10, store_bytes=1, decode=dict(decode, frames=9))
+
+
+def test_time_decode_reads_every_frame_with_the_pipeline_reader(tmp_path):
+    from shadowcam.io.raw_writer import write_dng
+
+    rng = np.random.default_rng(0)
+    paths = []
+    for k in range(3):
+        mosaic = rng.integers(600, 16000, size=(24, 32), dtype=np.uint16)
+        paths.append(write_dng(tmp_path / f"{k}.dng", mosaic, bit_depth=14, black_level=512, compression="ljpeg"))
+    decode = time_decode(paths)
+    assert decode["frames"] == 3 and decode["raw_bytes"] == sum(p.stat().st_size for p in paths)
+    assert decode["mosaic_s"] > 0 and decode["mosaic_cpu_s"] > 0 and decode["rgb_s"] > 0
+    assert decode["direct"]  # lossless-JPEG DNGs the writer makes are read directly, as the pipeline does
+    with pytest.raises(ValueError, match="at least one"):
+        time_decode([])

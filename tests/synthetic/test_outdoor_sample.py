@@ -83,5 +83,14 @@ def test_write_sample_writes_checksummed_frames_with_the_recorded_shake(tmp_path
     assert max(np.abs(sidecar["shake_dx_px"]).max(), np.abs(sidecar["shake_dy_px"]).max()) <= 1.5 + 1e-9
     for rel, digest in manifest["checksums"].items():
         assert file_sha256(tmp_path / "sample" / rel) == digest, rel
+    # frames are lossless JPEG as cameras write them: the same mosaics as uncompressed DNGs, smaller files
+    from shadowcam.io.raw_mosaic import read_mosaic
+
+    write_sample(source, tmp_path / "plain", tmp_path / "p.yaml", name="plain", size="96x64",
+                 frames=3, first=10, seed=2, shake_px=1.5, compression="none")
+    for name in ("000000.dng", "000002.dng"):
+        packed, plain = tmp_path / "sample" / "frames" / name, tmp_path / "plain" / "frames" / name
+        np.testing.assert_array_equal(read_mosaic(packed)[0], read_mosaic(plain)[0])
+        assert packed.stat().st_size < plain.stat().st_size
     with pytest.raises(ValueError, match="at least 3"):
         write_sample(source, tmp_path / "x", tmp_path / "x.yaml", name="x", size="96x64", frames=2)

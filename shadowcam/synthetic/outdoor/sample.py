@@ -179,7 +179,7 @@ def source_shake(source, first, stop):
 
 
 def write_sample(source, outdir, manifest_out, *, name, size="6000x4000", frames=16, first=40, bit_depth=14,
-                 seed=0, shake_px=2.0, source_label=None):
+                 seed=0, shake_px=2.0, source_label=None, compression="ljpeg"):
     """Write a real-size RAW time-lapse sample of a small outdoor capture and its manifest.
 
     Steadies consecutive source frames (their recorded shake undone), upsamples them
@@ -207,6 +207,8 @@ def write_sample(source, outdir, manifest_out, *, name, size="6000x4000", frames
         Largest camera shake of the sample (0: none).
     source_label : str, optional
         How the source is named in the provenance (default its name).
+    compression : {"ljpeg", "none"}, optional
+        DNG compression of the frames: lossless JPEG (what cameras write) or none.
 
     Returns
     -------
@@ -247,7 +249,7 @@ def write_sample(source, outdir, manifest_out, *, name, size="6000x4000", frames
                             shake=(shake_dx[k], shake_dy[k]))
         frame_name = f"frames/{k:06d}.dng"
         write_dng(outdir / frame_name, raw, bit_depth=sensor.bit_depth, black_level=sensor.black_level,
-                  capture_time=start_time + datetime.timedelta(seconds=float(times[k])))
+                  capture_time=start_time + datetime.timedelta(seconds=float(times[k])), compression=compression)
         names.append(frame_name)
         log.info("wrote %s (%d/%d), shake dx %+.3f dy %+.3f px", frame_name, k + 1, frames, shake_dx[k], shake_dy[k])
     sidecar = {"units": "s", "times_s": times.tolist(), "files": names,
