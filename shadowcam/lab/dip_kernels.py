@@ -502,9 +502,9 @@ def select_dips(values, frames, half_window):
 
 
 @nb.njit(cache=True, parallel=True)
-def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame, threshold,
+def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame, threshold, half_window,
                    before_frame, before_values, before_invalid, after_frame, after_values, after_invalid,
-                   previous, wants_next):
+                   before_sums, after_sums, previous, wants_next):
     """Compare smoothed frames ``j_from .. j_to - 1`` with each pixel's threshold around its centre.
 
     `ext` ``(T, P)`` float32 holds the raw signal of frames ``ext_first + t``,
@@ -519,7 +519,12 @@ def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame,
     previous frame's value and its own (``after_frame``, ``after_values``).
     Non-finite smoothed values are neither above nor below; those of owned
     frames are counted since the last frame above (`before_invalid`, reset
-    there) and before the first frame above (`after_invalid`).
+    there) and before the first frame above (`after_invalid`). The raw
+    samples of the same frames that lie more than `half_window` frames from
+    the centre (the dip outside the tracker's window) are summed exactly, as
+    the running sums hold them, into `before_sums` / `after_sums` ``(P, 4)``
+    int64: count, fixed-point sum, and the two parts of the sum of squares
+    (:func:`split_square`) as int64 multiples of ``2**-8`` and ``2**-40``.
     `previous` ``(P,)`` (smoothed value of frame ``j_from - 1``) and
     `wants_next` ``(P,)`` (the next frame's value is still to be stored in
     ``before_values[:, 1]``) carry the state across blocks.
@@ -543,6 +548,11 @@ def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame,
                 wants_next[p] = False
             owned = start <= j < stop
             finite = s - s == 0
+            outside = (j < c - half_window or j > c + half_window) and mid - mid == 0
+            x = np.float64(mid)
+            sq = x * x
+            hi = (sq + _SQ_HI) - _SQ_HI
+            lo = ((sq - hi) + _SQ_LO) - _SQ_LO
             if owned and j < c:
                 if not finite:
                     before_invalid[p] += 1
@@ -551,6 +561,14 @@ def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame,
                     before_values[p, 0] = s
                     before_invalid[p] = 0
                     wants_next[p] = True
+                    for q in range(4):
+                        before_sums[p, q] = 0
+                    outside = False
+                if outside:
+                    before_sums[p, 0] += 1
+                    before_sums[p, 1] += _fixed(x)
+                    before_sums[p, 2] += np.int64(hi * 256.0)
+                    before_sums[p, 3] += np.int64(lo * 2.0**40)
             elif owned and j > c and after_frame[p] < 0:
                 if not finite:
                     after_invalid[p] += 1
@@ -558,4 +576,10 @@ def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame,
                     after_frame[p] = j
                     after_values[p, 0] = previous[p] if j >= 1 else s
                     after_values[p, 1] = s
+                    outside = False
+                if outside:
+                    after_sums[p, 0] += 1
+                    after_sums[p, 1] += _fixed(x)
+                    after_sums[p, 2] += np.int64(hi * 256.0)
+                    after_sums[p, 3] += np.int64(lo * 2.0**40)
             previous[p] = s

@@ -37,6 +37,7 @@ IntervalTracker : second pass: each pixel's dip interval (entry and exit crossin
 DipInterval : entry, exit and their slopes per pixel; ``at(fraction)`` across the interval.
 IntervalPartial, merge_intervals : the interval of a sweep from its time chunks.
 half_depth : the default crossing level.
+without_interval : the summary's lit statistics without the whole dip, and the crossings at its half depth.
 track_intervals : the interval pass over a sweep's frames.
 """
 
@@ -446,6 +447,10 @@ class IntervalPartial:
         Smoothed values at the frame before `after_frame` and at it.
     after_invalid : (H, W) int64 ndarray
         Owned frames after the centre with a non-finite smoothed value before `after_frame`.
+    before_sums, after_sums : (H, W, 4) int64 ndarray
+        Count, fixed-point sum and square parts of the raw samples counted
+        like `before_invalid` / `after_invalid` but more than ``half_window``
+        frames from the centre (see :func:`shadowcam.lab.dip_kernels.interval_block`).
     """
 
     start: int
@@ -456,6 +461,8 @@ class IntervalPartial:
     after_frame: np.ndarray
     after_values: np.ndarray
     after_invalid: np.ndarray
+    before_sums: np.ndarray
+    after_sums: np.ndarray
 
 
 @dataclass
@@ -481,6 +488,10 @@ class DipInterval:
         Frames inside the interval with a non-finite smoothed value.
     threshold : (H, W) float64 ndarray
         The level the crossings were taken at.
+    beyond_count, beyond_sum, beyond_square : (H, W) ndarray
+        Count (int64), sum and sum of squares (float64) of the finite raw
+        samples inside the interval but outside the tracker's window (the
+        part of a wide dip that the :class:`DipSummary` counted as lit).
     """
 
     entry: np.ndarray
@@ -491,6 +502,9 @@ class DipInterval:
     exit_slope: np.ndarray
     invalid: np.ndarray
     threshold: np.ndarray
+    beyond_count: np.ndarray
+    beyond_sum: np.ndarray
+    beyond_square: np.ndarray
 
     def at(self, fraction):
         """Time at `fraction` across the interval (0 = entry, 0.5 = centre, 1 = exit), ``(H, W)``."""
@@ -512,6 +526,9 @@ class IntervalTracker:
     ----------
     centre_frame : (H, W) int ndarray
         Frame of each pixel's deepest minimum (negative = no dip: skipped).
+    half_window : int
+        The dip tracker's: samples further than this from the centre inside the
+        interval are summed (``beyond_*`` of :class:`DipInterval`).
     threshold : (H, W) float ndarray
         Level of the crossings (e.g. half depth, :func:`half_depth`).
     n_frames : int
@@ -524,13 +541,16 @@ class IntervalTracker:
 
     PAD = 2
 
-    def __init__(self, centre_frame, threshold, *, n_frames, owned=None):
+    def __init__(self, centre_frame, threshold, *, half_window, n_frames, owned=None):
         centre_frame = np.asarray(centre_frame)
         threshold = np.asarray(threshold, np.float64)
         if centre_frame.ndim != 2 or threshold.shape != centre_frame.shape:
             raise ValueError(f"centre_frame and threshold must be (H, W) arrays of one shape; "
                              f"got {centre_frame.shape} and {threshold.shape}")
         n_frames = int(n_frames)
+        if int(half_window) < 1:
+            raise ValueError(f"half_window must be >= 1; got {half_window!r}")
+        self.half_window = int(half_window)
         if n_frames < 1:
             raise ValueError(f"n_frames must be >= 1; got {n_frames}")
         start, stop = (0, n_frames) if owned is None else (int(owned[0]), min(int(owned[1]), n_frames))
@@ -551,7 +571,8 @@ class IntervalTracker:
         self._state = dict(
             before_frame=np.full(p, -1, np.int64), before_values=np.full((p, 2), np.nan, np.float32),
             before_invalid=np.zeros(p, np.int64), after_frame=np.full(p, -1, np.int64),
-            after_values=np.full((p, 2), np.nan, np.float32), after_invalid=np.zeros(p, np.int64))
+            after_values=np.full((p, 2), np.nan, np.float32), after_invalid=np.zeros(p, np.int64),
+            before_sums=np.zeros((p, 4), np.int64), after_sums=np.zeros((p, 4), np.int64))
         self._previous = np.full(p, np.nan, np.float32)
         self._wants_next = np.zeros(p, bool)
 
@@ -578,9 +599,9 @@ class IntervalTracker:
         if upto > self._done:
             s = self._state
             _k.interval_block(ext, ext_first, self._done, upto, *self.owned, self.n_frames, self._centre,
-                              self._threshold, s["before_frame"], s["before_values"], s["before_invalid"],
-                              s["after_frame"], s["after_values"], s["after_invalid"],
-                              self._previous, self._wants_next)
+                              self._threshold, self.half_window, s["before_frame"], s["before_values"],
+                              s["before_invalid"], s["after_frame"], s["after_values"], s["after_invalid"],
+                              s["before_sums"], s["after_sums"], self._previous, self._wants_next)
             self._done = upto
         self._carry = ext[-2:]
 
@@ -637,17 +658,21 @@ def merge_intervals(partials, *, n_frames, threshold):
     before = np.full(shape, -1, np.int64)
     before_values = np.full(shape + (2,), np.nan, np.float32)
     before_invalid = np.zeros(shape, np.int64)
-    for part in ordered:  # in time order: a later frame above resets the count
+    before_sums = np.zeros(shape + (4,), np.int64)
+    for part in ordered:  # in time order: a later frame above resets the counts
         found = part.before_frame >= 0
         before = np.where(found, part.before_frame, before)
         before_values = np.where(found[..., None], part.before_values, before_values)
         before_invalid = np.where(found, part.before_invalid, before_invalid + part.before_invalid)
+        before_sums = np.where(found[..., None], part.before_sums, before_sums + part.before_sums)
     after = np.full(shape, -1, np.int64)
     after_values = np.full(shape + (2,), np.nan, np.float32)
     after_invalid = np.zeros(shape, np.int64)
+    after_sums = np.zeros(shape + (4,), np.int64)
     for part in ordered:
         open_ = after < 0
         after_invalid = np.where(open_, after_invalid + part.after_invalid, after_invalid)
+        after_sums = np.where(open_[..., None], after_sums + part.after_sums, after_sums)
         take = open_ & (part.after_frame >= 0)
         after = np.where(take, part.after_frame, after)
         after_values = np.where(take[..., None], part.after_values, after_values)
@@ -662,9 +687,12 @@ def merge_intervals(partials, *, n_frames, threshold):
     # a crossing next to a non-finite value has no sub-frame position
     entry = np.where(np.isfinite(b1), entry, np.nan)
     exit_ = np.where(np.isfinite(a0), exit_, np.nan)
+    sums = before_sums + after_sums
     return DipInterval(entry=entry, exit=exit_, entry_open=before < 0, exit_open=after < 0,
                        entry_slope=entry_slope, exit_slope=exit_slope,
-                       invalid=before_invalid + after_invalid, threshold=threshold)
+                       invalid=before_invalid + after_invalid, threshold=threshold,
+                       beyond_count=sums[..., 0], beyond_sum=sums[..., 1] / _k.SUM_SCALE,
+                       beyond_square=sums[..., 2] / 256.0 + sums[..., 3] / 2.0**40)
 
 
 def track_intervals(blocks, summary, *, threshold=None):
@@ -683,7 +711,48 @@ def track_intervals(blocks, summary, *, threshold=None):
     DipInterval
     """
     threshold = half_depth(summary) if threshold is None else threshold
-    tracker = IntervalTracker(summary.minimum_frame, threshold, n_frames=summary.n_frames)
+    tracker = IntervalTracker(summary.minimum_frame, threshold, half_window=summary.half_window,
+                              n_frames=summary.n_frames)
     for block in blocks:
         tracker.update(block)
     return tracker.result()
+
+
+def without_interval(summary, interval):
+    """The lit statistics of `summary` with the whole dip interval taken out, and the crossings moved to match.
+
+    The tracker's lit level and noise count the frames of a dip wider than
+    its window as lit (lower level, higher noise). This removes those frames
+    (``beyond_*`` of `interval`) from the running sums and moves each
+    crossing along its local slope to the half depth of the corrected level
+    (first order; exact on a linear penumbra). Pixels with nothing beyond the
+    window keep their values bit for bit.
+
+    Returns
+    -------
+    summary : DipSummary
+        With `lit_level`, `noise` and `lit_count` corrected.
+    interval : DipInterval
+        With `entry`, `exit` and `threshold` corrected.
+    """
+    from dataclasses import replace
+
+    n = summary.lit_count.astype(np.float64)
+    k = interval.beyond_count.astype(np.float64)
+    level, noise = summary.lit_level, summary.noise
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit_sum = level * n - interval.beyond_sum
+        variance = noise**2 * np.maximum(n - 1, 1) / n
+        lit_square = (variance + level**2) * n - interval.beyond_square
+        new_level = lit_sum / (n - k)
+        new_variance = np.maximum(lit_square / (n - k) - new_level**2, 0) * (n - k) / np.maximum(n - k - 1, 1)
+    changed = (k > 0) & (n - k >= 3)
+    new_summary = replace(summary, lit_level=np.where(changed, new_level, level),
+                          noise=np.where(changed, np.sqrt(new_variance), noise),
+                          lit_count=np.where(changed, summary.lit_count - interval.beyond_count, summary.lit_count))
+    threshold = np.where(changed, half_depth(new_summary), interval.threshold)
+    shift = threshold - interval.threshold
+    with np.errstate(invalid="ignore", divide="ignore"):
+        entry = np.where(changed, interval.entry - shift / interval.entry_slope, interval.entry)
+        exit_ = np.where(changed, interval.exit + shift / interval.exit_slope, interval.exit)
+    return new_summary, replace(interval, entry=entry, exit=exit_, threshold=threshold)

@@ -25,7 +25,7 @@ def run(signal, threshold, centre, blocks=(7,)):
     """The interval of a 1-D signal (one pixel), fed in blocks cycling through `blocks`."""
     n = signal.shape[0]
     frames = signal.astype(np.float32)[:, None, None]
-    tracker = IntervalTracker(np.array([[centre]]), np.array([[threshold]]), n_frames=n)
+    tracker = IntervalTracker(np.array([[centre]]), np.array([[threshold]]), half_window=4, n_frames=n)
     i, k = 0, 0
     while i < n:
         size = blocks[k % len(blocks)]
@@ -85,7 +85,7 @@ def test_a_close_second_minimum_does_not_move_the_deepest_ones_interval(width, g
 
 
 @settings(max_examples=40, deadline=None)
-@given(plateau=st.integers(2, 200), where=st.floats(0, 1), inside=st.booleans())
+@given(plateau=st.integers(4, 200), where=st.floats(0, 1), inside=st.booleans())
 def test_non_finite_samples_inside_are_counted_outside_ignored(plateau, where, inside):
     n = plateau + 60
     signal, entry, exit_ = trapezoid(n, entry=20.0, plateau=plateau, ramp=4)
@@ -94,7 +94,9 @@ def test_non_finite_samples_inside_are_counted_outside_ignored(plateau, where, i
     else:
         frame = int(exit_ + 4 + where * (n - exit_ - 6))
     signal[frame] = np.nan if where < 0.5 else np.inf
-    interval = run(signal, 0.6, int((entry + exit_) / 2) + (5 if frame == int((entry + exit_) / 2) else 0))
+    # the deepest minimum (the centre) is a finite frame on the plateau, two frames from the bad one
+    centre = frame + 2 if inside and frame + 2 < exit_ - 2 else (frame - 2 if inside else int(entry) + 3)
+    interval = run(signal, 0.6, centre)
     if inside:
         # the non-finite sample spoils the smoothed values of its frame and both neighbours
         assert interval.invalid[0, 0] >= 1
@@ -137,18 +139,19 @@ def test_time_chunks_merge_bit_for_bit(cuts):
     whole = track_intervals([frames], summary, threshold=threshold)
     parts = []
     for start, stop in zip(cuts[:-1], cuts[1:]):
-        chunk = IntervalTracker(summary.minimum_frame, threshold, n_frames=n, owned=(start, stop))
+        chunk = IntervalTracker(summary.minimum_frame, threshold, half_window=3, n_frames=n, owned=(start, stop))
         lo, hi = max(0, start - 2), min(n, stop + 2)
         for i in range(lo, hi, 5):
             chunk.update(frames[i:min(i + 5, hi)])
         parts.append(chunk.partial())
     merged = merge_intervals(parts[::-1], n_frames=n, threshold=threshold)
-    for name in ("entry", "exit", "entry_slope", "exit_slope", "invalid", "entry_open", "exit_open"):
+    for name in ("entry", "exit", "entry_slope", "exit_slope", "invalid", "entry_open", "exit_open",
+                 "beyond_count", "beyond_sum", "beyond_square"):
         np.testing.assert_array_equal(getattr(merged, name), getattr(whole, name), err_msg=name)
 
 
 def test_state_does_not_grow_with_the_frames():
-    tracker = IntervalTracker(np.zeros((3, 4), int), np.ones((3, 4)), n_frames=5000)
+    tracker = IntervalTracker(np.zeros((3, 4), int), np.ones((3, 4)), half_window=4, n_frames=5000)
     before = sum(v.nbytes for v in tracker._state.values())
     for _ in range(50):
         tracker.update(np.ones((100, 3, 4), np.float32))
@@ -158,9 +161,38 @@ def test_state_does_not_grow_with_the_frames():
 
 def test_invalid_arguments_name_the_parameter():
     with pytest.raises(ValueError, match="owned"):
-        IntervalTracker(np.zeros((2, 2), int), np.ones((2, 2)), n_frames=10, owned=(5, 5))
+        IntervalTracker(np.zeros((2, 2), int), np.ones((2, 2)), half_window=4, n_frames=10, owned=(5, 5))
     with pytest.raises(ValueError, match="n_frames"):
-        IntervalTracker(np.zeros((2, 2), int), np.ones((2, 2)), n_frames=0)
-    tracker = IntervalTracker(np.zeros((2, 2), int), np.ones((2, 2)), n_frames=10)
+        IntervalTracker(np.zeros((2, 2), int), np.ones((2, 2)), half_window=4, n_frames=0)
+    tracker = IntervalTracker(np.zeros((2, 2), int), np.ones((2, 2)), half_window=4, n_frames=10)
     with pytest.raises(ValueError, match="block"):
         tracker.update(np.ones((3, 2, 3), np.float32))
+
+
+@settings(max_examples=30, deadline=None)
+@given(plateau=st.integers(10, 200), ramp=st.integers(4, 10), phase=st.floats(0, 1), floor=st.floats(0, 1))
+def test_wide_dip_half_depth_of_the_true_lit_level(plateau, ramp, phase, floor):
+    # the tracker's lit level counts the plateau beyond its window as lit; without_interval
+    # takes it out, and the crossings land on the true half depth
+    from shadowcam.lab.dip_tracker import without_interval
+
+    # the dip covers at most a third of the sweep (the correction is first order in the
+    # first pass's level error)
+    n = 3 * (plateau + 2 * ramp) + 60
+    signal, entry, exit_ = trapezoid(n, entry=30 + ramp / 2 + phase, plateau=plateau, ramp=ramp,
+                                     depth=0.8, floor=floor)
+    frames = signal.astype(np.float32)[:, None, None]
+    tracker = DipTracker((1, 1), half_window=4)
+    tracker.update(frames)
+    summary, interval = without_interval(*(lambda s: (s, track_intervals([frames], s)))(tracker.result()))
+    # what stays counted as lit: the ramps' frames at or above half depth, at most
+    # ramp / 2 + 1 each side, removing at most depth / 2 each; the crossing moves by half
+    # the level's error over the slope, plus up to 0.1 frame from the first-order move along
+    # a smoothed ramp's corner
+    bound = (ramp + 2) * 0.4 / summary.lit_count[0, 0]
+    assert 0 <= 1.0 + floor - summary.lit_level[0, 0] <= bound
+    assert summary.noise[0, 0] < 0.8 * np.sqrt(ramp / summary.lit_count[0, 0])
+    np.testing.assert_allclose([interval.entry[0, 0], interval.exit[0, 0]], [entry, exit_],
+                               atol=0.5 * bound / (0.8 / ramp) + 0.1)
+    # and the first pass alone is off by the plateau
+    assert 1.0 + floor - tracker.result().lit_level[0, 0] > bound

@@ -182,3 +182,62 @@ def test_a_sweep_without_timed_pixels_fails_with_the_reason_counts(case, reason,
         shadow_time_of_stores({"u": store}, half_window=4)
     with pytest.raises(ValueError, match="min_coverage must be"):
         shadow_time_of_stores({"u": store}, half_window=4, min_coverage=5)
+
+
+def _interval_times(frames, **options):
+    """Shadow times of a sweep with the dip-interval pass (as shadow_time_of_stores runs them)."""
+    from shadowcam.lab.dip_tracker import track_intervals, without_interval
+    from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
+
+    if frames.ndim == 3:
+        frames = frames[..., None]
+    summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)
+    summary, interval = without_interval(summary, track_intervals([frames], summary))
+    return summary_shadow_times(summary, interval=interval, **options)
+
+
+@pytest.mark.parametrize("width", [10.0, 24.0])
+def test_a_dip_wider_than_the_window_is_timed_at_its_interval(wire_sweep, width):
+    # a shadow 10 / 24 frames wide with 4-frame penumbrae (an area source), noise free:
+    # the window of 9 frames sees only its floor, the interval all of it
+    from shadowcam.lab.shadow_time import NEVER_SHADOWED, OK, WIDE_DIP, sweep_shadow_times
+
+    frames, gt = wire_sweep(n_frames=90, shape=(24, 32), width=width, ramp=4.0, px_per_frame=1.0,
+                            t0=20.0, tilt=0.3, level=1.0)
+    inside = np.isfinite(gt) & (gt - width / 2 - 3 > 0) & (gt + width / 2 + 3 < 89)
+    before = sweep_shadow_times([frames[..., None]], (24, 32), method="edge_fit")
+    # the first pass alone: the window ends on the floor (wide_dip), or the floor beyond it
+    # counted as lit noise hides the dip (never_shadowed)
+    assert np.mean(before["reason"][inside] == OK) < 0.1
+    assert np.mean(np.isin(before["reason"][inside], [WIDE_DIP, NEVER_SHADOWED])) > 0.9
+    after = _interval_times(frames, method="edge_fit")
+    assert np.mean(after["reason"][inside] == OK) >= 0.98
+    centre_error = np.abs(after["shadow_time"] - gt)[inside]
+    assert np.nanpercentile(centre_error, 95) <= 0.1
+    # half-depth crossings of the pixel-averaged dip: the shadow's edges
+    entry_error = np.abs(after["interval_entry"] - (gt - width / 2))[inside]
+    exit_error = np.abs(after["interval_exit"] - (gt + width / 2))[inside]
+    assert np.nanpercentile(entry_error, 95) <= 0.2 and np.nanpercentile(exit_error, 95) <= 0.2
+
+
+def test_a_noisy_wide_floor_is_one_dip_not_several(wire_sweep):
+    # the floor of a 30-frame dip holds many local minima: inside the interval they are the same dip
+    from shadowcam.lab.shadow_time import OK, SEVERAL_MINIMA
+
+    frames, gt = wire_sweep(n_frames=120, shape=(16, 16), width=30.0, ramp=4.0, px_per_frame=1.0,
+                            t0=40.0, tilt=0.0, level=1.0, noise=0.02, seed=2)
+    after = _interval_times(frames, method="dip_centroid")
+    inside = np.isfinite(gt) & (gt - 20 > 0) & (gt + 20 < 119)
+    assert np.mean(after["reason"][inside] == SEVERAL_MINIMA) < 0.02
+    assert np.mean(after["reason"][inside] == OK) > 0.95
+    # noise 0.02 on a slope of 0.25 per frame: each crossing's std is 0.61 * 0.08 = 0.05 frame
+    assert np.nanpercentile(np.abs(after["shadow_time"] - gt)[inside], 95) < 0.15
+
+
+def test_a_dip_still_on_at_the_sweeps_end_gets_its_reason(wire_sweep):
+    from shadowcam.lab.shadow_time import DIP_AT_SWEEP_END
+
+    frames, _ = wire_sweep(n_frames=40, shape=(8, 8), centres=38.0, width=16.0, ramp=4.0, level=1.0)
+    after = _interval_times(frames, method="edge_fit")
+    assert np.all(after["reason"] == DIP_AT_SWEEP_END)
+    assert np.all(np.isnan(after["shadow_time"]))
