@@ -517,7 +517,8 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
 
 
 def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
-    """Time the ``wide_dip`` pixels at the centre of their measured interval.
+    """Time the ``wide_dip`` pixels, and those whose interval is longer than half the window,
+    at the centre of their measured interval.
 
     Returns the updated ``reason, time, entry, exit, std`` and the
     ``interval_*`` variables (noise over the crossing's slope for the
@@ -527,8 +528,11 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     with np.errstate(invalid="ignore", divide="ignore"):
         entry_std = sigma / interval.entry_slope
         exit_std = sigma / interval.exit_slope
-    wide = reason == WIDE_DIP
-    reason = reason.copy()
+    # a dip whose half-depth interval is longer than half the window is truncated by it
+    # (window methods are then biased toward the window's centre): timed by its interval too
+    long_ = (reason == OK) & (interval.exit - interval.entry > summary.half_window)
+    wide = (reason == WIDE_DIP) | long_
+    reason = np.where(long_, WIDE_DIP, reason).astype(reason.dtype)
     reason[wide & (interval.entry_open | interval.exit_open)] = DIP_AT_SWEEP_END
     reason[(reason == WIDE_DIP) & (interval.invalid > 0)] = INVALID_INPUT
     timed = (reason == WIDE_DIP) & np.isfinite(interval.entry) & np.isfinite(interval.exit)
