@@ -241,3 +241,34 @@ def test_a_dip_still_on_at_the_sweeps_end_gets_its_reason(wire_sweep):
     after = _interval_times(frames, method="edge_fit")
     assert np.all(after["reason"] == DIP_AT_SWEEP_END)
     assert np.all(np.isnan(after["shadow_time"]))
+
+
+def test_wide_dips_keep_the_hard_cases_honest(wire_sweep):
+    # a 12-frame shadow with 4-frame penumbrae over a textured scene with a cast-shadow box, a
+    # second (unshadowed) light adding a floor of half the lit level, and sensor noise: no
+    # pixel of the cast shadow is timed, and the timed ones' errors follow their time_std
+    from shadowcam.lab.shadow_time import OK
+
+    frames, gt = wire_sweep(n_frames=100, shape=(32, 40), width=12.0, ramp=4.0, px_per_frame=1.0,
+                            t0=25.0, tilt=0.2, electrons=400, read_noise=2.0, seed=5,
+                            shadowed_box=(10, 20, 10, 20))
+    floor = 0.5 * frames[:5].mean(axis=0)  # the second light: constant, never shadowed
+    frames = frames + floor[None]
+    after = _interval_times(frames, method="edge_fit")
+    ok = after["reason"] == OK
+    assert not ok[10:20, 10:20].any()
+    inside = np.isfinite(gt) & (gt - 12 > 0) & (gt + 12 < 99)
+    assert ok[inside].mean() > 0.9
+    z = np.abs(after["shadow_time"] - gt)[ok & inside] / after["time_std"][ok & inside]
+    # calibrated within a factor: 99 % within 4 standard deviations
+    assert np.mean(z < 4) > 0.99
+
+
+def test_pure_noise_gets_no_time_with_the_interval_pass(wire_sweep):
+    from shadowcam.lab.shadow_time import OK
+
+    frames, _ = wire_sweep(n_frames=80, shape=(24, 24), centres=200.0, width=1.0, level=0.3, noise=0.01,
+                           seed=9)
+    after = _interval_times(frames, method="edge_fit")
+    # classify_dips' default false_alarm is 1e-2 per pixel on its own
+    assert np.mean(after["reason"] == OK) < 0.02
