@@ -588,7 +588,8 @@ class IntervalTracker:
         if block.ndim != 3 or block.shape[1:] != self.shape:
             raise ValueError(f"block must have shape (T, {self.shape[0]}, {self.shape[1]}[, C]), "
                              f"got {block.shape}")
-        block = np.where(np.isfinite(block), block, np.float32(np.nan)).reshape(block.shape[0], -1)
+        # non-finite samples stay as they are: the kernel counts them (never above nor below)
+        block = block.reshape(block.shape[0], -1)
         ext = np.concatenate([self._carry, block])
         ext_first = self._next - self._carry.shape[0]
         self._next += block.shape[0]
