@@ -517,8 +517,8 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
 
 
 def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
-    """Time the ``wide_dip`` pixels, and those whose interval is longer than half the window,
-    at the centre of their measured interval.
+    """Time the ``wide_dip`` and ``ok`` pixels whose half-depth interval reaches the window's
+    edge at the centre of their measured interval.
 
     Returns the updated ``reason, time, entry, exit, std`` and the
     ``interval_*`` variables (noise over the crossing's slope for the
@@ -528,15 +528,21 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     with np.errstate(invalid="ignore", divide="ignore"):
         entry_std = sigma / interval.entry_slope
         exit_std = sigma / interval.exit_slope
-    # a dip whose half-depth interval is longer than half the window is truncated by it
-    # (window methods are then biased toward the window's centre): timed by its interval too
-    long_ = (reason == OK) & (interval.exit - interval.entry > summary.half_window)
-    wide = (reason == WIDE_DIP) | long_
-    reason = np.where(long_, WIDE_DIP, reason).astype(reason.dtype)
-    reason[wide & (interval.entry_open | interval.exit_open)] = DIP_AT_SWEEP_END
-    reason[(reason == WIDE_DIP) & (interval.invalid > 0)] = INVALID_INPUT
-    timed = (reason == WIDE_DIP) & np.isfinite(interval.entry) & np.isfinite(interval.exit)
-    reason[reason == WIDE_DIP] = INVALID_INPUT  # a crossing next to a non-finite sample
+    # the half-depth interval reaches the window's first or last frame: the window truncates
+    # the dip (window methods are biased toward its centre), the interval does not. A dip
+    # flagged wide whose interval fits the window is dark at the window's edge for another
+    # reason (a step, a second shadow): it stays wide_dip
+    h = summary.half_window
+    opened = interval.entry_open | interval.exit_open
+    with np.errstate(invalid="ignore"):
+        beyond = (interval.entry < summary.minimum_frame - h + 1) | (interval.exit > summary.minimum_frame + h - 1)
+    wide = ((reason == WIDE_DIP) & (beyond | opened)) | ((reason == OK) & beyond)
+    at_end = wide & opened
+    broken = wide & ~at_end & ((interval.invalid > 0) | ~np.isfinite(interval.entry) | ~np.isfinite(interval.exit))
+    timed = wide & ~at_end & ~broken
+    reason = reason.copy()
+    reason[at_end] = DIP_AT_SWEEP_END
+    reason[broken] = INVALID_INPUT  # a non-finite sample inside, or next to a crossing
     reason[timed] = OK
     time = np.where(timed, interval.at(0.5), time)
     entry = np.where(timed, interval.entry, entry)
