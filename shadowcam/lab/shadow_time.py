@@ -540,11 +540,17 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     at_end = wide & opened
     broken = wide & ~at_end & ((interval.invalid > 0) | ~np.isfinite(interval.entry) | ~np.isfinite(interval.exit))
     timed = wide & ~at_end & ~broken
+    centre = interval.at(0.5)
+    # a dip the window flagged wide is a shadow only where the shadow's edge sweeps on: its
+    # centre agrees with timed neighbours' (a dip of some other event falls at its own time)
+    flagged = timed & (reason == WIDE_DIP)
+    others = (reason == OK) | timed
+    timed &= ~flagged | _supported_by_neighbours(flagged, others, np.where(timed, centre, time))
     reason = reason.copy()
     reason[at_end] = DIP_AT_SWEEP_END
     reason[broken] = INVALID_INPUT  # a non-finite sample inside, or next to a crossing
     reason[timed] = OK
-    time = np.where(timed, interval.at(0.5), time)
+    time = np.where(timed, centre, time)
     entry = np.where(timed, interval.entry, entry)
     exit_ = np.where(timed, interval.exit, exit_)
     std = np.where(timed, 0.5 * np.hypot(entry_std, exit_std), std)
