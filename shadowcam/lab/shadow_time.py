@@ -536,9 +536,9 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     opened = interval.entry_open | interval.exit_open
     with np.errstate(invalid="ignore"):
         beyond = (interval.entry < summary.minimum_frame - h + 1) | (interval.exit > summary.minimum_frame + h - 1)
-    wide = ((reason == WIDE_DIP) | (reason == OK)) & (beyond | opened)
-    # the dip was already on at the sweep's first frame or still on at its last: the window's
-    # time is a guess (the shadow may have passed before the sweep began)
+    # a flagged wide dip open at the sweep's start or end has no time; a dip the window
+    # timed keeps its time there (its centre is inside the sweep)
+    wide = ((reason == WIDE_DIP) & (beyond | opened)) | ((reason == OK) & beyond)
     at_end = wide & opened
     broken = wide & ~at_end & ((interval.invalid > 0) | ~np.isfinite(interval.entry) | ~np.isfinite(interval.exit))
     timed = wide & ~at_end & ~broken
