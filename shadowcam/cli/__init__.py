@@ -21,7 +21,7 @@ STEPS = {
     "decode": "decode",
     "merge-frames": "merge_frames",
     "shadow-time": "shadow_time",
-    "shadow-time-chunk": "shadow_time_chunk",
+    "shadow-time-chunk": "shadow_time_chunk", "viewpoint": "viewpoint",
     "dual-coords": "dual_coords",
     "dual-view": "dual_view",
     "accuracy": "accuracy",

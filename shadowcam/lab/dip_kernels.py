@@ -26,6 +26,7 @@ track_block : feed a block of frames to the state (in place).
 finish_centres : test the last centres of a sequence that ended.
 window_sums : the exact sums of stored windows (to take the dip out of the running sums).
 select_dips : the deepest and second dip of each pixel among candidate lists (merging chunks).
+interval_block : compare smoothed frames with a threshold around each pixel's deepest minimum (the dip's interval).
 """
 
 import numba as nb
@@ -497,3 +498,88 @@ def select_dips(values, frames, half_window):
         if other >= 0:
             second[p], has_second[p] = other, True
     return first, second, found, has_second
+
+
+
+@nb.njit(cache=True, parallel=True)
+def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame, threshold, half_window,
+                   before_frame, before_values, before_invalid, after_frame, after_values, after_invalid,
+                   before_sums, after_sums, previous, wants_next):
+    """Compare smoothed frames ``j_from .. j_to - 1`` with each pixel's threshold around its centre.
+
+    `ext` ``(T, P)`` float32 holds the raw signal of frames ``ext_first + t``,
+    including each computed frame's neighbours inside ``[0, end)``. The
+    smoothed value (``[1, 2, 1] / 4``, a neighbour outside ``[0, end)``
+    replaced by the frame itself, as in the dip tracker) of each frame ``j``
+    is compared with the pixel's `threshold` around its `centre_frame` (its
+    deepest minimum; -1 = none): the last owned frame (``start <= j < stop``)
+    before the centre at or above the threshold is kept with its smoothed
+    value and the next frame's (``before_frame``, ``before_values (P, 2)``),
+    and the first owned frame after the centre at or above it with the
+    previous frame's value and its own (``after_frame``, ``after_values``).
+    Non-finite smoothed values are neither above nor below; those of owned
+    frames are counted since the last frame above (`before_invalid`, reset
+    there) and before the first frame above (`after_invalid`). The raw
+    samples of the same frames that lie more than `half_window` frames from
+    the centre (the dip outside the tracker's window) are summed exactly, as
+    the running sums hold them, into `before_sums` / `after_sums` ``(P, 4)``
+    int64: count, fixed-point sum, and the two parts of the sum of squares
+    (:func:`split_square`) as int64 multiples of ``2**-8`` and ``2**-40``.
+    `previous` ``(P,)`` (smoothed value of frame ``j_from - 1``) and
+    `wants_next` ``(P,)`` (the next frame's value is still to be stored in
+    ``before_values[:, 1]``) carry the state across blocks.
+    """
+    n_p = ext.shape[1]
+    for p in nb.prange(n_p):
+        c = centre_frame[p]
+        if c < 0:
+            continue
+        theta = threshold[p]
+        for j in range(j_from, j_to):
+            t = j - ext_first
+            mid = ext[t, p]
+            prev = ext[t - 1, p] if j >= 1 else mid
+            nxt = ext[t + 1, p] if j + 1 < end else mid
+            s = mid * _HALF
+            s += _QUARTER * prev
+            s += _QUARTER * nxt
+            if wants_next[p]:
+                before_values[p, 1] = s
+                wants_next[p] = False
+            owned = start <= j < stop
+            finite = s - s == 0
+            outside = (j < c - half_window or j > c + half_window) and mid - mid == 0
+            x = np.float64(mid)
+            sq = x * x
+            hi = (sq + _SQ_HI) - _SQ_HI
+            lo = ((sq - hi) + _SQ_LO) - _SQ_LO
+            if owned and j < c:
+                if not finite:
+                    before_invalid[p] += 1
+                elif s >= theta:
+                    before_frame[p] = j
+                    before_values[p, 0] = s
+                    before_invalid[p] = 0
+                    wants_next[p] = True
+                    for q in range(4):
+                        before_sums[p, q] = 0
+                    outside = False
+                if outside:
+                    before_sums[p, 0] += 1
+                    before_sums[p, 1] += _fixed(x)
+                    before_sums[p, 2] += np.int64(hi * 256.0)
+                    before_sums[p, 3] += np.int64(lo * 2.0**40)
+            elif owned and j > c and after_frame[p] < 0:
+                if not finite:
+                    after_invalid[p] += 1
+                elif s >= theta:
+                    after_frame[p] = j
+                    after_values[p, 0] = previous[p] if j >= 1 else s
+                    after_values[p, 1] = s
+                    outside = False
+                if outside:
+                    after_sums[p, 0] += 1
+                    after_sums[p, 1] += _fixed(x)
+                    after_sums[p, 2] += np.int64(hi * 256.0)
+                    after_sums[p, 3] += np.int64(lo * 2.0**40)
+            previous[p] = s

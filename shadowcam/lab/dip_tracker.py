@@ -33,6 +33,12 @@ DipTracker : the streaming accumulator (``update`` with frame blocks, then ``res
 DipSummary : what the tracker hands to the timing methods (plain arrays).
 DipPartial : the state of one time chunk (``save`` / ``load``).
 merge_partials : the summary of a sweep from its time chunks.
+IntervalTracker : second pass: each pixel's dip interval (entry and exit crossings), whatever its width.
+DipInterval : entry, exit and their slopes per pixel; ``at(fraction)`` across the interval.
+IntervalPartial, merge_intervals : the interval of a sweep from its time chunks.
+half_depth : the default crossing level.
+without_interval : the summary's lit statistics without the whole dip, and the crossings at its half depth.
+track_intervals : the interval pass over a sweep's frames.
 """
 
 from dataclasses import dataclass, fields
@@ -418,3 +424,336 @@ def merge_partials(partials, *, n_frames):
         channel_sum=channel_sum / _k.SUM_SCALE if channel_sum.shape[-1] else None,
         saturated=saturated,
     )
+
+
+@dataclass
+class IntervalPartial:
+    """Where one time chunk's smoothed signal is at or above each pixel's threshold around its dip.
+
+    Attributes
+    ----------
+    start, stop : int
+        Owned frames ``[start, stop)``.
+    before_frame : (H, W) int64 ndarray
+        Last owned frame before the pixel's centre at or above the threshold (-1 = none).
+    before_values : (H, W, 2) float32 ndarray
+        Smoothed values at `before_frame` and the frame after it.
+    before_invalid : (H, W) int64 ndarray
+        Owned frames with a non-finite smoothed value after `before_frame`
+        (after `start` when there is none) and before the centre.
+    after_frame : (H, W) int64 ndarray
+        First owned frame after the centre at or above the threshold (-1 = none).
+    after_values : (H, W, 2) float32 ndarray
+        Smoothed values at the frame before `after_frame` and at it.
+    after_invalid : (H, W) int64 ndarray
+        Owned frames after the centre with a non-finite smoothed value before `after_frame`.
+    before_sums, after_sums : (H, W, 4) int64 ndarray
+        Count, fixed-point sum and square parts of the raw samples counted
+        like `before_invalid` / `after_invalid` but more than ``half_window``
+        frames from the centre (see :func:`shadowcam.lab.dip_kernels.interval_block`).
+    """
+
+    start: int
+    stop: int
+    before_frame: np.ndarray
+    before_values: np.ndarray
+    before_invalid: np.ndarray
+    after_frame: np.ndarray
+    after_values: np.ndarray
+    after_invalid: np.ndarray
+    before_sums: np.ndarray
+    after_sums: np.ndarray
+
+
+@dataclass
+class DipInterval:
+    """Each pixel's dip interval: where its smoothed signal stays below the threshold around its minimum.
+
+    Times are in frames, sub-frame by linear interpolation of the smoothed
+    signal between the last frame at or above the threshold and the next one
+    (entry), and between the last one below and the first one at or above
+    (exit). NaN where the interval reaches the sweep's start or end (no
+    frame above the threshold on that side) or where the pixel has no dip.
+
+    Attributes
+    ----------
+    entry, exit : (H, W) float64 ndarray
+        Threshold crossings before and after the minimum.
+    entry_open, exit_open : (H, W) bool ndarray
+        The interval reaches the sweep's start (end): no frame above the threshold on that side.
+    entry_slope, exit_slope : (H, W) float64 ndarray
+        Change of the smoothed signal over the crossing frame (signal units
+        per frame; positive), for the time uncertainty ``noise / slope``.
+    invalid : (H, W) int64 ndarray
+        Frames inside the interval with a non-finite smoothed value.
+    threshold : (H, W) float64 ndarray
+        The level the crossings were taken at.
+    beyond_count, beyond_sum, beyond_square : (H, W) ndarray
+        Count (int64), sum and sum of squares (float64) of the finite raw
+        samples inside the interval but outside the tracker's window (the
+        part of a wide dip that the :class:`DipSummary` counted as lit).
+    """
+
+    entry: np.ndarray
+    exit: np.ndarray
+    entry_open: np.ndarray
+    exit_open: np.ndarray
+    entry_slope: np.ndarray
+    exit_slope: np.ndarray
+    invalid: np.ndarray
+    threshold: np.ndarray
+    beyond_count: np.ndarray
+    beyond_sum: np.ndarray
+    beyond_square: np.ndarray
+
+    def at(self, fraction):
+        """Time at `fraction` across the interval (0 = entry, 0.5 = centre, 1 = exit), ``(H, W)``."""
+        return self.entry + float(fraction) * (self.exit - self.entry)
+
+
+class IntervalTracker:
+    """Streaming measurement of each pixel's dip interval, whatever its width.
+
+    The dip's frame and depth come from a first pass (a :class:`DipSummary`:
+    its deepest smoothed minimum and lit level); this pass streams the frames
+    again and keeps, per pixel, only the last frame before the minimum and
+    the first one after it where the smoothed signal is at or above
+    `threshold`, with the values either side of each crossing: O(1) state per
+    pixel, independent of the frames and of the dip's width (a plateau of
+    any length, penumbrae either side).
+
+    Parameters
+    ----------
+    centre_frame : (H, W) int ndarray
+        Frame of each pixel's deepest minimum (negative = no dip: skipped).
+    half_window : int
+        The dip tracker's: samples further than this from the centre inside the
+        interval are summed (``beyond_*`` of :class:`DipInterval`).
+    threshold : (H, W) float ndarray
+        Level of the crossings (e.g. half depth, :func:`half_depth`).
+    n_frames : int
+        Frames of the sweep.
+    owned : (int, int), optional
+        Time chunk ``(start, stop)``; feed frames ``[max(0, start - 2), min(n_frames, stop + 2))``
+        and take :meth:`partial`; :func:`merge_intervals` of the chunks equals the
+        single-pass :meth:`result` bit for bit. Default: the whole sweep.
+    """
+
+    PAD = 2
+
+    def __init__(self, centre_frame, threshold, *, half_window, n_frames, owned=None):
+        centre_frame = np.asarray(centre_frame)
+        threshold = np.asarray(threshold, np.float64)
+        if centre_frame.ndim != 2 or threshold.shape != centre_frame.shape:
+            raise ValueError(f"centre_frame and threshold must be (H, W) arrays of one shape; "
+                             f"got {centre_frame.shape} and {threshold.shape}")
+        n_frames = int(n_frames)
+        if int(half_window) < 1:
+            raise ValueError(f"half_window must be >= 1; got {half_window!r}")
+        self.half_window = int(half_window)
+        if n_frames < 1:
+            raise ValueError(f"n_frames must be >= 1; got {n_frames}")
+        start, stop = (0, n_frames) if owned is None else (int(owned[0]), min(int(owned[1]), n_frames))
+        if not 0 <= start < stop:
+            raise ValueError(f"owned must be (start, stop) with 0 <= start < stop <= n_frames; got {owned!r}")
+        self.shape = centre_frame.shape
+        self.n_frames = n_frames
+        self.owned = (start, stop)
+        p = centre_frame.size
+        self._centre = np.where(np.isfinite(threshold), centre_frame, -1).astype(np.int64).ravel()
+        # float32 comparison with the float32 smoothed signal
+        self._threshold = threshold.astype(np.float32).ravel()
+        self._first = max(0, start - self.PAD)
+        self._next = self._first
+        self._done = max(0, start - 1)  # next frame whose smoothed value is computed
+        self._last = min(n_frames, stop + 1)  # one past the last one
+        self._carry = np.empty((0, p), np.float32)
+        self._state = dict(
+            before_frame=np.full(p, -1, np.int64), before_values=np.full((p, 2), np.nan, np.float32),
+            before_invalid=np.zeros(p, np.int64), after_frame=np.full(p, -1, np.int64),
+            after_values=np.full((p, 2), np.nan, np.float32), after_invalid=np.zeros(p, np.int64),
+            before_sums=np.zeros((p, 4), np.int64), after_sums=np.zeros((p, 4), np.int64))
+        self._previous = np.full(p, np.nan, np.float32)
+        self._wants_next = np.zeros(p, bool)
+
+    def update(self, block):
+        """Feed the next frames, ``(T, H, W)`` signal or ``(T, H, W, C)`` channels (summed)."""
+        block = np.asarray(block, np.float32)
+        if block.ndim == 4:
+            # the channel sum in order, as the dip tracker forms it
+            signal = block[..., 0].copy()
+            for c in range(1, block.shape[3]):
+                signal += block[..., c]
+            block = signal
+        if block.ndim != 3 or block.shape[1:] != self.shape:
+            raise ValueError(f"block must have shape (T, {self.shape[0]}, {self.shape[1]}[, C]), "
+                             f"got {block.shape}")
+        # non-finite samples stay as they are: the kernel counts them (never above nor below)
+        block = block.reshape(block.shape[0], -1)
+        ext = np.concatenate([self._carry, block])
+        ext_first = self._next - self._carry.shape[0]
+        self._next += block.shape[0]
+        if self._next > self.n_frames:
+            raise ValueError(f"more frames fed than n_frames={self.n_frames}")
+        # frame j is computable once j + 1 is in (or j is the sweep's last frame)
+        upto = min(self._last, self._next - 1 if self._next < self.n_frames else self._next)
+        if upto > self._done:
+            s = self._state
+            _k.interval_block(ext, ext_first, self._done, upto, *self.owned, self.n_frames, self._centre,
+                              self._threshold, self.half_window, s["before_frame"], s["before_values"],
+                              s["before_invalid"], s["after_frame"], s["after_values"], s["after_invalid"],
+                              s["before_sums"], s["after_sums"], self._previous, self._wants_next)
+            self._done = upto
+        self._carry = ext[-2:]
+
+    def partial(self):
+        """The :class:`IntervalPartial` of the owned chunk (all its frames must have been fed)."""
+        if self._done < self._last:
+            raise ValueError(f"frames up to {min(self.n_frames, self.owned[1] + self.PAD)} must be fed "
+                             f"before partial(); fed up to {self._next}")
+        h, w = self.shape
+        s = {k: v.reshape((h, w) + v.shape[1:]) for k, v in self._state.items()}
+        return IntervalPartial(start=self.owned[0], stop=self.owned[1], **s)
+
+    def result(self):
+        """The :class:`DipInterval` of the whole sweep (the tracker must own it all)."""
+        if self.owned != (0, self.n_frames):
+            raise ValueError("result() needs a tracker owning the whole sweep; use partial() and merge_intervals()")
+        return merge_intervals([self.partial()], n_frames=self.n_frames,
+                               threshold=self._threshold.reshape(self.shape))
+
+
+def half_depth(summary):
+    """Threshold halfway between each pixel's lit level and its smoothed minimum, ``(H, W)``."""
+    return 0.5 * (summary.lit_level + summary.minimum_value.astype(np.float64))
+
+
+def merge_intervals(partials, *, n_frames, threshold):
+    """The :class:`DipInterval` of a sweep from the :class:`IntervalPartial` of its time chunks.
+
+    Parameters
+    ----------
+    partials : sequence of IntervalPartial
+        One per chunk, in any order, tiling ``[0, n_frames)``.
+    n_frames : int
+    threshold : (H, W) array_like
+        The threshold the chunks were tracked with.
+
+    Returns
+    -------
+    DipInterval
+        Equal bit for bit to the single-pass :meth:`IntervalTracker.result`.
+    """
+    if not partials:
+        raise ValueError("partials is empty: give the partials of every time chunk")
+    ordered = sorted(partials, key=lambda part: part.start)
+    expected = 0
+    for part in ordered:
+        if part.start != expected:
+            raise ValueError(f"partials must tile frames [0, {n_frames}) without gaps or overlaps; "
+                             f"a chunk starts at {part.start} where {expected} was expected")
+        expected = part.stop
+    if expected != int(n_frames):
+        raise ValueError(f"n_frames is {n_frames} but the partials cover frames [0, {expected})")
+    shape = ordered[0].before_frame.shape
+    before = np.full(shape, -1, np.int64)
+    before_values = np.full(shape + (2,), np.nan, np.float32)
+    before_invalid = np.zeros(shape, np.int64)
+    before_sums = np.zeros(shape + (4,), np.int64)
+    for part in ordered:  # in time order: a later frame above resets the counts
+        found = part.before_frame >= 0
+        before = np.where(found, part.before_frame, before)
+        before_values = np.where(found[..., None], part.before_values, before_values)
+        before_invalid = np.where(found, part.before_invalid, before_invalid + part.before_invalid)
+        before_sums = np.where(found[..., None], part.before_sums, before_sums + part.before_sums)
+    after = np.full(shape, -1, np.int64)
+    after_values = np.full(shape + (2,), np.nan, np.float32)
+    after_invalid = np.zeros(shape, np.int64)
+    after_sums = np.zeros(shape + (4,), np.int64)
+    for part in ordered:
+        open_ = after < 0
+        after_invalid = np.where(open_, after_invalid + part.after_invalid, after_invalid)
+        after_sums = np.where(open_[..., None], after_sums + part.after_sums, after_sums)
+        take = open_ & (part.after_frame >= 0)
+        after = np.where(take, part.after_frame, after)
+        after_values = np.where(take[..., None], part.after_values, after_values)
+    threshold = np.asarray(threshold, np.float32).astype(np.float64)
+    b0, b1 = (before_values[..., i].astype(np.float64) for i in (0, 1))
+    a0, a1 = (after_values[..., i].astype(np.float64) for i in (0, 1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        entry_slope = b0 - b1
+        exit_slope = a1 - a0
+        entry = np.where(before >= 0, before + (b0 - threshold) / entry_slope, np.nan)
+        exit_ = np.where(after >= 0, after - 1 + (threshold - a0) / exit_slope, np.nan)
+    # a crossing next to a non-finite value has no sub-frame position
+    entry = np.where(np.isfinite(b1), entry, np.nan)
+    exit_ = np.where(np.isfinite(a0), exit_, np.nan)
+    sums = before_sums + after_sums
+    return DipInterval(entry=entry, exit=exit_, entry_open=before < 0, exit_open=after < 0,
+                       entry_slope=entry_slope, exit_slope=exit_slope,
+                       invalid=before_invalid + after_invalid, threshold=threshold,
+                       beyond_count=sums[..., 0], beyond_sum=sums[..., 1] / _k.SUM_SCALE,
+                       beyond_square=sums[..., 2] / 256.0 + sums[..., 3] / 2.0**40)
+
+
+def track_intervals(blocks, summary, *, threshold=None):
+    """Second pass over a sweep's frames: the dip interval of every pixel of `summary`.
+
+    Parameters
+    ----------
+    blocks : iterable of (T, H, W[, C]) ndarray
+        The same frames as fed to the :class:`DipTracker`, in time order.
+    summary : DipSummary
+    threshold : (H, W) ndarray, optional
+        Default :func:`half_depth`.
+
+    Returns
+    -------
+    DipInterval
+    """
+    threshold = half_depth(summary) if threshold is None else threshold
+    tracker = IntervalTracker(summary.minimum_frame, threshold, half_window=summary.half_window,
+                              n_frames=summary.n_frames)
+    for block in blocks:
+        tracker.update(block)
+    return tracker.result()
+
+
+def without_interval(summary, interval):
+    """The lit statistics of `summary` with the whole dip interval taken out, and the crossings moved to match.
+
+    The tracker's lit level and noise count the frames of a dip wider than
+    its window as lit (lower level, higher noise). This removes those frames
+    (``beyond_*`` of `interval`) from the running sums and moves each
+    crossing along its local slope to the half depth of the corrected level
+    (first order; exact on a linear penumbra). Pixels with nothing beyond the
+    window keep their values bit for bit.
+
+    Returns
+    -------
+    summary : DipSummary
+        With `lit_level`, `noise` and `lit_count` corrected.
+    interval : DipInterval
+        With `entry`, `exit` and `threshold` corrected.
+    """
+    from dataclasses import replace
+
+    n = summary.lit_count.astype(np.float64)
+    k = interval.beyond_count.astype(np.float64)
+    level, noise = summary.lit_level, summary.noise
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit_sum = level * n - interval.beyond_sum
+        variance = noise**2 * np.maximum(n - 1, 1) / n
+        lit_square = (variance + level**2) * n - interval.beyond_square
+        new_level = lit_sum / (n - k)
+        new_variance = np.maximum(lit_square / (n - k) - new_level**2, 0) * (n - k) / np.maximum(n - k - 1, 1)
+    changed = (k > 0) & (n - k >= 3)
+    new_summary = replace(summary, lit_level=np.where(changed, new_level, level),
+                          noise=np.where(changed, np.sqrt(new_variance), noise),
+                          lit_count=np.where(changed, summary.lit_count - interval.beyond_count, summary.lit_count))
+    threshold = np.where(changed, half_depth(new_summary), interval.threshold)
+    shift = threshold - interval.threshold
+    with np.errstate(invalid="ignore", divide="ignore"):
+        entry = np.where(changed, interval.entry - shift / interval.entry_slope, interval.entry)
+        exit_ = np.where(changed, interval.exit + shift / interval.exit_slope, interval.exit)
+    return new_summary, replace(interval, entry=entry, exit=exit_, threshold=threshold)

@@ -47,8 +47,9 @@ REASONS = {
     4: "several_minima",
     5: "invalid_input",
     6: "wide_dip",
+    7: "dip_at_sweep_end",
 }
-OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP = range(7)
+OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP, DIP_AT_SWEEP_END = range(8)
 
 #: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
 _SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
@@ -361,7 +362,7 @@ def _wider_than_window(summary, depth, significant):
 def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
                   false_alarm=1e-2, weak_false_alarm=0.5,
                   min_relative_depth=0.1, min_lit_fraction=0.5, shadow_ratio=0.1,
-                  noise_floor=1e-4, second_dip_ratio=0.5):
+                  noise_floor=1e-4, second_dip_ratio=0.5, interval=None):
     """Decide per pixel whether its dip is a reliable shadow, and why not.
 
     A dip is detected when it is deeper than pure noise gets within the
@@ -396,6 +397,10 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     second_dip_ratio : float, optional
         A second dip (another local minimum more than half a window away) at
         least this deep (relative to the first) marks the pixel ``several_minima``.
+    interval : DipInterval, optional
+        The dip's measured interval (:func:`shadowcam.lab.dip_tracker.track_intervals`):
+        a second minimum inside it is part of the same dip (the floor of a
+        wide dip), not a second one.
 
     Returns
     -------
@@ -428,6 +433,11 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     several = detected & (second_depth >= second_dip_ratio * depth) & (
         second_depth / (noise * _SMOOTHED_NOISE) > z
     )
+    if interval is not None:
+        with np.errstate(invalid="ignore"):
+            first = np.where(interval.entry_open, -np.inf, np.floor(interval.entry))
+            last = np.where(interval.exit_open, np.inf, np.ceil(interval.exit))
+            several &= ~((summary.second_frame >= first) & (summary.second_frame <= last))
     reason[(reason == OK) & several] = SEVERAL_MINIMA
     reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
     if saturated is not None:
@@ -444,7 +454,7 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     return reason, np.nan_to_num(contrast, nan=0.0, posinf=0.0).astype(np.float32)
 
 
-def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=None,
+def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=None, interval=None,
                  **classify_params):
     """Time and classify the dips of one sweep.
 
@@ -456,6 +466,12 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
     saturated : (H, W) bool ndarray, optional
     method_params : dict, optional
         Keyword options of the timing method.
+    interval : DipInterval, optional
+        The measured dip intervals (:func:`shadowcam.lab.dip_tracker.track_intervals`):
+        a dip wider than the window is then timed at its interval's centre
+        (``dip_at_sweep_end`` when the interval reaches the sweep's start or
+        end, ``invalid_input`` with a non-finite sample inside), and the
+        ``interval_*`` variables are returned.
     **classify_params
         Options of :func:`classify_dips`.
 
@@ -464,15 +480,19 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
     dict of (H, W) ndarrays
         ``shadow_time``, ``entry_time``, ``exit_time`` (frames, NaN where
         unreliable), ``time_std`` (frames), ``confidence`` (0..1),
-        ``contrast``, ``reason`` (uint8), ``lit_level``, ``noise``.
+        ``contrast``, ``reason`` (uint8), ``lit_level``, ``noise``; with
+        `interval` also ``interval_entry``, ``interval_exit`` (half-depth
+        crossings, frames) and ``interval_entry_std``, ``interval_exit_std``.
     """
     if method not in SHADOW_TIME_METHODS:
         raise ValueError(
             f"method must be one of {sorted(SHADOW_TIME_METHODS)}, got {method!r}"
         )
-    reason, contrast = classify_dips(summary, saturated=saturated, **classify_params)
+    reason, contrast = classify_dips(summary, saturated=saturated, interval=interval, **classify_params)
     masked = _masked_summary(summary, reason == OK)
     time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
+    if interval is not None:
+        reason, time, entry, exit_, std, extra = _time_wide_dips(summary, interval, reason, time, entry, exit_, std)
     last = summary.n_frames - 1
     outside = ~((time >= 0) & (time <= last))
     reason = reason.copy()
@@ -491,7 +511,54 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
         "reason": reason,
         "lit_level": summary.lit_level.astype(np.float32),
         "noise": summary.noise.astype(np.float32),
+        **({} if interval is None else {
+            key: np.where(good, value, nan).astype(np.float32) for key, value in extra.items()}),
     }
+
+
+def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
+    """Time the ``wide_dip`` and ``ok`` pixels whose half-depth interval reaches the window's
+    edge at the centre of their measured interval.
+
+    Returns the updated ``reason, time, entry, exit, std`` and the
+    ``interval_*`` variables (noise over the crossing's slope for the
+    standard deviations).
+    """
+    sigma = summary.noise * _SMOOTHED_NOISE
+    with np.errstate(invalid="ignore", divide="ignore"):
+        entry_std = sigma / interval.entry_slope
+        exit_std = sigma / interval.exit_slope
+    # the half-depth interval reaches the window's first or last frame: the window truncates
+    # the dip (window methods are biased toward its centre), the interval does not. A dip
+    # flagged wide whose interval fits the window is dark at the window's edge for another
+    # reason (a step, a second shadow): it stays wide_dip
+    h = summary.half_window
+    opened = interval.entry_open | interval.exit_open
+    with np.errstate(invalid="ignore"):
+        beyond = (interval.entry < summary.minimum_frame - h + 1) | (interval.exit > summary.minimum_frame + h - 1)
+    # a flagged wide dip open at the sweep's start or end has no time; a dip the window
+    # timed keeps its time there (its centre is inside the sweep)
+    wide = ((reason == WIDE_DIP) & (beyond | opened)) | ((reason == OK) & beyond)
+    at_end = wide & opened
+    broken = wide & ~at_end & ((interval.invalid > 0) | ~np.isfinite(interval.entry) | ~np.isfinite(interval.exit))
+    timed = wide & ~at_end & ~broken
+    centre = interval.at(0.5)
+    # a dip the window flagged wide is a shadow only where the shadow's edge sweeps on: its
+    # centre agrees with timed neighbours' (a dip of some other event falls at its own time)
+    flagged = timed & (reason == WIDE_DIP)
+    others = (reason == OK) | timed
+    timed &= ~flagged | _supported_by_neighbours(flagged, others, np.where(timed, centre, time))
+    reason = reason.copy()
+    reason[at_end] = DIP_AT_SWEEP_END
+    reason[broken] = INVALID_INPUT  # a non-finite sample inside, or next to a crossing
+    reason[timed] = OK
+    time = np.where(timed, centre, time)
+    entry = np.where(timed, interval.entry, entry)
+    exit_ = np.where(timed, interval.exit, exit_)
+    std = np.where(timed, 0.5 * np.hypot(entry_std, exit_std), std)
+    extra = {"interval_entry": interval.entry, "interval_exit": interval.exit,
+             "interval_entry_std": entry_std, "interval_exit_std": exit_std}
+    return reason, time, entry, exit_, std, extra
 
 
 def _masked_summary(summary, keep):
@@ -608,7 +675,7 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
 
 
 def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
-                         classify_params=None):
+                         classify_params=None, interval=None):
     """Shadow times of one sweep from its tracked :class:`DipSummary`.
 
     The second half of :func:`sweep_shadow_times`, for a summary obtained
@@ -621,6 +688,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
         With channel sums (the tracker was fed ``(T, H, W, C)`` blocks).
     method, cfa_pattern, method_params, classify_params
         As :func:`sweep_shadow_times`.
+    interval : DipInterval, optional
+        As :func:`shadow_times`.
 
     Returns
     -------
@@ -636,7 +705,7 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
             site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],
         )
     results = shadow_times(summary, method=method, saturated=summary.saturated,
-                           method_params=method_params, **classify_params)
+                           method_params=method_params, interval=interval, **classify_params)
     results["lit_image"] = lit_image
     results["n_frames"] = summary.n_frames
     return results
@@ -652,6 +721,10 @@ _VARIABLE_ATTRS = {
     "lit_level": ("linear", "unshadowed level of the channel sum"),
     "noise": ("linear", "temporal noise standard deviation of the channel sum"),
     "lit_image": ("linear", "unshadowed colour per channel"),
+    "interval_entry": ("frame", "time the smoothed signal falls below half the dip's depth (dip interval entry)"),
+    "interval_exit": ("frame", "time the smoothed signal comes back above half the dip's depth (interval exit)"),
+    "interval_entry_std": ("frame", "standard deviation of interval_entry (noise over the crossing's slope)"),
+    "interval_exit_std": ("frame", "standard deviation of interval_exit (noise over the crossing's slope)"),
 }
 
 
@@ -678,6 +751,8 @@ def shadow_time_dataset(per_sweep, *, channels=("R", "G", "B")):
     names = list(per_sweep)
     data = {}
     for key, (units, long_name) in _VARIABLE_ATTRS.items():
+        if not all(key in per_sweep[n] for n in names):
+            continue
         stacked = np.stack([per_sweep[n][key] for n in names])
         dims = ("sweep", "row", "col", "channel") if stacked.ndim == 4 else ("sweep", "row", "col")
         data[key] = (dims, stacked, {"units": units, "long_name": long_name})
@@ -700,7 +775,10 @@ _EMPTY_HINTS = {
     "saturated": "the frames are saturated: lower the exposure",
     "several_minima": "the pixels see several shadows: check the sweep's files and order",
     "invalid_input": "the sweep is too short or its frames are invalid: it needs more frames than the dip window",
-    "wide_dip": "the shadow passes slower than the dip window: raise half_window",
+    "wide_dip": "the shadow passes slower than the dip window and its interval was not measured: "
+                "run the interval pass (shadow_time_of_stores does)",
+    "dip_at_sweep_end": "the shadow is still on the pixels at the sweep's first or last frame: "
+                        "check that the sweep starts and ends with the mask out of view",
 }
 
 
@@ -755,7 +833,7 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
         If a sweep has (almost) no timed pixel, with the reason counts.
     """
     from shadowcam.io.frame_store import iter_frame_chunks
-    from shadowcam.lab.dip_tracker import DipPartial, merge_partials
+    from shadowcam.lab.dip_tracker import DipPartial, merge_partials, track_intervals, without_interval
 
     if method not in SHADOW_TIME_METHODS:
         raise ValueError(f"method: unknown {method!r}; choose from {sorted(SHADOW_TIME_METHODS)}")
@@ -773,13 +851,15 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
         if sweep in partials:
             log.info("sweep %s: merging %d time chunks of %d frames", sweep, len(partials[sweep]), n_frames)
             summary = merge_partials([DipPartial.load(p) for p in partials[sweep]], n_frames=n_frames)
-            per_sweep[sweep] = summary_shadow_times(summary, **options)
         else:
             log.info("sweep %s: %d frames of %dx%d", sweep, n_frames, shape[0], shape[1])
             progress = Progress(max(n_frames, 1), f"shadow times of sweep {sweep}")
-            per_sweep[sweep] = sweep_shadow_times(
-                (block for _, block in iter_frame_chunks(frames)), shape,
-                half_window=half_window, progress=progress.update, **options)
+            summary, _, _ = track_sweep((block for _, block in iter_frame_chunks(frames)), shape,
+                                        half_window=half_window, progress=progress.update)
+        log.info("sweep %s: dip intervals", sweep)
+        interval = track_intervals((block for _, block in iter_frame_chunks(frames)), summary)
+        summary, interval = without_interval(summary, interval)
+        per_sweep[sweep] = summary_shadow_times(summary, interval=interval, **options)
     dataset = shadow_time_dataset(per_sweep)
     check_timed(dataset, min_coverage=min_coverage)
     return dataset

@@ -157,7 +157,7 @@ def test_stores_of_two_sweeps_give_one_dataset_equal_to_each_sweep_alone(wire_sw
 
     dataset = shadow_time_of_stores({"u": store(frames_u), "v": store(frames_v)}, half_window=4)
     assert list(dataset["sweep"].values) == ["u", "v"]
-    alone = run(frames_v, half_window=4)
+    alone = _interval_times(frames_v)  # the tracker and the interval pass, as the stores get
     np.testing.assert_array_equal(dataset["shadow_time"].sel(sweep="v").values, alone["shadow_time"])
     err, found = abs_error({"shadow_time": dataset["shadow_time"].sel(sweep="u").values}, gt_u)
     assert found > 0.95 and np.median(err) < 0.1
@@ -182,3 +182,93 @@ def test_a_sweep_without_timed_pixels_fails_with_the_reason_counts(case, reason,
         shadow_time_of_stores({"u": store}, half_window=4)
     with pytest.raises(ValueError, match="min_coverage must be"):
         shadow_time_of_stores({"u": store}, half_window=4, min_coverage=5)
+
+
+def _interval_times(frames, **options):
+    """Shadow times of a sweep with the dip-interval pass (as shadow_time_of_stores runs them)."""
+    from shadowcam.lab.dip_tracker import track_intervals, without_interval
+    from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
+
+    if frames.ndim == 3:
+        frames = frames[..., None]
+    summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)
+    summary, interval = without_interval(summary, track_intervals([frames], summary))
+    return summary_shadow_times(summary, interval=interval, **options)
+
+
+@pytest.mark.parametrize("width", [10.0, 24.0])
+def test_a_dip_wider_than_the_window_is_timed_at_its_interval(wire_sweep, width):
+    # a shadow 10 / 24 frames wide with 4-frame penumbrae (an area source), noise free:
+    # the window of 9 frames sees only its floor, the interval all of it
+    from shadowcam.lab.shadow_time import NEVER_SHADOWED, OK, WIDE_DIP, sweep_shadow_times
+
+    frames, gt = wire_sweep(n_frames=90, shape=(24, 32), width=width, ramp=4.0, px_per_frame=1.0,
+                            t0=20.0, tilt=0.3, level=1.0)
+    inside = np.isfinite(gt) & (gt - width / 2 - 3 > 0) & (gt + width / 2 + 3 < 89)
+    before = sweep_shadow_times([frames[..., None]], (24, 32), method="edge_fit")
+    # the first pass alone: the window ends on the floor (wide_dip), or the floor beyond it
+    # counted as lit noise hides the dip (never_shadowed)
+    assert np.mean(before["reason"][inside] == OK) < 0.1
+    assert np.mean(np.isin(before["reason"][inside], [WIDE_DIP, NEVER_SHADOWED])) > 0.9
+    after = _interval_times(frames, method="edge_fit")
+    assert np.mean(after["reason"][inside] == OK) >= 0.98
+    centre_error = np.abs(after["shadow_time"] - gt)[inside]
+    assert np.nanpercentile(centre_error, 95) <= 0.1
+    # half-depth crossings of the pixel-averaged dip: the shadow's edges
+    entry_error = np.abs(after["interval_entry"] - (gt - width / 2))[inside]
+    exit_error = np.abs(after["interval_exit"] - (gt + width / 2))[inside]
+    assert np.nanpercentile(entry_error, 95) <= 0.2 and np.nanpercentile(exit_error, 95) <= 0.2
+
+
+def test_a_noisy_wide_floor_is_one_dip_not_several(wire_sweep):
+    # the floor of a 30-frame dip holds many local minima: inside the interval they are the same dip
+    from shadowcam.lab.shadow_time import OK, SEVERAL_MINIMA
+
+    frames, gt = wire_sweep(n_frames=120, shape=(16, 16), width=30.0, ramp=4.0, px_per_frame=1.0,
+                            t0=40.0, tilt=0.0, level=1.0, noise=0.02, seed=2)
+    after = _interval_times(frames, method="dip_centroid")
+    inside = np.isfinite(gt) & (gt - 20 > 0) & (gt + 20 < 119)
+    assert np.mean(after["reason"][inside] == SEVERAL_MINIMA) < 0.02
+    assert np.mean(after["reason"][inside] == OK) > 0.95
+    # noise 0.02 on a slope of 0.25 per frame: each crossing's std is 0.61 * 0.08 = 0.05 frame
+    assert np.nanpercentile(np.abs(after["shadow_time"] - gt)[inside], 95) < 0.15
+
+
+def test_a_dip_still_on_at_the_sweeps_end_gets_its_reason(wire_sweep):
+    from shadowcam.lab.shadow_time import DIP_AT_SWEEP_END
+
+    frames, _ = wire_sweep(n_frames=40, shape=(8, 8), centres=38.0, width=16.0, ramp=4.0, level=1.0)
+    after = _interval_times(frames, method="edge_fit")
+    assert np.all(after["reason"] == DIP_AT_SWEEP_END)
+    assert np.all(np.isnan(after["shadow_time"]))
+
+
+def test_wide_dips_keep_the_hard_cases_honest(wire_sweep):
+    # a 12-frame shadow with 4-frame penumbrae over a textured scene with a cast-shadow box, a
+    # second (unshadowed) light adding a floor of half the lit level, and sensor noise: no
+    # pixel of the cast shadow is timed, and the timed ones' errors follow their time_std
+    from shadowcam.lab.shadow_time import OK
+
+    frames, gt = wire_sweep(n_frames=100, shape=(32, 40), width=12.0, ramp=4.0, px_per_frame=1.0,
+                            t0=25.0, tilt=0.2, electrons=400, read_noise=2.0, seed=5,
+                            shadowed_box=(10, 20, 10, 20))
+    floor = 0.5 * frames[:5].mean(axis=0)  # the second light: constant, never shadowed
+    frames = frames + floor[None]
+    after = _interval_times(frames, method="edge_fit")
+    ok = after["reason"] == OK
+    assert not ok[10:20, 10:20].any()
+    inside = np.isfinite(gt) & (gt - 12 > 0) & (gt + 12 < 99)
+    assert ok[inside].mean() > 0.9
+    z = np.abs(after["shadow_time"] - gt)[ok & inside] / after["time_std"][ok & inside]
+    # calibrated within a factor: 99 % within 4 standard deviations
+    assert np.mean(z < 4) > 0.99
+
+
+def test_pure_noise_gets_no_time_with_the_interval_pass(wire_sweep):
+    from shadowcam.lab.shadow_time import OK
+
+    frames, _ = wire_sweep(n_frames=80, shape=(24, 24), centres=200.0, width=1.0, level=0.3, noise=0.01,
+                           seed=9)
+    after = _interval_times(frames, method="edge_fit")
+    # classify_dips' default false_alarm is 1e-2 per pixel on its own
+    assert np.mean(after["reason"] == OK) < 0.02

@@ -36,7 +36,7 @@ def test_params_blocks_name_the_library_options(schema):
     assert set(_block(schema, "evaluate", "method")["enum"]) == set(SHADOW_TIME_METHODS)
     method_params = set().union(*(_options(f) for f in SHADOW_TIME_METHODS.values()))
     assert set(_block(schema, "shadow_time", "params", "method_params")["properties"]) == method_params
-    classify = _options(classify_dips, skip=("saturated", "site_level", "site_colour"))
+    classify = _options(classify_dips, skip=("saturated", "site_level", "site_colour", "interval"))
     assert set(_block(schema, "shadow_time", "params", "classify_params")["properties"]) == classify
     dual_coords = _block(schema, "dual_coords", "params")
     assert set(dual_coords["properties"]) == {"min_confidence", *UNIFORM_OPTIONS, *CALIBRATION_OPTIONS}

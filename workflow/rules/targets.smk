@@ -26,6 +26,11 @@ def dataset_targets(ds):
             f"results/{ds}/{stage}.nc" for stage in plan.stages
         ]
         targets += [] if plan.single_sweep else [f"results/{ds}/figures"]
+        if "dual_view" in plan.stages:
+            targets += [
+                f"results/{ds}/viewpoints/{vp}/dual_view.nc"
+                for vp in config["dual_view"]["viewpoints"]
+            ]
         accuracy = [f"results/{ds}/accuracy.json", f"results/{ds}/accuracy.csv"]
     return targets + (accuracy if plan.has_ground_truth else [])
 
