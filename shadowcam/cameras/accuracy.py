@@ -25,6 +25,7 @@ redundancy_gain : RMSE ratio of the linear camera from a subset of sweeps over a
 SWEEP_GEOMETRY_TARGETS : tolerances of the measured sweep slant (deg) and speed (relative).
 sweep_geometry_errors : measured slant and speed of the extra sweeps against their declaration.
 sweep_geometry_targets : target rows (value, threshold, pass) of those errors.
+camera_grid_map : map from the ground truth's dual grid to a camera model's grid.
 """
 
 import math
@@ -261,3 +262,37 @@ def sweep_geometry_targets(errors):
                          "threshold": threshold, "comparison": "<=",
                          "pass": bool(value <= threshold)})
     return rows
+
+
+def camera_grid_map(attrs, *, truth_sweeps=("u", "v")):
+    """Map from the ground truth's dual grid to a camera model's dual grid, or None.
+
+    The ground truth's reciprocal render lies on the grid of the exact times of two sweeps
+    (``(t_a, t_b)`` of `truth_sweeps`, centre of column i at ``t_a = i``). The cross-slit
+    camera's grid is that pair of times; the linear camera's grid is the mask plane, where
+    each sweep's time is the exact affine function ``t_k = a_k u + b_k v + c_k``
+    (attr ``sweep_rows``), so the map is the inverse of the two sweeps' rows.
+
+    Parameters
+    ----------
+    attrs : mapping
+        Attributes of a dual-coordinates dataset of a camera model (``method``, ``sweeps``
+        and, for ``linear``, ``sweep_rows``).
+    truth_sweeps : (str, str)
+        The sweeps whose exact times span the ground truth's grid.
+
+    Returns
+    -------
+    (3, 3) float64 ndarray or None
+        Homography ``(t_a, t_b) -> (u, v)``; None for another model or when the camera
+        has not both sweeps.
+    """
+    method = attrs.get("method")
+    names = str(attrs.get("sweeps", "")).split()
+    if method == "cross_slit" and names == list(truth_sweeps):
+        return np.eye(3)
+    if method != "linear" or not all(s in names for s in truth_sweeps):
+        return None
+    rows = np.asarray(attrs["sweep_rows"], dtype=np.float64).reshape(len(names), 3)
+    to_times = np.vstack([rows[names.index(s)] for s in truth_sweeps] + [[0.0, 0.0, 1.0]])
+    return np.linalg.inv(to_times)

@@ -313,6 +313,10 @@ def _dual_grid_map(dual_coords, ground_truth):
         scale = np.asarray(attrs.get("scale", (1.0, 1.0)), dtype=np.float64)
         offset = np.asarray(attrs.get("offset", (0.0, 0.0)), dtype=np.float64)
         return np.array([[scale[0], 0, offset[0]], [0, scale[1], offset[1]], [0, 0, 1.0]])
+    if method not in ("uniform", "calibration"):  # a camera model's own grid
+        from shadowcam.cameras.accuracy import camera_grid_map
+
+        return camera_grid_map(attrs)
     needed = ("t_cal_u", "t_cal_v", "plane_xy")
     if method != "calibration" or not all(k in ground_truth for k in needed):
         return None

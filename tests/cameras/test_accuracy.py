@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from shadowcam.cameras.accuracy import (
     line_direction_spread,
@@ -114,3 +116,29 @@ def test_sweep_geometry_sees_a_wrong_speed_declaration():
     assert result["angle_error_deg"] == pytest.approx(expected, abs=1e-6)
     with pytest.raises(ValueError, match="at least three"):
         sweep_geometry_errors(times, wrong[:2], dual_shape=(48, 48))
+
+
+@given(angle=st.floats(20.0, 160.0), speed=st.floats(0.3, 3.0), v_speed=st.floats(0.3, 3.0))
+@settings(max_examples=40, deadline=None)
+def test_camera_grid_map_takes_the_truth_times_to_the_linear_grid(angle, speed, v_speed):
+    from shadowcam.cameras.accuracy import camera_grid_map
+    from shadowcam.cameras.models import declared_sweeps, sweep_rows
+
+    sweeps = declared_sweeps({"sweeps": [{"name": "u", "frames": 40},
+                                         {"name": "w", "angle_deg": angle, "speed": speed, "frames": 50},
+                                         {"name": "v", "angle_deg": 90, "speed": v_speed, "frames": 60}]})
+    rows = sweep_rows(sweeps, dual_shape=(30, 40))
+    u, v = np.meshgrid(np.linspace(-2, 41, 7), np.linspace(-1, 31, 5))
+    t = {s["name"]: r[0] * u + r[1] * v + r[2] for s, r in zip(sweeps, rows)}
+    grid = camera_grid_map({"method": "linear", "sweeps": "u w v", "sweep_rows": rows.ravel()})
+    mapped = grid @ np.stack([t["u"].ravel(), t["v"].ravel(), np.ones(u.size)])
+    np.testing.assert_allclose(mapped[:2] / mapped[2], [u.ravel(), v.ravel()], atol=1e-9)
+
+
+def test_camera_grid_map_of_other_cameras():
+    from shadowcam.cameras.accuracy import camera_grid_map
+
+    np.testing.assert_array_equal(camera_grid_map({"method": "cross_slit", "sweeps": "u v"}), np.eye(3))
+    assert camera_grid_map({"method": "cross_slit", "sweeps": "a b"}) is None
+    assert camera_grid_map({"method": "linear", "sweeps": "u w", "sweep_rows": np.zeros(6)}) is None
+    assert camera_grid_map({"method": "pushbroom", "sweeps": "u"}) is None
