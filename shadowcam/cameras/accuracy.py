@@ -26,6 +26,7 @@ SWEEP_GEOMETRY_TARGETS : tolerances of the measured sweep slant (deg) and speed 
 sweep_geometry_errors : measured slant and speed of the extra sweeps against their declaration.
 sweep_geometry_targets : target rows (value, threshold, pass) of those errors.
 camera_grid_map : map from the ground truth's dual grid to a camera model's grid.
+linear_redundancy : dual RMSE of the linear camera from all sweeps and from two, same pixels.
 """
 
 import math
@@ -296,3 +297,63 @@ def camera_grid_map(attrs, *, truth_sweeps=("u", "v")):
     rows = np.asarray(attrs["sweep_rows"], dtype=np.float64).reshape(len(names), 3)
     to_times = np.vstack([rows[names.index(s)] for s in truth_sweeps] + [[0.0, 0.0, 1.0]])
     return np.linalg.inv(to_times)
+
+
+def linear_redundancy(shadow_time, description, truth_times, *, pair=("u", "v"), dual_shape=None):
+    """Dual-coordinate RMSE of the linear camera from all its sweeps and from two of them.
+
+    Both estimates (:func:`shadowcam.cameras.models.camera_coords_from_shadow_time`, model
+    ``linear``) are scored against the exact coordinates on the same pixels (valid in both,
+    with exact times), so their ratio is the gain of the redundant sweeps.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``shadow_time (sweep, row, col)`` of every declared sweep.
+    description : mapping
+        Capture description with three or more sweeps.
+    truth_times : mapping of str to (rows, cols) ndarray
+        Exact shadow times of the sweeps of `pair` (NaN = none).
+    pair : (str, str)
+        The two sweeps of the smaller estimate; their exact times give the truth.
+    dual_shape : (int, int), optional
+        ``(N_v, N_u)``; default the linear camera's.
+
+    Returns
+    -------
+    dict
+        ``sweeps_all``, ``sweeps_two`` (names), ``rmse_all``, ``rmse_two`` (dual px),
+        ``n_pixels``, ``gain`` (``rmse_two / rmse_all``, > 1 when the redundancy lowers the
+        error) and ``reduction`` (``1 - rmse_all / rmse_two``).
+    """
+    from shadowcam.cameras.models import camera_coords_from_shadow_time
+
+    sweeps = list(description["sweeps"])
+    names = [s["name"] for s in sweeps]
+    if len(sweeps) < 3 or not all(p in names for p in pair):
+        raise ValueError(f"description.sweeps: needs three or more sweeps including {list(pair)}; "
+                         f"got {names}")
+    full = camera_coords_from_shadow_time(shadow_time, description, model="linear",
+                                          dual_shape=dual_shape)
+    shape = (int(full.attrs["dual_height"]), int(full.attrs["dual_width"]))
+    two = camera_coords_from_shadow_time(
+        shadow_time, {**description, "sweeps": [s for s in sweeps if s["name"] in pair]},
+        model="linear", dual_shape=shape)
+    grid = camera_grid_map(full.attrs, truth_sweeps=pair)
+    t_a, t_b = (np.asarray(truth_times[p], dtype=np.float64) for p in pair)
+    w = grid[2, 0] * t_a + grid[2, 1] * t_b + grid[2, 2]
+    true_u = (grid[0, 0] * t_a + grid[0, 1] * t_b + grid[0, 2]) / w
+    true_v = (grid[1, 0] * t_a + grid[1, 1] * t_b + grid[1, 2]) / w
+    keep = full["valid"].values & two["valid"].values & np.isfinite(true_u) & np.isfinite(true_v)
+    if not keep.any():
+        raise ValueError("truth_times: no pixel has exact times and coordinates from both estimates")
+
+    def rmse(coords):
+        du = coords["u"].values[keep] - true_u[keep]
+        dv = coords["v"].values[keep] - true_v[keep]
+        return float(np.sqrt(np.mean(du**2 + dv**2)))
+
+    rmse_all, rmse_two = rmse(full), rmse(two)
+    return {"sweeps_all": " ".join(names), "sweeps_two": " ".join(pair), "rmse_all": rmse_all,
+            "rmse_two": rmse_two, "n_pixels": int(keep.sum()), "gain": rmse_two / rmse_all,
+            "reduction": 1.0 - rmse_all / rmse_two}

@@ -43,9 +43,9 @@ def add_parser(subparsers, name):
     return parser
 
 
-def _add_sweep_geometry(report, manifest, shadow_time):
-    """Lab captures with more than two scene sweeps: their measured slant and speed."""
-    from shadowcam.cameras.accuracy import sweep_geometry_errors, sweep_geometry_targets
+def _add_sweep_geometry(report, manifest, shadow_time, gt):
+    """Lab captures with more than two scene sweeps: measured slant and speed, gain of the redundancy."""
+    from shadowcam.cameras.accuracy import linear_redundancy, sweep_geometry_errors, sweep_geometry_targets
     from shadowcam.io.capture_plan import capture_plan
 
     plan = capture_plan(manifest["manifest_path"])
@@ -55,6 +55,8 @@ def _add_sweep_geometry(report, manifest, shadow_time):
     n, grid = plan.n_frames(plan.scene_sweeps[0]), manifest.get("dual") or {}
     shape = (grid.get("height", n), grid.get("width", n))
     report["sweep_geometry"] = sweep_geometry_errors(times, list(plan.camera["sweeps"]), dual_shape=shape)
+    if plan.camera_model == "linear":
+        report["redundancy"] = linear_redundancy(shadow_time, plan.camera, {s: gt[f"t_{s}"].values for s in ("u", "v")})
     report["targets"] += sweep_geometry_targets(report["sweep_geometry"])
     report["all_targets_pass"] = all(t["pass"] for t in report["targets"])
 
@@ -77,7 +79,7 @@ def run(args):
                              dual_view=open_dataset(args.dual_view) if args.dual_view else None,
                              pushbroom=open_dataset(args.pushbroom) if args.pushbroom else None,
                              reference=reference_image(open_frames(args.reference)) if args.reference else None)
-    _add_sweep_geometry(report, manifest, open_dataset(args.shadow_time))
+    _add_sweep_geometry(report, manifest, open_dataset(args.shadow_time), gt)
     report.update(noise_source=source, dataset=manifest["name"],
                   inputs={str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view, args.pushbroom) if p},
                   ground_truth_sha256=gt.attrs.get("source_sha256", ""))

@@ -461,6 +461,9 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
         if grid_map is None:
             report["dual_image"] = {"skipped": "the ground truth cannot express this dual grid"}
         else:
+            if "intrinsics_affine" in dual_view.attrs:  # the view of chosen virtual intrinsics
+                affine = np.asarray(dual_view.attrs["intrinsics_affine"], dtype=np.float64).reshape(2, 3)
+                grid_map = np.vstack([affine, [0.0, 0.0, 1.0]]) @ grid_map
             reciprocal, visible = _reciprocal_on_grid(ground_truth, grid_map, image.shape[:2])
             report["dual_image"] = dual_image_errors(
                 image, dual_view["coverage"].values, reciprocal, dual_cam_visible=visible)

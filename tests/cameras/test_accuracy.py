@@ -142,3 +142,24 @@ def test_camera_grid_map_of_other_cameras():
     assert camera_grid_map({"method": "cross_slit", "sweeps": "a b"}) is None
     assert camera_grid_map({"method": "linear", "sweeps": "u w", "sweep_rows": np.zeros(6)}) is None
     assert camera_grid_map({"method": "pushbroom", "sweeps": "u"}) is None
+
+
+def test_redundant_sweeps_lower_the_dual_error_on_the_same_pixels(timed_capture):
+    from shadowcam.cameras.accuracy import linear_redundancy
+
+    description = {"scene": "tabletop", "seed": 3, "height": 40, "width": 40, "frames": 32,
+                   "sweeps": [{"name": "u"}, {"name": "v", "angle_deg": 90},
+                              {"name": "w", "angle_deg": 45, "speed": 1.0}]}
+    _, gt, shadow_time, _ = timed_capture(description, noise_std=0.02)
+    truth = {s: gt[f"t_{s}"].values for s in ("u", "v")}
+    found = linear_redundancy(shadow_time, description, truth)
+    assert found["sweeps_two"] == "u v" and found["n_pixels"] > 1000
+    # two sweeps: (u, v) are the times themselves; the third adds an independent equation
+    two = camera_coords_from_shadow_time(shadow_time, {**description, "sweeps": description["sweeps"][:2]},
+                                         model="linear")
+    keep = two["valid"].values & np.isfinite(truth["u"]) & np.isfinite(truth["v"])
+    direct = np.sqrt(np.mean((two["u"].values - truth["u"])[keep] ** 2 + (two["v"].values - truth["v"])[keep] ** 2))
+    assert found["rmse_two"] == pytest.approx(direct, rel=0.05)
+    assert found["gain"] > 1.0 and found["reduction"] == pytest.approx(1 - 1 / found["gain"])
+    with pytest.raises(ValueError, match="three or more"):
+        linear_redundancy(shadow_time, {**description, "sweeps": description["sweeps"][:2]}, truth)
