@@ -27,6 +27,9 @@ sweep_geometry_errors : measured slant and speed of the extra sweeps against the
 sweep_geometry_targets : target rows (value, threshold, pass) of those errors.
 camera_grid_map : map from the ground truth's dual grid to a camera model's grid.
 linear_redundancy : dual RMSE of the linear camera from all sweeps and from two, same pixels.
+DUAL_STRAIGHTNESS_TARGET : largest RMS deviation (dual px) of straight edges in the dual view.
+straightness_check : straightness of the ground truth's edges seen through optics, with its target.
+add_camera_checks : the camera-specific checks of a capture added to its accuracy report.
 """
 
 import math
@@ -357,3 +360,88 @@ def linear_redundancy(shadow_time, description, truth_times, *, pair=("u", "v"),
     return {"sweeps_all": " ".join(names), "sweeps_two": " ".join(pair), "rmse_all": rmse_all,
             "rmse_two": rmse_two, "n_pixels": int(keep.sum()), "gain": rmse_two / rmse_all,
             "reduction": 1.0 - rmse_all / rmse_two}
+
+
+#: largest RMS distance (dual px) of straight scene edges from their line in the dual view
+DUAL_STRAIGHTNESS_TARGET = 0.5
+
+
+def straightness_check(dual_coords, ground_truth, *, min_points=5):
+    """Straightness of the ground truth's straight edges seen through the optics, with its target.
+
+    Parameters
+    ----------
+    dual_coords : xarray.Dataset
+        ``u``, ``v`` over ``(row, col)``; attrs ``dual_height``, ``dual_width``.
+    ground_truth : xarray.Dataset
+        ``edge_camera_xy (edge_point, cam_xy)``, ``edge_label``, ``edge_lit``,
+        ``edge_through_optics`` (the renderer's edge points).
+    min_points : int
+        Edges with fewer points are not measured.
+
+    Returns
+    -------
+    report : dict or None
+        :func:`straightness_primal_dual` of the lit edge points seen through the optics;
+        None when the ground truth has no such points.
+    target : dict or None
+        ``dual_straightness_rms_px`` row (``value``, ``threshold``
+        :data:`DUAL_STRAIGHTNESS_TARGET`, ``comparison`` ``<=``, ``pass``).
+    """
+    if "edge_camera_xy" not in ground_truth:
+        return None, None
+    keep = ground_truth["edge_lit"].values & ground_truth["edge_through_optics"].values
+    if not keep.any():
+        return None, None
+    report = straightness_primal_dual(
+        dual_coords["u"].transpose("row", "col").values, dual_coords["v"].transpose("row", "col").values,
+        ground_truth["edge_camera_xy"].values[keep], ground_truth["edge_label"].values[keep],
+        min_points=min_points)
+    value = float(report["dual_rms"])
+    return report, {"target": "dual_straightness_rms_px", "sweep": None, "value": value,
+                    "threshold": DUAL_STRAIGHTNESS_TARGET, "comparison": "<=",
+                    "pass": bool(value <= DUAL_STRAIGHTNESS_TARGET)}
+
+
+def add_camera_checks(report, shadow_time, ground_truth, *, camera_model, description,
+                      dual_coords=None):
+    """Add the camera-specific checks of a lab capture to an accuracy report (in place).
+
+    * three or more scene sweeps: ``sweep_geometry`` (:func:`sweep_geometry_errors`, with
+      targets) and, for the linear camera, ``redundancy`` (:func:`linear_redundancy`);
+    * straight edges seen through optics in the ground truth: ``straightness``
+      (:func:`straightness_check`, with its target).
+
+    Parameters
+    ----------
+    report : dict
+        ``lab.accuracy.accuracy_report`` output (``targets``, ``all_targets_pass`` updated).
+    shadow_time, ground_truth : xarray.Dataset
+    camera_model : str
+        The capture plan's camera model.
+    description : mapping
+        The capture plan's capture description (``sweeps`` with ``frames``).
+    dual_coords : xarray.Dataset, optional
+
+    Returns
+    -------
+    dict
+        `report`.
+    """
+    sweeps = list(description.get("sweeps", ()))
+    if len(sweeps) >= 3:
+        times = {s["name"]: shadow_time["shadow_time"].sel(sweep=s["name"]).transpose("row", "col").values
+                 for s in sweeps}
+        n = int(sweeps[0]["frames"])
+        report["sweep_geometry"] = sweep_geometry_errors(times, sweeps, dual_shape=(n, n))
+        report["targets"] += sweep_geometry_targets(report["sweep_geometry"])
+        if camera_model == "linear":
+            report["redundancy"] = linear_redundancy(
+                shadow_time, description, {s: ground_truth[f"t_{s}"].values for s in ("u", "v")})
+    if dual_coords is not None:
+        found, target = straightness_check(dual_coords, ground_truth)
+        if found is not None:
+            report["straightness"] = found
+            report["targets"].append(target)
+    report["all_targets_pass"] = bool(report["targets"]) and all(t["pass"] for t in report["targets"])
+    return report

@@ -560,10 +560,20 @@ TABLE_ROWS = {
         "gain": ("dual view gain fitted to the reciprocal render", "1", 1.0),
         "n_mask": ("dual pixels in the GT valid mask", "dual px", 1.0),
     },
+    "straightness": {
+        "primal_rms": ("straight edges: RMS distance from their line, primal view", "px", 1.0),
+        "dual_rms": ("straight edges: RMS distance from their line, dual view", "dual px", 1.0),
+        "n_edges": ("straight edges measured", "edge", 1.0),
+    },
+    "redundancy": {
+        "rmse_two": ("dual coordinates RMSE from sweeps u, v alone", "dual px", 1.0),
+        "rmse_all": ("dual coordinates RMSE from all sweeps", "dual px", 1.0),
+        "reduction": ("dual coordinates RMSE lowered by the extra sweeps", "%", 100.0),
+    },
 }
-#: target name -> the report key it checks (per sweep of ``shadow_time``)
+#: target name -> the report key it checks (per sweep of ``shadow_time``; sweep None: a section)
 TARGET_KEYS = {"shadow_time_p95_frames": "p95", "shadow_time_coverage": "coverage",
-               "false_time_rate": "false_time_rate"}
+               "false_time_rate": "false_time_rate", "dual_straightness_rms_px": "dual_rms"}
 #: what the ground truth is (shown with the table)
 GROUND_TRUTH_DEFINITION = (
     "Ground truth: exact per-pixel shadow times t_u, t_v (frame at which the wire's shadow line "

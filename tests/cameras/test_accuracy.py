@@ -163,3 +163,29 @@ def test_redundant_sweeps_lower_the_dual_error_on_the_same_pixels(timed_capture)
     assert found["gain"] > 1.0 and found["reduction"] == pytest.approx(1 - 1 / found["gain"])
     with pytest.raises(ValueError, match="three or more"):
         linear_redundancy(shadow_time, {**description, "sweeps": description["sweeps"][:2]}, truth)
+
+
+def test_straightness_check_reads_the_ground_truth_edges_and_sets_its_target():
+    import xarray as xr
+
+    from shadowcam.cameras.accuracy import DUAL_STRAIGHTNESS_TARGET, add_camera_checks, straightness_check
+
+    v, u = np.mgrid[0:40, 0:40].astype(np.float64)
+    # primal bent: the camera sees the straight lines x = 10, 20, 30 along a parabola;
+    # the dual coordinates undo the bend exactly (u = x - bend(y))
+    rows = np.arange(2.0, 38.0)
+    bend = 0.01 * (rows - 20) ** 2
+    xy = np.concatenate([np.column_stack([x + bend, rows]) for x in (10, 20, 30)])
+    labels = np.repeat([0, 1, 2], len(rows))
+    coords = xr.Dataset({"u": (("row", "col"), u - 0.01 * (v - 20) ** 2), "v": (("row", "col"), v)})
+    gt = xr.Dataset({"edge_camera_xy": (("edge_point", "cam_xy"), xy), "edge_label": ("edge_point", labels),
+                     "edge_lit": ("edge_point", np.ones(len(xy), bool)),
+                     "edge_through_optics": ("edge_point", np.ones(len(xy), bool))})
+    found, target = straightness_check(coords, gt)
+    assert found["n_edges"] == 3 and found["primal_rms"] > 0.5 and found["dual_rms"] < 1e-2, found
+    assert target["threshold"] == DUAL_STRAIGHTNESS_TARGET and target["pass"]
+    assert straightness_check(coords, gt.drop_vars("edge_camera_xy")) == (None, None)
+    report = {"targets": [], "all_targets_pass": False}
+    add_camera_checks(report, None, gt, camera_model="perspective", description={"sweeps": []},
+                      dual_coords=coords)
+    assert report["straightness"] == found and report["all_targets_pass"]
