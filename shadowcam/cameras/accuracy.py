@@ -25,6 +25,11 @@ redundancy_gain : RMSE ratio of the linear camera from a subset of sweeps over a
 SWEEP_GEOMETRY_TARGETS : tolerances of the measured sweep slant (deg) and speed (relative).
 sweep_geometry_errors : measured slant and speed of the extra sweeps against their declaration.
 sweep_geometry_targets : target rows (value, threshold, pass) of those errors.
+camera_grid_map : map from the ground truth's dual grid to a camera model's grid.
+linear_redundancy : dual RMSE of the linear camera from all sweeps and from two, same pixels.
+DUAL_STRAIGHTNESS_TARGET : largest RMS deviation (dual px) of straight edges in the dual view.
+straightness_check : straightness of the ground truth's edges seen through optics, with its target.
+add_camera_checks : the camera-specific checks of a capture added to its accuracy report.
 """
 
 import math
@@ -261,3 +266,182 @@ def sweep_geometry_targets(errors):
                          "threshold": threshold, "comparison": "<=",
                          "pass": bool(value <= threshold)})
     return rows
+
+
+def camera_grid_map(attrs, *, truth_sweeps=("u", "v")):
+    """Map from the ground truth's dual grid to a camera model's dual grid, or None.
+
+    The ground truth's reciprocal render lies on the grid of the exact times of two sweeps
+    (``(t_a, t_b)`` of `truth_sweeps`, centre of column i at ``t_a = i``). The cross-slit
+    camera's grid is that pair of times; the linear camera's grid is the mask plane, where
+    each sweep's time is the exact affine function ``t_k = a_k u + b_k v + c_k``
+    (attr ``sweep_rows``), so the map is the inverse of the two sweeps' rows.
+
+    Parameters
+    ----------
+    attrs : mapping
+        Attributes of a dual-coordinates dataset of a camera model (``method``, ``sweeps``
+        and, for ``linear``, ``sweep_rows``).
+    truth_sweeps : (str, str)
+        The sweeps whose exact times span the ground truth's grid.
+
+    Returns
+    -------
+    (3, 3) float64 ndarray or None
+        Homography ``(t_a, t_b) -> (u, v)``; None for another model or when the camera
+        has not both sweeps.
+    """
+    method = attrs.get("method")
+    names = str(attrs.get("sweeps", "")).split()
+    if method == "cross_slit" and names == list(truth_sweeps):
+        return np.eye(3)
+    if method != "linear" or not all(s in names for s in truth_sweeps):
+        return None
+    rows = np.asarray(attrs["sweep_rows"], dtype=np.float64).reshape(len(names), 3)
+    to_times = np.vstack([rows[names.index(s)] for s in truth_sweeps] + [[0.0, 0.0, 1.0]])
+    return np.linalg.inv(to_times)
+
+
+def linear_redundancy(shadow_time, description, truth_times, *, pair=("u", "v"), dual_shape=None):
+    """Dual-coordinate RMSE of the linear camera from all its sweeps and from two of them.
+
+    Both estimates (:func:`shadowcam.cameras.models.camera_coords_from_shadow_time`, model
+    ``linear``) are scored against the exact coordinates on the same pixels (valid in both,
+    with exact times), so their ratio is the gain of the redundant sweeps.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``shadow_time (sweep, row, col)`` of every declared sweep.
+    description : mapping
+        Capture description with three or more sweeps.
+    truth_times : mapping of str to (rows, cols) ndarray
+        Exact shadow times of the sweeps of `pair` (NaN = none).
+    pair : (str, str)
+        The two sweeps of the smaller estimate; their exact times give the truth.
+    dual_shape : (int, int), optional
+        ``(N_v, N_u)``; default the linear camera's.
+
+    Returns
+    -------
+    dict
+        ``sweeps_all``, ``sweeps_two`` (names), ``rmse_all``, ``rmse_two`` (dual px),
+        ``n_pixels``, ``gain`` (``rmse_two / rmse_all``, > 1 when the redundancy lowers the
+        error) and ``reduction`` (``1 - rmse_all / rmse_two``).
+    """
+    from shadowcam.cameras.models import camera_coords_from_shadow_time
+
+    sweeps = list(description["sweeps"])
+    names = [s["name"] for s in sweeps]
+    if len(sweeps) < 3 or not all(p in names for p in pair):
+        raise ValueError(f"description.sweeps: needs three or more sweeps including {list(pair)}; "
+                         f"got {names}")
+    full = camera_coords_from_shadow_time(shadow_time, description, model="linear",
+                                          dual_shape=dual_shape)
+    shape = (int(full.attrs["dual_height"]), int(full.attrs["dual_width"]))
+    two = camera_coords_from_shadow_time(
+        shadow_time, {**description, "sweeps": [s for s in sweeps if s["name"] in pair]},
+        model="linear", dual_shape=shape)
+    grid = camera_grid_map(full.attrs, truth_sweeps=pair)
+    t_a, t_b = (np.asarray(truth_times[p], dtype=np.float64) for p in pair)
+    w = grid[2, 0] * t_a + grid[2, 1] * t_b + grid[2, 2]
+    true_u = (grid[0, 0] * t_a + grid[0, 1] * t_b + grid[0, 2]) / w
+    true_v = (grid[1, 0] * t_a + grid[1, 1] * t_b + grid[1, 2]) / w
+    keep = full["valid"].values & two["valid"].values & np.isfinite(true_u) & np.isfinite(true_v)
+    if not keep.any():
+        raise ValueError("truth_times: no pixel has exact times and coordinates from both estimates")
+
+    def rmse(coords):
+        du = coords["u"].values[keep] - true_u[keep]
+        dv = coords["v"].values[keep] - true_v[keep]
+        return float(np.sqrt(np.mean(du**2 + dv**2)))
+
+    rmse_all, rmse_two = rmse(full), rmse(two)
+    return {"sweeps_all": " ".join(names), "sweeps_two": " ".join(pair), "rmse_all": rmse_all,
+            "rmse_two": rmse_two, "n_pixels": int(keep.sum()), "gain": rmse_two / rmse_all,
+            "reduction": 1.0 - rmse_all / rmse_two}
+
+
+#: largest RMS distance (dual px) of straight scene edges from their line in the dual view
+DUAL_STRAIGHTNESS_TARGET = 0.5
+
+
+def straightness_check(dual_coords, ground_truth, *, min_points=5):
+    """Straightness of the ground truth's straight edges seen through the optics, with its target.
+
+    Parameters
+    ----------
+    dual_coords : xarray.Dataset
+        ``u``, ``v`` over ``(row, col)``; attrs ``dual_height``, ``dual_width``.
+    ground_truth : xarray.Dataset
+        ``edge_camera_xy (edge_point, cam_xy)``, ``edge_label``, ``edge_lit``,
+        ``edge_through_optics`` (the renderer's edge points).
+    min_points : int
+        Edges with fewer points are not measured.
+
+    Returns
+    -------
+    report : dict or None
+        :func:`straightness_primal_dual` of the lit edge points seen through the optics;
+        None when the ground truth has no such points.
+    target : dict or None
+        ``dual_straightness_rms_px`` row (``value``, ``threshold``
+        :data:`DUAL_STRAIGHTNESS_TARGET`, ``comparison`` ``<=``, ``pass``).
+    """
+    if "edge_camera_xy" not in ground_truth:
+        return None, None
+    keep = ground_truth["edge_lit"].values & ground_truth["edge_through_optics"].values
+    if not keep.any():
+        return None, None
+    report = straightness_primal_dual(
+        dual_coords["u"].transpose("row", "col").values, dual_coords["v"].transpose("row", "col").values,
+        ground_truth["edge_camera_xy"].values[keep], ground_truth["edge_label"].values[keep],
+        min_points=min_points)
+    value = float(report["dual_rms"])
+    return report, {"target": "dual_straightness_rms_px", "sweep": None, "value": value,
+                    "threshold": DUAL_STRAIGHTNESS_TARGET, "comparison": "<=",
+                    "pass": bool(value <= DUAL_STRAIGHTNESS_TARGET)}
+
+
+def add_camera_checks(report, shadow_time, ground_truth, *, camera_model, description,
+                      dual_coords=None):
+    """Add the camera-specific checks of a lab capture to an accuracy report (in place).
+
+    * three or more scene sweeps: ``sweep_geometry`` (:func:`sweep_geometry_errors`, with
+      targets) and, for the linear camera, ``redundancy`` (:func:`linear_redundancy`);
+    * straight edges seen through optics in the ground truth: ``straightness``
+      (:func:`straightness_check`, with its target).
+
+    Parameters
+    ----------
+    report : dict
+        ``lab.accuracy.accuracy_report`` output (``targets``, ``all_targets_pass`` updated).
+    shadow_time, ground_truth : xarray.Dataset
+    camera_model : str
+        The capture plan's camera model.
+    description : mapping
+        The capture plan's capture description (``sweeps`` with ``frames``).
+    dual_coords : xarray.Dataset, optional
+
+    Returns
+    -------
+    dict
+        `report`.
+    """
+    sweeps = list(description.get("sweeps", ()))
+    if len(sweeps) >= 3:
+        times = {s["name"]: shadow_time["shadow_time"].sel(sweep=s["name"]).transpose("row", "col").values
+                 for s in sweeps}
+        n = int(sweeps[0]["frames"])
+        report["sweep_geometry"] = sweep_geometry_errors(times, sweeps, dual_shape=(n, n))
+        report["targets"] += sweep_geometry_targets(report["sweep_geometry"])
+        if camera_model == "linear":
+            report["redundancy"] = linear_redundancy(
+                shadow_time, description, {s: ground_truth[f"t_{s}"].values for s in ("u", "v")})
+    if dual_coords is not None:
+        found, target = straightness_check(dual_coords, ground_truth)
+        if found is not None:
+            report["straightness"] = found
+            report["targets"].append(target)
+    report["all_targets_pass"] = bool(report["targets"]) and all(t["pass"] for t in report["targets"])
+    return report

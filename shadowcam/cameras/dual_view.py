@@ -345,7 +345,8 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     -------
     xarray.Dataset
         :func:`dual_view_dataset` with attrs ``colour_source``, ``dual_coords_model``,
-        ``resampling_seconds``.
+        ``resampling_seconds`` (and ``intrinsics_affine``, ``intrinsics`` of `coords` from
+        ``cameras.intrinsics.coords_to_intrinsics``).
 
     Raises
     ------
@@ -379,4 +380,7 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     dataset = dual_view_dataset(image, coverage, method=method, params=params, channels=channels)
     dataset.attrs.update(colour_source="reference" if reference is not None else "mean lit_image of u, v",
                          dual_coords_model=coords.attrs.get("model", ""), resampling_seconds=seconds)
+    for key in ("intrinsics_affine", "intrinsics"):  # the grid of chosen virtual intrinsics
+        if key in coords.attrs:
+            dataset.attrs[key] = coords.attrs[key]
     return dataset

@@ -20,6 +20,8 @@ intrinsics_affine : the 2 x 3 affine ``(u, v, 1) -> (x, y)`` and output shape of
 apply_affine : apply a 2 x 3 affine to coordinate maps.
 resample_to_intrinsics : the dual view resampled onto the chosen intrinsics.
 measure_skew_stretch : skew angle and stretch of virtual coordinates against metric ones.
+INTRINSICS_OPTIONS : keys of the virtual intrinsics (config ``dual_view.intrinsics``).
+coords_to_intrinsics : dual coordinates moved onto the output grid of chosen intrinsics.
 """
 
 import math
@@ -28,6 +30,9 @@ import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in_interval, check_positive
 from shadowcam.cameras.dual_view import resample_dual_view
+
+#: keys of the virtual intrinsics of the dual view (config ``dual_view.intrinsics``)
+INTRINSICS_OPTIONS = ("skew_deg", "aspect", "size")
 
 
 def intrinsics_affine(dual_shape, *, skew_deg=0.0, aspect=1.0, scale=1.0, shape=None):
@@ -154,3 +159,42 @@ def measure_skew_stretch(t_a, t_b, u, v, *, min_points=10):
     return {"skew_deg": 90.0 - math.degrees(math.acos(abs(cosine))), "stretch": norm_a / norm_b,
             "jacobian": jac, "residual_rms": float(np.sqrt(np.mean(residual**2))),
             "n_points": int(u.size)}
+
+
+def coords_to_intrinsics(coords, *, skew_deg=0.0, aspect=1.0, size=None):
+    """Dual coordinates moved onto the output grid of chosen virtual intrinsics.
+
+    The dual view resampled from the returned coordinates
+    (:func:`shadowcam.cameras.dual_view.dual_view_from_coords`) is the view of the chosen
+    intrinsics (:func:`intrinsics_affine` with ``scale`` 1).
+
+    Parameters
+    ----------
+    coords : xarray.Dataset
+        ``u``, ``v``, ``valid`` over ``(row, col)`` (metric dual pixels); attrs
+        ``dual_height``, ``dual_width``.
+    skew_deg, aspect : float, keyword-only
+        As :func:`intrinsics_affine`.
+    size : (int, int), optional
+        ``(height, width)`` of the output; default the bounding box of the mapped grid.
+
+    Returns
+    -------
+    xarray.Dataset
+        A copy with ``u``, ``v`` in output pixels; attrs ``dual_height``, ``dual_width`` of the
+        output, ``intrinsics_affine`` (the 2 x 3 affine, row-major) and ``intrinsics`` (text).
+    """
+    if size is not None and (np.ndim(size) != 1 or len(size) != 2):
+        raise ValueError(f"size must be (height, width); got {size!r}")
+    dual_shape = (int(coords.attrs["dual_height"]), int(coords.attrs["dual_width"]))
+    affine, shape = intrinsics_affine(dual_shape, skew_deg=skew_deg, aspect=aspect,
+                                      shape=None if size is None else tuple(size))
+    x, y = apply_affine(affine, coords["u"].values, coords["v"].values)
+    out = coords.copy()
+    out["u"] = out["u"].copy(data=x.astype(np.float32))
+    out["v"] = out["v"].copy(data=y.astype(np.float32))
+    out.attrs.update(dual_height=int(shape[0]), dual_width=int(shape[1]),
+                     intrinsics_affine=affine.ravel(),
+                     intrinsics=f"skew {skew_deg:g} deg, aspect {aspect:g}, "
+                                f"{shape[0]}x{shape[1]} px")
+    return out

@@ -45,15 +45,21 @@ estimate_sweep : a sweep's angle, speed and offset from its times and the u/v sw
 camera_perspective, camera_orthographic, camera_linear, camera_cross_slit, camera_pushbroom :
     the entries.
 camera_coords_from_shadow_time : shadow-time dataset + description -> dual-coordinates dataset.
+FRAME_INDEX_MODELS : cameras whose dual coordinates are the standard pair's frame indices.
+capture_dual_coords : the dual coordinates of a capture by its camera model (the step's front).
 """
 
+import inspect
 import math
 
 import numpy as np
 
+from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
 from shadowcam._shared.validation import check_array, check_in, check_positive
 from shadowcam.cameras.dual_coords import REASON_FLAGS as DUAL_REASON_FLAGS
-from shadowcam.cameras.dual_coords import dual_coords_dataset, dual_coords_uniform
+from shadowcam.cameras.dual_coords import (
+    dual_coords_dataset, dual_coords_from_shadow_time, dual_coords_uniform,
+)
 
 #: keys of a sweep declaration (a subset of the renderer's sweep specification keys)
 SWEEP_KEYS = ("name", "angle_deg", "motion_deg", "speed", "speed_scene", "frames",
@@ -655,3 +661,71 @@ def camera_coords_from_shadow_time(shadow_time, description, *, model="auto", du
                               flag_meanings=" ".join(REASON_FLAGS[k] for k in sorted(REASON_FLAGS)))
     return ds
 
+
+
+#: camera models whose dual coordinates are the frame indices of the standard pair
+#: (``dual_coords.dual_coords_uniform``, or the calibration plane when it is measured)
+FRAME_INDEX_MODELS = ("perspective", "orthographic")
+
+
+def capture_dual_coords(shadow_time, description, *, camera_model, dual_model="uniform",
+                        dual_width=None, dual_height=None, min_confidence=0.0,
+                        min_coverage=MIN_COVERAGE, **options):
+    """Dual coordinates of a capture by its camera model: the dual-coords step's front function.
+
+    The standard pair (``perspective`` / ``orthographic``) runs the dual-coordinate model
+    `dual_model` (:func:`shadowcam.cameras.dual_coords.dual_coords_from_shadow_time`:
+    frame index = dual coordinate, or the calibration plane); every other camera of
+    :data:`CAMERA_MODELS` (``linear``, ``cross_slit``, ``pushbroom``) runs its own model
+    (:func:`camera_coords_from_shadow_time`) on the camera's dual grid.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``shadow_time (sweep, row, col)``; attrs ``n_frames_<sweep>``.
+    description : mapping
+        The capture description (``CapturePlan.camera``: ``light``, ``sweeps``).
+    camera_model : str
+        A key of :data:`CAMERA_MODELS` (``CapturePlan.camera_model``).
+    dual_model : {"uniform", "calibration"}
+        Model of the standard pair (``CapturePlan.dual_model``).
+    dual_width, dual_height : int, optional
+        Dual grid size; default the camera's grid.
+    min_confidence : float
+        Shadow times of lower confidence count as missing.
+    min_coverage : float
+        Smallest fraction of the camera pixels that must get dual coordinates.
+    **options
+        Options of the model (those of the standard pair's model, e.g. ``scale``, are not
+        used by the other cameras).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``dual_coords.dual_coords_dataset``; attrs ``method`` (``uniform``, ``calibration``
+        or the camera model), ``model_choice``.
+
+    Raises
+    ------
+    ValueError
+        Unknown `camera_model`, or fewer than `min_coverage` of the pixels covered.
+    """
+    check_in(camera_model, "camera_model", tuple(CAMERA_MODELS))
+    if camera_model in FRAME_INDEX_MODELS:
+        return dual_coords_from_shadow_time(
+            shadow_time, method=dual_model, dual_width=dual_width, dual_height=dual_height,
+            min_confidence=min_confidence, min_coverage=min_coverage, **options)
+    shape = None if dual_width is None or dual_height is None else (int(dual_height), int(dual_width))
+    taken = inspect.signature(CAMERA_MODELS[camera_model]).parameters
+    ds = camera_coords_from_shadow_time(shadow_time, description, model=camera_model,
+                                        dual_shape=shape, min_confidence=min_confidence,
+                                        **{k: v for k, v in options.items() if k in taken})
+    check_coverage(int(ds["valid"].sum()), ds["valid"].size,
+                   what="camera pixels with dual coordinates",
+                   reasons={REASON_FLAGS[k]: int((ds["reason"].values == k).sum())
+                            for k in sorted(REASON_FLAGS) if k},
+                   hint="the shadow times leave these pixels out (see shadow_time's reason counts)",
+                   min_coverage=min_coverage)
+    ds.attrs["model_choice"] = (f"{camera_model} camera: chosen by the capture plan from the "
+                                f"sweep geometry (sweeps {ds.attrs['sweeps']})")
+    return ds

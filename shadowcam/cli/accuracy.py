@@ -43,25 +43,11 @@ def add_parser(subparsers, name):
     return parser
 
 
-def _add_sweep_geometry(report, manifest, shadow_time):
-    """Lab captures with more than two scene sweeps: their measured slant and speed."""
-    from shadowcam.cameras.accuracy import sweep_geometry_errors, sweep_geometry_targets
-    from shadowcam.io.capture_plan import capture_plan
-
-    plan = capture_plan(manifest["manifest_path"])
-    if plan.is_outdoor or len(plan.scene_sweeps) < 3:
-        return
-    times = {s: shadow_time["shadow_time"].sel(sweep=s).transpose("row", "col").values for s in plan.scene_sweeps}
-    n, grid = plan.n_frames(plan.scene_sweeps[0]), manifest.get("dual") or {}
-    shape = (grid.get("height", n), grid.get("width", n))
-    report["sweep_geometry"] = sweep_geometry_errors(times, list(plan.camera["sweeps"]), dual_shape=shape)
-    report["targets"] += sweep_geometry_targets(report["sweep_geometry"])
-    report["all_targets_pass"] = all(t["pass"] for t in report["targets"])
-
-
 def run(args):
     """Evaluate the products against the manifest's ground truth and write the report."""
+    from shadowcam.cameras.accuracy import add_camera_checks
     from shadowcam.cameras.dual_view import reference_image
+    from shadowcam.io.capture_plan import capture_plan
     from shadowcam.io.frame_store import open_frames
     from shadowcam.io.ground_truth import load_ground_truth
     from shadowcam.io.manifest import load_manifest
@@ -77,7 +63,11 @@ def run(args):
                              dual_view=open_dataset(args.dual_view) if args.dual_view else None,
                              pushbroom=open_dataset(args.pushbroom) if args.pushbroom else None,
                              reference=reference_image(open_frames(args.reference)) if args.reference else None)
-    _add_sweep_geometry(report, manifest, open_dataset(args.shadow_time))
+    plan = capture_plan(manifest["manifest_path"])
+    if not plan.is_outdoor:
+        add_camera_checks(report, open_dataset(args.shadow_time), gt, camera_model=plan.camera_model,
+                          description=plan.camera,
+                          dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None)
     report.update(noise_source=source, dataset=manifest["name"],
                   inputs={str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view, args.pushbroom) if p},
                   ground_truth_sha256=gt.attrs.get("source_sha256", ""))

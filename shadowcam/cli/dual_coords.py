@@ -2,7 +2,8 @@
 
 Reads ``shadow_time.nc`` (and, for the calibration-plane method, the
 manifest's ``calibration_plane`` homography and optional mask) and writes
-``results/<ds>/dual_coords.nc`` (:func:`shadowcam.cameras.dual_coords.dual_coords_from_shadow_time`).
+``results/<ds>/dual_coords.nc`` (:func:`shadowcam.cameras.models.capture_dual_coords`: the
+capture plan's camera model; the standard pair runs the dual-coordinate model).
 ``--model auto`` tests uniform motion against the calibration plane when the manifest
 has one and the calibration sweeps ``cal_u``, ``cal_v`` were timed, else assumes it.
 
@@ -23,9 +24,10 @@ from pathlib import Path
 from shadowcam._shared.coverage import MIN_COVERAGE
 from shadowcam.cameras.dual_coords import (
     CALIBRATION_OPTIONS, DUAL_COORD_METHODS, UNIFORM_OPTIONS, choose_dual_coords_method,
-    dual_coords_from_shadow_time,
 )
+from shadowcam.cameras.models import capture_dual_coords
 from shadowcam.cli.options import parse_params
+from shadowcam.io.capture_plan import capture_plan
 from shadowcam.io.datasets import open_dataset, write_dataset
 from shadowcam.io.images import read_image
 from shadowcam.io.manifest import load_manifest, verify_checksums
@@ -61,8 +63,9 @@ def run(args):
     if model == "calibration" and "mask" in plane:
         checksums.update(verify_checksums(manifest, ["calibration_plane"]))
         mask = read_image(Path(manifest["root"]) / manifest["files"]["calibration_plane"][0])[..., 0] > 0.5
-    dataset = dual_coords_from_shadow_time(
-        shadow_time, method=model, dual_width=params.get("dual_width", grid.get("width")),
+    plan = capture_plan(args.manifest, dual_model=model)
+    dataset = capture_dual_coords(
+        shadow_time, plan.camera, camera_model=plan.camera_model, dual_model=model, dual_width=params.get("dual_width", grid.get("width")),
         dual_height=params.get("dual_height", grid.get("height")),
         min_confidence=params.get("min_confidence", 0.0), min_coverage=params.get("min_coverage", MIN_COVERAGE),
         homography=plane.get("homography"), plane_mask=mask,

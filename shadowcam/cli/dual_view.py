@@ -20,6 +20,7 @@ run : resample and write the outputs.
 import logging
 
 from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS, dual_view_from_coords
+from shadowcam.cameras.intrinsics import INTRINSICS_OPTIONS, coords_to_intrinsics
 from shadowcam.cli.options import parse_params
 from shadowcam.io.datasets import open_dataset, write_dataset
 from shadowcam.io.frame_store import open_frames
@@ -39,6 +40,8 @@ def add_parser(subparsers, name):
                         help="resampling onto the dual grid (default mesh)")
     parser.add_argument("--params", default="{}",
                         help="JSON method options: mesh: max_edge; idw: k, radius, power")
+    parser.add_argument("--intrinsics", default="{}",
+                        help="JSON virtual intrinsics of the output: skew_deg, aspect, size [height, width]")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/dual_view.nc")
     parser.add_argument("--exr", default=None, help="linear float EXR of the dual view")
     parser.add_argument("--png", default=None, help="8-bit sRGB preview PNG")
@@ -48,12 +51,15 @@ def add_parser(subparsers, name):
 def run(args):
     """Resample the camera colours into the dual grid and write the outputs."""
     params = parse_params(args.params)
+    intrinsics = parse_params(args.intrinsics, allowed=set(INTRINSICS_OPTIONS))
     coords, shadow_time = open_dataset(args.dual_coords), open_dataset(args.shadow_time)
+    if intrinsics:
+        coords = coords_to_intrinsics(coords, **intrinsics)
     reference = open_frames(args.reference) if args.reference else None
     dataset = dual_view_from_coords(coords, shadow_time, reference=reference, method=args.method, **params)
     inputs = (coords, shadow_time) + ((reference,) if reference is not None else ())
     checksums = {str(path): file_sha256(path) for path in (args.dual_coords, args.shadow_time)}
-    write_dataset(dataset, args.out, config={"method": args.method, **params, "reference": bool(args.reference)},
+    write_dataset(dataset, args.out, config={"method": args.method, **params, **({"intrinsics": intrinsics} if intrinsics else {}), "reference": bool(args.reference)},
                   inputs=inputs, checksums=checksums, step="dual-view")
     image = dataset["dual_view"].values
     if args.exr:

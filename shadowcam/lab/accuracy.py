@@ -313,6 +313,10 @@ def _dual_grid_map(dual_coords, ground_truth):
         scale = np.asarray(attrs.get("scale", (1.0, 1.0)), dtype=np.float64)
         offset = np.asarray(attrs.get("offset", (0.0, 0.0)), dtype=np.float64)
         return np.array([[scale[0], 0, offset[0]], [0, scale[1], offset[1]], [0, 0, 1.0]])
+    if method not in ("uniform", "calibration"):  # a camera model's own grid
+        from shadowcam.cameras.accuracy import camera_grid_map
+
+        return camera_grid_map(attrs)
     needed = ("t_cal_u", "t_cal_v", "plane_xy")
     if method != "calibration" or not all(k in ground_truth for k in needed):
         return None
@@ -457,6 +461,9 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
         if grid_map is None:
             report["dual_image"] = {"skipped": "the ground truth cannot express this dual grid"}
         else:
+            if "intrinsics_affine" in dual_view.attrs:  # the view of chosen virtual intrinsics
+                affine = np.asarray(dual_view.attrs["intrinsics_affine"], dtype=np.float64).reshape(2, 3)
+                grid_map = np.vstack([affine, [0.0, 0.0, 1.0]]) @ grid_map
             reciprocal, visible = _reciprocal_on_grid(ground_truth, grid_map, image.shape[:2])
             report["dual_image"] = dual_image_errors(
                 image, dual_view["coverage"].values, reciprocal, dual_cam_visible=visible)
@@ -553,10 +560,20 @@ TABLE_ROWS = {
         "gain": ("dual view gain fitted to the reciprocal render", "1", 1.0),
         "n_mask": ("dual pixels in the GT valid mask", "dual px", 1.0),
     },
+    "straightness": {
+        "primal_rms": ("straight edges: RMS distance from their line, primal view", "px", 1.0),
+        "dual_rms": ("straight edges: RMS distance from their line, dual view", "dual px", 1.0),
+        "n_edges": ("straight edges measured", "edge", 1.0),
+    },
+    "redundancy": {
+        "rmse_two": ("dual coordinates RMSE from sweeps u, v alone", "dual px", 1.0),
+        "rmse_all": ("dual coordinates RMSE from all sweeps", "dual px", 1.0),
+        "reduction": ("dual coordinates RMSE lowered by the extra sweeps", "%", 100.0),
+    },
 }
-#: target name -> the report key it checks (per sweep of ``shadow_time``)
+#: target name -> the report key it checks (per sweep of ``shadow_time``; sweep None: a section)
 TARGET_KEYS = {"shadow_time_p95_frames": "p95", "shadow_time_coverage": "coverage",
-               "false_time_rate": "false_time_rate"}
+               "false_time_rate": "false_time_rate", "dual_straightness_rms_px": "dual_rms"}
 #: what the ground truth is (shown with the table)
 GROUND_TRUTH_DEFINITION = (
     "Ground truth: exact per-pixel shadow times t_u, t_v (frame at which the wire's shadow line "

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from shadowcam.cameras.accuracy import (
     line_direction_spread,
@@ -114,3 +116,76 @@ def test_sweep_geometry_sees_a_wrong_speed_declaration():
     assert result["angle_error_deg"] == pytest.approx(expected, abs=1e-6)
     with pytest.raises(ValueError, match="at least three"):
         sweep_geometry_errors(times, wrong[:2], dual_shape=(48, 48))
+
+
+@given(angle=st.floats(20.0, 160.0), speed=st.floats(0.3, 3.0), v_speed=st.floats(0.3, 3.0))
+@settings(max_examples=40, deadline=None)
+def test_camera_grid_map_takes_the_truth_times_to_the_linear_grid(angle, speed, v_speed):
+    from shadowcam.cameras.accuracy import camera_grid_map
+    from shadowcam.cameras.models import declared_sweeps, sweep_rows
+
+    sweeps = declared_sweeps({"sweeps": [{"name": "u", "frames": 40},
+                                         {"name": "w", "angle_deg": angle, "speed": speed, "frames": 50},
+                                         {"name": "v", "angle_deg": 90, "speed": v_speed, "frames": 60}]})
+    rows = sweep_rows(sweeps, dual_shape=(30, 40))
+    u, v = np.meshgrid(np.linspace(-2, 41, 7), np.linspace(-1, 31, 5))
+    t = {s["name"]: r[0] * u + r[1] * v + r[2] for s, r in zip(sweeps, rows)}
+    grid = camera_grid_map({"method": "linear", "sweeps": "u w v", "sweep_rows": rows.ravel()})
+    mapped = grid @ np.stack([t["u"].ravel(), t["v"].ravel(), np.ones(u.size)])
+    np.testing.assert_allclose(mapped[:2] / mapped[2], [u.ravel(), v.ravel()], atol=1e-9)
+
+
+def test_camera_grid_map_of_other_cameras():
+    from shadowcam.cameras.accuracy import camera_grid_map
+
+    np.testing.assert_array_equal(camera_grid_map({"method": "cross_slit", "sweeps": "u v"}), np.eye(3))
+    assert camera_grid_map({"method": "cross_slit", "sweeps": "a b"}) is None
+    assert camera_grid_map({"method": "linear", "sweeps": "u w", "sweep_rows": np.zeros(6)}) is None
+    assert camera_grid_map({"method": "pushbroom", "sweeps": "u"}) is None
+
+
+def test_redundant_sweeps_lower_the_dual_error_on_the_same_pixels(timed_capture):
+    from shadowcam.cameras.accuracy import linear_redundancy
+
+    description = {"scene": "tabletop", "seed": 3, "height": 40, "width": 40, "frames": 32,
+                   "sweeps": [{"name": "u"}, {"name": "v", "angle_deg": 90},
+                              {"name": "w", "angle_deg": 45, "speed": 1.0}]}
+    _, gt, shadow_time, _ = timed_capture(description, noise_std=0.02)
+    truth = {s: gt[f"t_{s}"].values for s in ("u", "v")}
+    found = linear_redundancy(shadow_time, description, truth)
+    assert found["sweeps_two"] == "u v" and found["n_pixels"] > 1000
+    # two sweeps: (u, v) are the times themselves; the third adds an independent equation
+    two = camera_coords_from_shadow_time(shadow_time, {**description, "sweeps": description["sweeps"][:2]},
+                                         model="linear")
+    keep = two["valid"].values & np.isfinite(truth["u"]) & np.isfinite(truth["v"])
+    direct = np.sqrt(np.mean((two["u"].values - truth["u"])[keep] ** 2 + (two["v"].values - truth["v"])[keep] ** 2))
+    assert found["rmse_two"] == pytest.approx(direct, rel=0.05)
+    assert found["gain"] > 1.0 and found["reduction"] == pytest.approx(1 - 1 / found["gain"])
+    with pytest.raises(ValueError, match="three or more"):
+        linear_redundancy(shadow_time, {**description, "sweeps": description["sweeps"][:2]}, truth)
+
+
+def test_straightness_check_reads_the_ground_truth_edges_and_sets_its_target():
+    import xarray as xr
+
+    from shadowcam.cameras.accuracy import DUAL_STRAIGHTNESS_TARGET, add_camera_checks, straightness_check
+
+    v, u = np.mgrid[0:40, 0:40].astype(np.float64)
+    # primal bent: the camera sees the straight lines x = 10, 20, 30 along a parabola;
+    # the dual coordinates undo the bend exactly (u = x - bend(y))
+    rows = np.arange(2.0, 38.0)
+    bend = 0.01 * (rows - 20) ** 2
+    xy = np.concatenate([np.column_stack([x + bend, rows]) for x in (10, 20, 30)])
+    labels = np.repeat([0, 1, 2], len(rows))
+    coords = xr.Dataset({"u": (("row", "col"), u - 0.01 * (v - 20) ** 2), "v": (("row", "col"), v)})
+    gt = xr.Dataset({"edge_camera_xy": (("edge_point", "cam_xy"), xy), "edge_label": ("edge_point", labels),
+                     "edge_lit": ("edge_point", np.ones(len(xy), bool)),
+                     "edge_through_optics": ("edge_point", np.ones(len(xy), bool))})
+    found, target = straightness_check(coords, gt)
+    assert found["n_edges"] == 3 and found["primal_rms"] > 0.5 and found["dual_rms"] < 1e-2, found
+    assert target["threshold"] == DUAL_STRAIGHTNESS_TARGET and target["pass"]
+    assert straightness_check(coords, gt.drop_vars("edge_camera_xy")) == (None, None)
+    report = {"targets": [], "all_targets_pass": False}
+    add_camera_checks(report, None, gt, camera_model="perspective", description={"sweeps": []},
+                      dual_coords=coords)
+    assert report["straightness"] == found and report["all_targets_pass"]

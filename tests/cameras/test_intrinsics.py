@@ -62,3 +62,32 @@ def test_dual_view_resampled_to_chosen_intrinsics(timed_capture):
 def test_bad_intrinsics_are_refused(options, message):
     with pytest.raises(ValueError, match=message):
         intrinsics_affine((8, 8), **options)
+
+
+def test_coords_on_chosen_intrinsics_map_the_grid_corners_exactly():
+    import xarray as xr
+
+    from shadowcam.cameras.dual_coords import dual_coords_dataset
+    from shadowcam.cameras.intrinsics import coords_to_intrinsics
+
+    v, u = np.mgrid[0:20, 0:30].astype(np.float64)
+    coords = dual_coords_dataset(u, v, np.ones(u.shape, bool), method="linear",
+                                 info={"model": "linear", "dual_height": 20, "dual_width": 30})
+    out = coords_to_intrinsics(coords, skew_deg=30.0, aspect=2.0)
+    t = np.tan(np.radians(30.0))
+    # bounding box of the mapped grid: width 30 + 20 tan(30), height 2 x 20
+    assert (out.attrs["dual_height"], out.attrs["dual_width"]) == (40, int(np.ceil(30 + 20 * t)))
+    x, y = out["u"].values, out["v"].values
+    # column axis leans by the skew, rows stretched by the aspect, grid centred
+    np.testing.assert_allclose(x[5, 7] - x[4, 7], t, atol=1e-5)
+    np.testing.assert_allclose(x[4, 8] - x[4, 7], 1.0, atol=1e-5)
+    np.testing.assert_allclose(y[5, 7] - y[4, 7], 2.0, atol=1e-5)
+    np.testing.assert_allclose((x.min() + x.max()) / 2, (out.attrs["dual_width"] - 1) / 2, atol=1e-4)
+    np.testing.assert_allclose((y.min() + y.max()) / 2, (40 - 1) / 2, atol=1e-4)
+    assert isinstance(out, xr.Dataset) and out.attrs["intrinsics_affine"].shape == (6,)
+    sized = coords_to_intrinsics(coords, size=(24, 36))
+    assert (sized.attrs["dual_height"], sized.attrs["dual_width"]) == (24, 36)
+    with pytest.raises(ValueError, match="skew_deg"):
+        coords_to_intrinsics(coords, skew_deg=85.0)
+    with pytest.raises(ValueError, match="size"):
+        coords_to_intrinsics(coords, size=(24,))

@@ -214,3 +214,24 @@ def test_frames_to_cross_the_dual_field(shape, angle, speed, expected):
 def test_frames_to_cross_needs_a_positive_speed():
     with pytest.raises(ValueError, match="speed"):
         frames_to_cross((20, 20), 0.0, 0.0)
+
+
+def test_capture_front_runs_the_plans_camera_model(timed_capture):
+    from shadowcam.cameras.dual_coords import dual_coords_from_shadow_time
+    from shadowcam.cameras.models import capture_dual_coords
+
+    _, gt, shadow_time, _ = timed_capture({**SIZE, "sweeps": SLANTED})
+    description = {"light": "point", "sweeps": SLANTED}
+    linear = capture_dual_coords(shadow_time, description, camera_model="linear")
+    assert linear.attrs["method"] == "linear" and "linear camera" in linear.attrs["model_choice"]
+    direct = camera_coords_from_shadow_time(shadow_time, description, model="linear")
+    np.testing.assert_array_equal(linear["u"].values, direct["u"].values)
+    # the standard pair keeps the dual-coordinate model (frame index = dual coordinate)
+    standard = capture_dual_coords(shadow_time, {"sweeps": STANDARD}, camera_model="perspective")
+    uniform = dual_coords_from_shadow_time(shadow_time, method="uniform")
+    assert standard.attrs["method"] == "uniform"
+    np.testing.assert_array_equal(standard["v"].values, uniform["v"].values)
+    with pytest.raises(ValueError, match="camera_model"):
+        capture_dual_coords(shadow_time, description, camera_model="fisheye")
+    with pytest.raises(ValueError, match="min_coverage"):
+        capture_dual_coords(shadow_time, description, camera_model="linear", min_coverage=1.0)

@@ -297,3 +297,23 @@ def test_open_shutter_makes_the_sampled_dip_centroid_the_shadow_time():
         assert errors[1.0] < 0.01 < 0.1 < errors[0.0], errors
     with pytest.raises(ValueError, match="shutter"):
         sweep_frames(capture._paths["u"], scene.sweeps["u"], scene.mask, shutter=1.5)
+
+
+def test_ground_truth_carries_the_straight_edge_points_of_a_squares_plane():
+    from shadowcam.synthetic.lab.edges import square_edge_points
+    from shadowcam.synthetic.lab.scenes import scene_from_description
+
+    description = {"scene": "tabletop_squares", "seed": 0, "height": 32, "width": 32, "frames": 16}
+    scene = scene_from_description(description)
+    gt = prepare_capture(scene, supersample=1, calibration=False).ground_truth
+    edges = square_edge_points(scene)
+    assert gt.sizes["edge_point"] == len(edges.label) > 20
+    np.testing.assert_allclose(gt["edge_camera_xy"].values, edges.camera_xy, atol=1e-5)
+    # without optics the camera sees every edge point directly, on the camera's pixel grid
+    assert not gt["edge_through_optics"].values.any()
+    xy = gt["edge_camera_xy"].values
+    assert np.all((xy >= -0.5) & (xy <= 31.5))
+    # a point on an edge of constant plane x sits on a pixel-centre row (and vice versa)
+    on_row = np.isclose(xy[:, 1], np.round(xy[:, 1]), atol=1e-6)
+    on_col = np.isclose(xy[:, 0], np.round(xy[:, 0]), atol=1e-6)
+    assert np.all(on_row | on_col)

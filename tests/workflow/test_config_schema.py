@@ -12,6 +12,7 @@ import yaml
 
 from shadowcam.cameras.dual_coords import CALIBRATION_OPTIONS, DUAL_COORD_MODELS, UNIFORM_OPTIONS
 from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS
+from shadowcam.cameras.intrinsics import INTRINSICS_OPTIONS, coords_to_intrinsics
 from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, classify_dips
 
 
@@ -44,6 +45,8 @@ def test_params_blocks_name_the_library_options(schema):
     assert set(_block(schema, "dual_view", "method")["enum"]) == set(DUAL_VIEW_METHODS)
     resampling = set().union(*(_options(f, skip=("valid", "shape", "eps")) for f in DUAL_VIEW_METHODS.values()))
     assert set(_block(schema, "dual_view", "params")["properties"]) == resampling
+    assert set(_block(schema, "dual_view", "intrinsics")["properties"]) == set(INTRINSICS_OPTIONS)
+    assert _options(coords_to_intrinsics) == set(INTRINSICS_OPTIONS)
 
 
 def _errors(schema, doc):
@@ -59,6 +62,7 @@ def _errors(schema, doc):
      "dual_coords.params.min_confidence: 5 is greater than the maximum of 1"),
     ({"dual_view": {"params": {"max_edge": "long"}}}, "dual_view.params.max_edge: 'long' is not of type"),
     ({"min_coverage": 2}, "min_coverage: 2 is greater than the maximum of 1"),
+    ({"dual_view": {"intrinsics": {"skew": 10}}}, "dual_view.intrinsics: Additional properties"),
 ])
 def test_a_wrong_option_names_its_key(schema, doc, expected):
     errors = _errors(schema, {"datasets": ["synthetic_tiny"], **doc})

@@ -59,3 +59,13 @@ def test_every_shadow_camera_runs_from_its_manifest_to_accuracy(tmp_path, workfl
     rows = {t["target"]: t for t in report["targets"] if t["sweep"] == "s"}
     assert rows["sweep_angle_error_deg"]["value"] <= 0.5 and rows["sweep_angle_error_deg"]["pass"]
     assert rows["sweep_speed_rel_error"]["value"] <= 0.01 and rows["sweep_speed_rel_error"]["pass"]
+    # the linear camera's own grid (48 x 48 mask plane): its dual RMSE and the gain of sweep s
+    coords_model = report["dual_model"]["model"]
+    assert coords_model == "linear" and report["dual_coords"]["rmse"] <= 0.3, report["dual_coords"]
+    redundancy = report["redundancy"]
+    assert redundancy["sweeps_two"] == "u v" and redundancy["rmse_all"] <= redundancy["rmse_two"]
+    # straight squares' edges seen through the mirror / glass: dual view <= 0.5 px RMS
+    for ds in ("synthetic_mirror", "synthetic_glass"):
+        report = json.loads((Path(workdir) / "results" / ds / "accuracy.json").read_text())
+        row = next(t for t in report["targets"] if t["target"] == "dual_straightness_rms_px")
+        assert report["straightness"]["n_edges"] >= 6 and row["value"] <= 0.5 and row["pass"], ds

@@ -50,7 +50,9 @@ rule dual_view:
         options=as_json(
             {**config["dual_view"]["params"], "min_coverage": config["min_coverage"]}
         ),
+        intrinsics=as_json(config["dual_view"]["intrinsics"]),
     shell:
         "shadowcam dual-view --dual-coords {input.dual_coords} --shadow-time {input.shadow_time}"
         " {params.reference} --method {params.method} --params {params.options:q}"
-        " --out {output.nc} --exr {output.exr} --png {output.png} > {log} 2>&1"
+        " --intrinsics {params.intrinsics:q} --out {output.nc} --exr {output.exr}"
+        " --png {output.png} > {log} 2>&1"

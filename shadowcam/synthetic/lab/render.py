@@ -550,6 +550,31 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(),
             "dual_cam_xy": cam_xy.reshape(*shape, 2)}
 
 
+def _edge_point_truth(scene):
+    """GT variables of the exact points on the back plane's square edges (``edges``), if any.
+
+    Straight scene edges measure the straightness of the primal and dual views
+    (``cameras.accuracy.straightness_primal_dual``); only a back plane with a ``squares``
+    texture has them.
+    """
+    from shadowcam.synthetic.lab.edges import square_edge_points
+
+    plane = getattr(scene, "back_plane", None)
+    texture = getattr(getattr(plane, "material", None), "texture", None)
+    if getattr(texture, "kind", None) != "squares":
+        return {}
+    edges = square_edge_points(scene)
+    dims = ("edge_point",)
+    return {
+        "edge_camera_xy": (dims + ("cam_xy",), edges.camera_xy.astype(np.float32), "pixel",
+                           "camera (col, row) pixel-centre index of a point on a straight edge"),
+        "edge_label": (dims, edges.label, "1", "straight world line of the edge point"),
+        "edge_lit": (dims, edges.lit, "1", "edge point faces the light and sees its centre"),
+        "edge_through_optics": (dims, edges.through_optics, "1",
+                                "the camera sees the edge point through an optical element"),
+    }
+
+
 def _light_attrs(light):
     light_d = {"type": type(light).__name__}
     for key in ("position", "direction", "intensity", "irradiance", "normal", "size", "shape"):
@@ -731,6 +756,7 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
     data.update({f"lit_{n}": (rc, gt[f"lit_{n}"], "1",
                               f"pixel-centre point faces the light of sweep {n}, light visible")
                  for n in names if f"lit_{n}" in gt})
+    data.update(_edge_point_truth(scene))
     homography = None
     if calibration:
         cal = calibration_scene(scene)
