@@ -308,4 +308,4 @@ def far_field(ray_set, *, c_step_deg=15.0, gamma_step_deg=1.0):
     widest = float(np.degrees(np.arctan(np.nanmax(np.hypot(d[..., 0], d[..., 1]) / d[..., 2]))))
     gamma = np.arange(0.0, min(np.floor(widest), 89.0) + gamma_step_deg / 2, gamma_step_deg)
     c = np.arange(0.0, 360.0 - c_step_deg / 2, c_step_deg)
-    return far_field_table(ray_set, vertical_angles=gamma, horizontal_angles=c, bin_deg=gamma_step_deg)
+    return far_field_table(ray_set, vertical_angles=gamma, horizontal_angles=c)
