@@ -2,9 +2,13 @@
 
 For each render position: relative RMSE after one gain fit of the render and of the
 naive baseline (the nearest captured screen rescaled by inverse square and
-magnification), their ratio (target <= 0.5) and the correlation of the DoG(1, 4 px)
-band-passed render and truth (target >= 0.9); the far field's median relative error
-over directions above 5 % of the peak (target 5 %); the fraction of pixels with a ray
+magnification), their ratio (target <= 0.5), the correlation of the DoG(1, 4 px)
+band-passed render and truth (target >= 0.9) and the relative RMSE of the band-passed
+images (the ring pattern's fine structure; the render's below the baseline's); the far
+field of the rays on the equal-area direction chart at the capture's angular resolution
+(near + far camera pitch over the screen separation) against the true intensity
+integrated over the same cells: median relative error over cells above 5 % of the peak
+(target 5 %); the fraction of pixels with a ray
 (:func:`shadowcam.lightfield.accuracy.lightfield_accuracy`). Writes JSON and a quantity table CSV.
 
 Example::
@@ -14,7 +18,6 @@ Example::
         --sweeps results/synthetic_lightfield/lightfield/shadow_times/*.nc \\
         --rays results/synthetic_lightfield/lightfield/rays.nc \\
         --renders results/synthetic_lightfield/lightfield/renders.nc \\
-        --table results/synthetic_lightfield/lightfield/far_field.nc \\
         --json results/synthetic_lightfield/lightfield/accuracy.json \\
         --csv results/synthetic_lightfield/lightfield/accuracy.csv
 
@@ -33,6 +36,7 @@ from shadowcam.io.capture_plan import capture_plan
 from shadowcam.io.datasets import open_dataset
 from shadowcam.io.manifest import load_manifest
 from shadowcam.lightfield.accuracy import accuracy_rows, lightfield_accuracy
+from shadowcam.lightfield.photometry_export import far_field_grid, rays_resolution_deg
 from shadowcam.lightfield.stages import read_description, screen_maps
 from shadowcam.synthetic.lightfield.capture import capture_from_plan
 
@@ -43,7 +47,6 @@ def add_parser(subparsers, name):
     for option, text in (("manifest", "data_manifest/<ds>.yaml (rendered, kind lightfield)"),
                          ("capture", "capture folder with capture.json"), ("rays", "rays netCDF of lightfield-rays"),
                          ("renders", "renders netCDF of lightfield-render (lux)"),
-                         ("table", "candela table netCDF of lightfield-export (cd)"),
                          ("json", "output JSON of the scores"), ("csv", "output quantity table CSV")):
         parser.add_argument(f"--{option}", required=True, help=text)
     parser.add_argument("--sweeps", nargs="+", required=True, help="<screen>_<h|v>.nc of lightfield-shadow-times")
@@ -54,13 +57,14 @@ def run(args):
     """Score the light field against the renderer's ground truth."""
     source = capture_from_plan(capture_plan(args.manifest), load_manifest(args.manifest)["synthetic"]).source
     sweeps = {tuple(Path(p).stem.rsplit("_", 1)): open_dataset(p) for p in args.sweeps}
-    table = open_dataset(args.table)["intensity"]
-    far_truth = source.far_field(table["gamma"].values[None, :], table["C"].values[:, None],
-                                 bin_deg=float(table.attrs.get("bin_deg", 1.0)))
+    ray_set = open_dataset(args.rays)
+    far = far_field_grid(ray_set["direction"].values, ray_set["flux"].values,
+                         resolution_deg=rays_resolution_deg(ray_set))
+    far_truth = source.far_field_grid(resolution_deg=far.attrs["resolution_deg"], size=far.shape[0]).values
     scores = lightfield_accuracy(
-        open_dataset(args.renders), table.values, screen_maps(sweeps, read_description(args.capture)),
+        open_dataset(args.renders), far, screen_maps(sweeps, read_description(args.capture)),
         lambda z, shape, pitch: source.irradiance(centre=(0.0, 0.0, z), shape=shape, pixel_size=pitch),
-        far_truth=far_truth, flags=open_dataset(args.rays)["flag"].values)
+        far_truth=far_truth, flags=ray_set["flag"].values)
     with atomic_path(args.json) as tmp:
         tmp.write_text(json.dumps(scores, indent=1))
     with atomic_path(args.csv) as tmp:

@@ -60,7 +60,7 @@ def run(args):
                   for z, p in zip(renders["position"].values, renders["pixel_size"].values)]
         figures["renders"] = lf.renders_figure(renders["irradiance"].values, truths, renders["position"].values)
         gamma, c = table["gamma"].values, table["C"].values
-        far_truth = source.far_field(gamma[None, :], c[:, None], bin_deg=float(table.attrs.get("bin_deg", 1.0)))
+        far_truth = source.far_field(gamma[None, :], c[:, None], resolution_deg=float(table.attrs["resolution_deg"]))
         figures["far_field"] = lf.far_field_figure(gamma, c, table.values, far_truth)
     with atomic_directory(args.outdir) as tmp:
         for name, figure in figures.items():

@@ -1,15 +1,24 @@
-"""The source's far-field candela table and its IES LM-63-2002 and EULUMDAT files.
+"""The source's far field (intensity over directions), its candela table and IES / EULUMDAT files.
 
-The far field is the rays' flux per solid angle: the flux-conserving rendering
-(:func:`shadowcam.lightfield.render.irradiance_on_plane`) on a plane far beyond the
-source, whose grid is a tangent-plane grid of directions (pitch ``tan(bin)``); a bin's
-solid angle is ``pitch**2 * cos(theta)**3``. Angles follow photometric type C with the
-source's optical axis (+z) as nadir: vertical angle ``gamma`` (= theta) from the axis,
-horizontal angle ``C`` (= phi) from the screen's +x (col) axis towards +y (rows).
+The intensity in a direction is the irradiance times ``d**2`` on a screen at distance
+``d -> infinity``: each ray tube's flux spread over its solid-angle footprint. The
+directions are charted by Lambert's azimuthal equal-area projection about the optical
+axis (+z), ``(x, y) = sqrt(2 / (1 + d_z)) (d_x, d_y)`` for unit ``d``, in which area is
+solid angle; the tubes are splatted on a square grid of that chart by exact area shares
+(:func:`shadowcam.lightfield.render.splat_tubes`, the code of the screen renders), so a
+cell's intensity is its flux over its area (sr), with no Jacobian approximation. The
+cell size is the angular resolution the capture supports (:func:`capture_resolution_deg`):
+the angular width of the light through one near-screen and one far-screen camera pixel.
+Angles follow photometric type C with the optical axis as nadir: vertical angle
+``gamma`` (= theta) from the axis, horizontal angle ``C`` (= phi) from the screen's +x
+(col) axis towards +y (rows).
 
 Offers
 ------
-tangent_grid_intensity : intensity (cd) at (theta, phi) from a flux grid over tangent-plane directions.
+equal_area_chart : chart coordinates of directions.
+capture_resolution_deg : the angular resolution of a two-screen capture.
+far_field_grid : intensity (cd) per equal-area cell of a grid of ray tubes, as a DataArray.
+sample_far_field : a far-field grid sampled at (theta, phi).
 far_field_table : the candela table ``(C, gamma)`` of a rays dataset, as a DataArray.
 format_ies : IES LM-63-2002 text of a candela table.
 format_ldt : EULUMDAT text of a candela table.
@@ -24,45 +33,99 @@ from scipy.ndimage import map_coordinates
 
 from shadowcam._shared.atomic import atomic_path
 from shadowcam._shared.validation import check_array, check_in, check_positive
-from shadowcam.lightfield.render import irradiance_on_plane
-
-#: distance of the far plane, mm (the source's size is negligible against it)
-FAR_DISTANCE_MM = 1.0e7
+from shadowcam.lightfield.render import splat_tubes
 
 
-def tangent_grid_intensity(flux, pitch, theta, phi):
-    """Intensity (cd) in directions from a grid of flux binned over tangent-plane directions.
+def equal_area_chart(direction):
+    """Lambert azimuthal equal-area coordinates ``x, y`` of directions ``(..., 3)`` about +z.
+
+    Area in the chart is solid angle (sr); near the axis the coordinates are radians.
+    """
+    d = np.asarray(direction, np.float64)
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.sqrt(2.0 / (1.0 + d[..., 2]))
+    return k * d[..., 0], k * d[..., 1]
+
+
+def _chart_of_angles(theta, phi):
+    theta, phi = np.broadcast_arrays(np.radians(theta), np.radians(phi))
+    rho = 2.0 * np.sin(theta / 2.0)
+    return rho * np.cos(phi), rho * np.sin(phi)
+
+
+def capture_resolution_deg(near_pitch_mm, far_pitch_mm, separation_mm):
+    """Angular resolution of a two-screen capture, degrees: ``(p_near + p_far) / separation``.
+
+    Light through one near-screen and one far-screen camera pixel (pitches ``p``, mm on
+    the screens) spans this angle; finer structure of the far field is not resolved.
+    """
+    for value, name in ((near_pitch_mm, "near_pitch_mm"), (far_pitch_mm, "far_pitch_mm"),
+                        (separation_mm, "separation_mm")):
+        check_positive(value, name, finite=True)
+    return float(np.degrees((near_pitch_mm + far_pitch_mm) / separation_mm))
+
+
+def far_field_grid(direction, flux, *, resolution_deg, size=None):
+    """Intensity of a grid of ray tubes, per cell of the equal-area chart.
 
     Parameters
     ----------
-    flux : (S, S) ndarray
-        Flux (lm) per bin; bin ``(i, j)`` is centred at ``tan`` coordinates
-        ``((j - (S-1)/2) * pitch, (i - (S-1)/2) * pitch)`` (x along cols, y along rows).
-    pitch : float
-        Bin pitch in tangent units.
-    theta, phi : ndarray
-        Directions in degrees (broadcast together).
+    direction : (H, W, 3) ndarray
+        Direction of the ray at each tube's centre (any length, +z forward).
+    flux : (H, W) ndarray
+        Flux of each tube, lm (non-finite: dropped).
+    resolution_deg : float, keyword-only
+        Cell size, degrees of the chart near the axis (cells are ``radians(resolution_deg)**2`` sr).
+    size : int, optional, keyword-only
+        Cells per side (centred on the axis); default: enough to hold every direction.
 
     Returns
     -------
-    ndarray
-        Intensity in cd, bilinearly interpolated (0 outside the grid).
+    xarray.DataArray
+        ``(row, col)`` intensity in cd (flux over the cell's solid angle), with chart
+        coordinates ``y`` (rows) and ``x`` (cols).
     """
-    flux = check_array(flux, "flux", ndim=2)
-    check_positive(pitch, "pitch", finite=True)
-    h, w = flux.shape
-    tx = (np.arange(w) - (w - 1) / 2) * pitch
-    ty = (np.arange(h) - (h - 1) / 2) * pitch
-    cos3 = (1.0 + tx[None, :] ** 2 + ty[:, None] ** 2) ** -1.5
-    intensity = flux / (pitch**2 * cos3)
-    theta, phi = np.broadcast_arrays(np.radians(theta), np.radians(phi))
-    t = np.tan(theta)
-    cols = t * np.cos(phi) / pitch + (w - 1) / 2
-    rows = t * np.sin(phi) / pitch + (h - 1) / 2
-    return map_coordinates(intensity, [rows.ravel(), cols.ravel()], order=1, cval=0.0).reshape(theta.shape)
+    direction = check_array(direction, "direction", ndim=3)
+    flux = check_array(flux, "flux", shape=direction.shape[:2])
+    check_positive(resolution_deg, "resolution_deg", finite=True)
+    pitch = np.radians(resolution_deg)
+    x, y = equal_area_chart(direction)
+    if size is None:
+        reach = float(np.nanmax(np.hypot(x, y)))
+        size = 2 * int(np.ceil(reach / pitch)) + 5
+    elif not (int(size) == size and size >= 1):
+        raise ValueError(f"size must be a positive int; got {size!r}")
+    size = int(size)
+    values = splat_tubes(x, y, flux, shape=(size, size), pitch=pitch) / pitch**2
+    axis = (np.arange(size) - (size - 1) / 2) * pitch
+    return xr.DataArray(values, dims=("row", "col"), coords={"y": ("row", axis), "x": ("col", axis)},
+                        attrs={"units": "cd", "long_name": "luminous intensity per equal-area cell",
+                               "chart": "Lambert azimuthal equal-area about +z", "resolution_deg": float(resolution_deg)})
 
 
-def far_field_table(rays, *, vertical_angles, horizontal_angles, bin_deg=1.0):
+def sample_far_field(grid, theta, phi):
+    """Bilinear samples of a :func:`far_field_grid` at ``theta`` (from the axis), ``phi`` (from +x), degrees."""
+    values = check_array(np.asarray(grid), "grid", ndim=2)
+    pitch = np.radians(float(grid.attrs["resolution_deg"]))
+    x, y = _chart_of_angles(theta, phi)
+    h, w = values.shape
+    cols = x / pitch + (w - 1) / 2
+    rows = y / pitch + (h - 1) / 2
+    return map_coordinates(values, [rows.ravel(), cols.ravel()], order=1, cval=0.0).reshape(x.shape)
+
+
+def rays_resolution_deg(rays):
+    """:func:`capture_resolution_deg` of a rays dataset (its screens' camera pitches and positions)."""
+    missing = [k for k in ("near_pitch_mm", "far_pitch_mm") if k not in rays.attrs]
+    if missing:
+        raise ValueError(f"rays dataset lacks the attributes {missing}: write it again with "
+                         "lightfield-rays, or pass resolution_deg")
+    return capture_resolution_deg(rays.attrs["near_pitch_mm"], rays.attrs["far_pitch_mm"],
+                                  rays.attrs["far_position_mm"] - rays.attrs["near_position_mm"])
+
+
+def far_field_table(rays, *, vertical_angles, horizontal_angles, resolution_deg=None):
     """Candela table of the source described by a rays dataset.
 
     Parameters
@@ -73,13 +136,13 @@ def far_field_table(rays, *, vertical_angles, horizontal_angles, bin_deg=1.0):
         Gamma (from the optical axis), degrees in ``[0, 90)``.
     horizontal_angles : (Hz,) array_like, keyword-only
         C angles, degrees in ``[0, 360]``.
-    bin_deg : float, keyword-only
-        Angular resolution of the tangent-plane grid near the axis, degrees.
+    resolution_deg : float, optional, keyword-only
+        Cell size of the :func:`far_field_grid`; default the capture's (:func:`rays_resolution_deg`).
 
     Returns
     -------
     xarray.DataArray
-        ``(C, gamma)`` intensities in cd.
+        ``(C, gamma)`` intensities in cd (the grid sampled bilinearly).
     """
     gamma = check_array(vertical_angles, "vertical_angles", ndim=1, dtype_kind="iuf").astype(np.float64)
     c = check_array(horizontal_angles, "horizontal_angles", ndim=1, dtype_kind="iuf").astype(np.float64)
@@ -87,19 +150,14 @@ def far_field_table(rays, *, vertical_angles, horizontal_angles, bin_deg=1.0):
         raise ValueError(f"vertical_angles must lie in [0, 90) degrees; got {gamma.min()}..{gamma.max()}")
     if c.size == 0 or not (c.min() >= 0 and c.max() <= 360):
         raise ValueError(f"horizontal_angles must lie in [0, 360] degrees; got {c.min()}..{c.max()}")
-    check_positive(bin_deg, "bin_deg", finite=True)
-    pitch = np.tan(np.radians(bin_deg))
-    direction = rays["direction"].values
-    slopes = np.abs(direction[..., :2] / direction[..., 2:3])
-    extent = float(np.nanmax(slopes)) * 1.05 + 2 * pitch
-    size = int(np.ceil(2 * extent / pitch)) + 3
-    plane = irradiance_on_plane(rays, centre=(0.0, 0.0, FAR_DISTANCE_MM), shape=(size, size),
-                                pixel_size=pitch * FAR_DISTANCE_MM)
-    flux = plane.values.astype(np.float64) * (pitch * FAR_DISTANCE_MM * 1e-3) ** 2
-    table = tangent_grid_intensity(flux, pitch, gamma[None, :], c[:, None])
+    if resolution_deg is None:
+        resolution_deg = rays_resolution_deg(rays)
+    grid = far_field_grid(rays["direction"].values, rays["flux"].values, resolution_deg=resolution_deg)
+    table = sample_far_field(grid, gamma[None, :], c[:, None])
     return xr.DataArray(table, dims=("C", "gamma"), coords={"C": c, "gamma": gamma},
                         attrs={"units": "cd", "long_name": "luminous intensity",
-                               "photometric_type": "C (nadir = optical axis +z)", "bin_deg": float(bin_deg)})
+                               "photometric_type": "C (nadir = optical axis +z)",
+                               "resolution_deg": float(resolution_deg)})
 
 
 def _numbers(values, per_line=10, fmt="{:.6g}"):

@@ -128,7 +128,9 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
         screen), ``flux`` (lm through the pixel), ``mask`` ``(row, col, mask_axis)`` mm,
         ``confidence`` in [0, 1] and ``flag`` (:data:`REASONS`). A pixel whose ray is not
         found (flag > 0, confidence 0) keeps its flux and takes the direction of the
-        nearest found ray; its ``mask`` is NaN.
+        nearest found ray; its ``mask`` is NaN. Attributes: the screens' positions and
+        camera pitches (``near_pitch_mm``, ``far_pitch_mm``: square root of the median
+        pixel area).
     """
     z1, z2 = near["position_mm"], far["position_mm"]
     if not z2 > z1:
@@ -176,7 +178,9 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
         },
         coords={"row": np.arange(shape[0]), "col": np.arange(shape[1]), "axis": ["x", "y", "z"],
                 "mask_axis": ["x", "y"]},
-        attrs={"near_position_mm": z1, "far_position_mm": z2, "convention": "lengths in mm; +z from the source"},
+        attrs={"near_position_mm": z1, "far_position_mm": z2, "convention": "lengths in mm; +z from the source",
+               "near_pitch_mm": float(np.sqrt(np.median(near["area"]))),
+               "far_pitch_mm": float(np.sqrt(np.median(far["area"])))},
     )
 
 

@@ -20,6 +20,7 @@ plane_frame : origin, col axis, row axis and unit normal of a plane.
 splat_bilinear : add weights at fractional (row, col) positions to a grid.
 splat_polygons : spread weights uniformly over polygons onto a grid with exact area weights.
 tube_triangles : the triangles of the pixel ray tubes of a grid of plane hits.
+splat_tubes : the flux of a grid of ray tubes on a square grid of any 2-D chart, by exact area.
 irradiance_on_plane : the rays' irradiance on a plane grid (position, tilt), as a DataArray.
 """
 
@@ -203,6 +204,35 @@ def tube_triangles(u, v):
     return out[0], out[1]
 
 
+def splat_tubes(u, v, flux, *, shape, pitch):
+    """Flux of a grid of ray tubes summed into a square grid, by exact area shares.
+
+    The chart ``(u, v)`` may be a plane's coordinates (irradiance) or an equal-area
+    chart of directions (intensity, :mod:`shadowcam.lightfield.photometry_export`).
+
+    Parameters
+    ----------
+    u, v : (H, W) ndarray
+        Chart coordinates of the rays through the tubes' centres (:func:`tube_triangles`).
+    flux : (H, W) ndarray
+        Flux of each tube.
+    shape : (rows, cols), keyword-only
+        Target grid, centred on the chart's origin; cols along ``u``, rows along ``v``.
+    pitch : float, keyword-only
+        Cell size in chart units.
+
+    Returns
+    -------
+    (rows, cols) float64 ndarray
+        Flux per cell (flux outside the grid is dropped).
+    """
+    tri_u, tri_v = tube_triangles(u, v)
+    weights = np.broadcast_to(0.25 * np.asarray(flux, np.float64), tri_u.shape[:3])
+    cols = tri_u.reshape(-1, 3) / pitch + (shape[1] - 1) / 2
+    rows = tri_v.reshape(-1, 3) / pitch + (shape[0] - 1) / 2
+    return splat_polygons(rows, cols, weights.ravel(), shape)
+
+
 def irradiance_on_plane(rays, *, centre, shape, pixel_size, normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0)):
     """Irradiance of a ray set on a plane grid.
 
@@ -230,12 +260,7 @@ def irradiance_on_plane(rays, *, centre, shape, pixel_size, normal=(0.0, 0.0, 1.
         raise ValueError(f"shape must be (rows, cols) of positive ints; got {shape}")
     plane = plane_frame(centre, normal, up)
     u, v = _hits(rays["origin"].values, rays["direction"].values, *plane)
-    tri_u, tri_v = tube_triangles(u, v)
-    flux = np.broadcast_to(0.25 * rays["flux"].values, tri_u.shape[:3])
-    cols = tri_u.reshape(-1, 3) / pixel_size + (shape[1] - 1) / 2
-    rows = tri_v.reshape(-1, 3) / pixel_size + (shape[0] - 1) / 2
-    grid = splat_polygons(rows, cols, flux.ravel(), shape)
-    irradiance = grid / (pixel_size * 1e-3) ** 2
+    irradiance = splat_tubes(u, v, rays["flux"].values, shape=shape, pitch=pixel_size) / (pixel_size * 1e-3) ** 2
     rows = (np.arange(shape[0]) - (shape[0] - 1) / 2) * pixel_size
     cols = (np.arange(shape[1]) - (shape[1] - 1) / 2) * pixel_size
     return xr.DataArray(

@@ -296,11 +296,16 @@ def render_positions(ray_set, description, positions_mm, *, pitch_factor=2.0):
 
 
 def far_field(ray_set, *, c_step_deg=15.0, gamma_step_deg=1.0):
-    """The rays' candela table, ``gamma`` from 0 to the widest ray's angle, ``C`` every `c_step_deg`."""
+    """The rays' candela table, ``gamma`` from 0 to the widest ray's angle, ``C`` every `c_step_deg`.
+
+    The table samples the far field resolved at the capture's angular resolution
+    (:func:`shadowcam.lightfield.photometry_export.far_field_table`); the steps only
+    choose where it is sampled.
+    """
     check_positive(c_step_deg, "c_step_deg", finite=True)
     check_positive(gamma_step_deg, "gamma_step_deg", finite=True)
     d = ray_set["direction"].values
     widest = float(np.degrees(np.arctan(np.nanmax(np.hypot(d[..., 0], d[..., 1]) / d[..., 2]))))
     gamma = np.arange(0.0, min(np.floor(widest), 89.0) + gamma_step_deg / 2, gamma_step_deg)
     c = np.arange(0.0, 360.0 - c_step_deg / 2, c_step_deg)
-    return far_field_table(ray_set, vertical_angles=gamma, horizontal_angles=c, bin_deg=gamma_step_deg)
+    return far_field_table(ray_set, vertical_angles=gamma, horizontal_angles=c)

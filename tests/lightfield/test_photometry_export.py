@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from shadowcam.lightfield.photometry_export import tangent_grid_intensity, write_photometry
+from shadowcam.lightfield.photometry_export import (
+    capture_resolution_deg, equal_area_chart, far_field_grid, far_field_table, write_photometry)
 
 
 def _table():
@@ -44,10 +45,52 @@ def test_bad_table_leaves_no_file(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-def test_tangent_grid_intensity_of_an_isotropic_source():
-    pitch = 0.01
-    n = 101
-    t = (np.arange(n) - 50) * pitch
-    cos3 = (1 + t[None, :] ** 2 + t[:, None] ** 2) ** -1.5
-    flux = 7.0 * pitch**2 * cos3  # 7 cd everywhere
-    assert np.allclose(tangent_grid_intensity(flux, pitch, np.array([0.0, 10.0, 20.0]), np.array([0, 45, 200])), 7.0)
+def _cos_n_rays(n_power, *, z=100.0, half=50.0, count=201, peak=100.0):
+    """Rays of a point source ``I = peak cos(gamma)**n`` through a screen grid at `z` (mm): directions, flux (lm)."""
+    t = np.linspace(-half, half, count)
+    x, y = np.meshgrid(t, t, indexing="xy")
+    r2 = x**2 + y**2 + z**2
+    cos = z / np.sqrt(r2)
+    area = (t[1] - t[0]) ** 2 * 1e-6
+    flux = peak * cos**n_power * cos / (r2 * 1e-6) * area
+    return np.stack([x / z, y / z, np.ones_like(x)], -1), flux
+
+
+def _exact_cell_mean(intensity, grid, sub=24):
+    """Mean of ``intensity(gamma_rad)`` over each chart cell of `grid` (sub x sub samples per cell)."""
+    pitch = np.radians(grid.attrs["resolution_deg"])
+    offsets = (np.arange(sub) + 0.5) / sub - 0.5
+    x = grid["x"].values[None, :, None, None] + pitch * offsets[None, None, None, :]
+    y = grid["y"].values[:, None, None, None] + pitch * offsets[None, None, :, None]
+    gamma = 2 * np.arcsin(np.minimum(np.hypot(x, y) / 2, 1.0))
+    return intensity(gamma).mean(axis=(2, 3))
+
+
+@pytest.mark.parametrize("n_power", [1, 3])
+def test_far_field_of_a_cos_n_emitter_is_its_exact_cell_mean(n_power):
+    direction, flux = _cos_n_rays(n_power)
+    grid = far_field_grid(direction, flux, resolution_deg=1.0)
+    cell_sr = np.radians(1.0) ** 2
+    assert np.isclose(grid.values.sum() * cell_sr, flux.sum(), rtol=1e-9)  # flux kept
+    exact = _exact_cell_mean(lambda g: 100.0 * np.cos(g) ** n_power, grid)
+    gamma = 2 * np.degrees(np.arcsin(np.hypot(grid["x"].values[None, :], grid["y"].values[:, None]) / 2))
+    inside = gamma < 24.0  # cells well inside the screen's 26.6 deg field
+    error = np.abs(grid.values[inside] / exact[inside] - 1)
+    assert np.median(error) < 1e-3 and error.max() < 5e-3
+    table = far_field_table(xr.Dataset({"direction": (("row", "col", "axis"), direction),
+                                        "flux": (("row", "col"), flux)}),
+                            vertical_angles=[0.0, 10.0, 20.0], horizontal_angles=[0.0, 45.0, 200.0],
+                            resolution_deg=1.0)
+    assert np.allclose(table.values, 100.0 * np.cos(np.radians([0.0, 10.0, 20.0])) ** n_power, rtol=5e-3)
+
+
+def test_equal_area_chart_area_is_solid_angle():
+    # a cone of half-angle g covers 2 pi (1 - cos g) sr; in the chart a disc of radius 2 sin(g / 2)
+    g = np.radians(35.0)
+    x, y = equal_area_chart(np.array([np.sin(g), 0.0, np.cos(g)]))
+    assert np.isclose(np.pi * (x**2 + y**2), 2 * np.pi * (1 - np.cos(g)))
+    assert np.isclose(capture_resolution_deg(1.0, 2.0, 300.0), np.degrees(0.01))
+    with pytest.raises(ValueError, match="separation_mm"):
+        capture_resolution_deg(1.0, 2.0, 0.0)
+    with pytest.raises(ValueError, match="resolution_deg"):
+        far_field_grid(np.ones((2, 2, 3)), np.ones((2, 2)), resolution_deg=-1.0)

@@ -49,3 +49,41 @@ def test_rendered_screen_beats_the_naive_baseline_by_half(captured_rays, target_
                                        target_shape=shape, pixel_size=pitch)
     ratio = accuracy.relative_rmse_gain(rendered, truth) / accuracy.relative_rmse_gain(baseline, truth)
     assert ratio <= 0.5
+
+
+def test_bandpass_error_scores_the_rings_amplitude_and_place():
+    y, x = np.mgrid[:64, :64]
+    r = np.hypot(x - 32, y - 32)
+    truth = 10 + np.cos(2 * np.pi * r / 9.0)
+    assert accuracy.bandpass_error(3.0 * truth, truth) < 1e-12          # one gain: exact
+    assert np.isclose(accuracy.bandpass_error(np.full_like(truth, 10.0), truth), 1.0)  # rings missing
+    inverted = 20 - truth
+    assert accuracy.bandpass_error(inverted, truth) > 1.5               # rings in the wrong place
+    half = 10 + 0.5 * np.cos(2 * np.pi * r / 9.0)                       # rings at half amplitude
+    assert 0.4 < accuracy.bandpass_error(half, truth) < 0.6
+
+
+@pytest.mark.parametrize("target_mm, screen", [(350.0, 0), (675.0, 1)])
+def test_rendered_rings_are_closer_than_the_baselines(captured_rays, target_mm, screen):
+    capture, maps, ray_set = captured_rays
+    pitch = capture.homography(0)[0, 1] * target_mm / capture.positions_mm[0]  # the camera's own pitch
+    truth = capture.source.irradiance(centre=(0, 0, target_mm), shape=capture.shape, pixel_size=pitch)
+    rendered = irradiance_on_plane(ray_set, centre=(0, 0, target_mm), shape=capture.shape, pixel_size=pitch).values
+    baseline = accuracy.naive_baseline(maps[screen]["irradiance"], maps[screen]["xy"],
+                                       position_mm=capture.positions_mm[screen], target_position_mm=target_mm,
+                                       target_shape=capture.shape, pixel_size=pitch)
+    assert accuracy.bandpass_error(rendered, truth) < 0.75 * accuracy.bandpass_error(baseline, truth)
+
+
+def test_far_field_of_the_capture_at_its_resolution(captured_rays):
+    from shadowcam.lightfield.photometry_export import far_field_grid, rays_resolution_deg
+
+    capture, _, ray_set = captured_rays
+    resolution = rays_resolution_deg(ray_set)
+    near, far = (capture.homography(s)[0, 1] for s in range(2))
+    assert np.isclose(resolution, np.degrees((near + far) / 200.0), rtol=0.03)  # camera pitches on the screens
+    estimate = far_field_grid(ray_set["direction"].values, ray_set["flux"].values, resolution_deg=resolution)
+    truth = capture.source.far_field_grid(resolution_deg=resolution, size=estimate.shape[0]).values
+    assert np.isclose(np.nansum(estimate.values), truth.sum(), rtol=0.005)  # the rays' flux
+    # regression bound of the measured median error (docs/benchmarks.md; the 5 % target is not met)
+    assert accuracy.far_field_error(estimate.values, truth) < 0.10

@@ -140,7 +140,6 @@ rule lightfield_accuracy:
         sweeps=get_lightfield_sweeps,
         rays="results/{ds}/lightfield/rays.nc",
         renders="results/{ds}/lightfield/renders.nc",
-        table="results/{ds}/lightfield/far_field.nc",
     output:
         json="results/{ds}/lightfield/accuracy.json",
         csv="results/{ds}/lightfield/accuracy.csv",
@@ -156,7 +155,7 @@ rule lightfield_accuracy:
     shell:
         "shadowcam lightfield-accuracy --manifest {input.manifest} --capture {input.capture}"
         " --sweeps {input.sweeps} --rays {input.rays} --renders {input.renders}"
-        " --table {input.table} --json {output.json} --csv {output.csv} > {log} 2>&1"
+        " --json {output.json} --csv {output.csv} > {log} 2>&1"
 
 
 rule lightfield_report:

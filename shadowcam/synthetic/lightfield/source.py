@@ -11,7 +11,8 @@ keeps one ray per screen point at every distance. The flux density through the m
 (lm / mm^2) has rings of its own and an azimuthal lobe.
 
 Ground truth is computed by tracing a fine regular grid of rays (deterministic
-quadrature) and splatting their flux bilinearly onto a pixel grid.
+quadrature) and splatting their flux bilinearly onto a pixel grid (screens), or their
+tubes by exact area onto the equal-area direction chart (far field).
 
 Offers
 ------
@@ -22,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from shadowcam.lightfield.photometry_export import tangent_grid_intensity
+from shadowcam.lightfield.photometry_export import far_field_grid, sample_far_field
 from shadowcam.lightfield.render import plane_frame, splat_bilinear
 
 
@@ -129,18 +130,21 @@ class ReflectorSource:
         grid = splat_bilinear(rows, cols, flux, shape)
         return grid / (pixel_size * 1e-3) ** 2
 
-    def far_field(self, theta, phi, *, n=1536, bin_deg=1.0):
-        """Ground-truth intensity (cd) in directions ``theta`` (from the axis) and ``phi`` (from +x), degrees.
+    def far_field_grid(self, *, resolution_deg, size=None, n=768):
+        """Ground-truth intensity (cd) per cell of the equal-area direction chart.
 
-        The flux of the quadrature rays binned by direction on a tangent-plane grid of
-        pitch ``tan(bin_deg)``, divided by the solid angle of each bin, sampled bilinearly.
+        The quadrature's ``n x n`` ray tubes splatted exactly as the capture's tubes are
+        (:func:`shadowcam.lightfield.photometry_export.far_field_grid`): the integral of
+        the intensity over each cell, divided by its solid angle, to within the
+        quadrature's tube size. `resolution_deg` and `size` as that function.
         """
         x, y, flux = self.quadrature(n)
-        d = self.rays(x, y)
-        pitch = np.tan(np.radians(bin_deg))
-        extent = np.abs(d[:, :2]).max() * 1.05
-        size = int(np.ceil(2 * extent / pitch)) + 3
-        cols = d[:, 0] / pitch + (size - 1) / 2
-        rows = d[:, 1] / pitch + (size - 1) / 2
-        grid = splat_bilinear(rows, cols, flux, (size, size))
-        return tangent_grid_intensity(grid, pitch, theta, phi)
+        d = self.rays(x, y).reshape(n, n, 3)
+        return far_field_grid(d, flux.reshape(n, n), resolution_deg=resolution_deg, size=size)
+
+    def far_field(self, theta, phi, *, resolution_deg, n=768):
+        """Ground-truth intensity (cd) in directions ``theta`` (from the axis), ``phi`` (from +x), degrees.
+
+        :meth:`far_field_grid` sampled bilinearly (as a capture's candela table is).
+        """
+        return sample_far_field(self.far_field_grid(resolution_deg=resolution_deg, n=n), theta, phi)
