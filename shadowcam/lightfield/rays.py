@@ -27,8 +27,9 @@ from scipy.interpolate import LinearNDInterpolator
 from scipy.ndimage import distance_transform_edt
 
 from shadowcam._shared.atomic import atomic_path
-from shadowcam._shared.validation import check_positive, check_same_shape
+from shadowcam._shared.validation import check_in, check_positive, check_same_shape
 from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
+from shadowcam.lightfield.direction_fit import direction_noise, far_magnification, fit_directions
 
 #: ray flag code -> meaning (0 = a ray)
 REASONS = {
@@ -110,7 +111,12 @@ def screen_mask_map(horizontal, vertical, *, xy, area, position_mm):
             "position_mm": float(position_mm)}
 
 
-def rays_dataset(near, far, *, mask_std_scale=0.05):
+#: what a pixel without its own correspondence does in renders: take the local fit's direction
+#: (``"fit"``), be left out (``"drop"``), or take the nearest found ray's (``"nearest"``)
+EDGE_RAYS = ("fit", "drop", "nearest")
+
+
+def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edge_rays="fit"):
     """The rays through the near and the far screens' points of equal mask coordinates.
 
     Parameters
@@ -119,6 +125,14 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
         :func:`screen_mask_map` of the near and the far screen.
     mask_std_scale : float, keyword-only
         Mask-coordinate standard deviation (mm) at which the confidence is ``exp(-1/2)``.
+    smooth_directions : bool, keyword-only
+        Estimate directions by the weighted local-linear fit of
+        :func:`shadowcam.lightfield.direction_fit.fit_directions` (noise propagated from the
+        shadow-time std); else (default) each ray keeps its own measured direction: on the
+        synthetic capture the direction errors are correlated between neighbouring rays, so
+        the fit does not reduce them (docs/benchmarks.md).
+    edge_rays : {"fit", "drop", "nearest"}, keyword-only
+        :data:`EDGE_RAYS`: direction of a pixel without its own correspondence.
 
     Returns
     -------
@@ -126,9 +140,11 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
         On the near screen's pixel grid ``(row, col)``: ``origin`` and ``direction``
         ``(row, col, axis)`` (mm; direction with unit z), ``irradiance`` (lux at the near
         screen), ``flux`` (lm through the pixel), ``mask`` ``(row, col, mask_axis)`` mm,
-        ``confidence`` in [0, 1] and ``flag`` (:data:`REASONS`). A pixel whose ray is not
-        found (flag > 0, confidence 0) keeps its flux and takes the direction of the
-        nearest found ray; its ``mask`` is NaN. Attributes: the screens' positions and
+        ``confidence`` in [0, 1], ``direction_std`` (per axis, from the noise model; of the
+        fit when smoothed) and ``flag`` (:data:`REASONS`). A pixel whose ray is not found
+        (flag > 0, confidence 0, ``mask`` NaN) keeps its flag; by `edge_rays` its direction
+        is the local fit's from its neighbours (with that fit's std), or NaN with flux 0
+        (left out of renders), or the nearest found ray's. Attributes: the screens' positions and
         camera pitches (``near_pitch_mm``, ``far_pitch_mm``: square root of the median
         pixel area).
     """
@@ -136,6 +152,7 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
     if not z2 > z1:
         raise ValueError(f"far position_mm must be > near position_mm ({z1}); got {z2}")
     check_positive(mask_std_scale, "mask_std_scale", finite=True)
+    check_in(edge_rays, "edge_rays", EDGE_RAYS)
     shape = near["ok"].shape
     flag = np.zeros(shape, np.uint8)
     flag[~near["ok"]] = NO_SHADOW_NEAR
@@ -143,24 +160,45 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
     if far_ok.sum() < 3:
         raise ValueError(f"far screen must have at least 3 pixels with shadow times of both sweeps; got "
                          f"{int(far_ok.sum())}: check the far screen's sweeps")
-    interpolate = LinearNDInterpolator(far["mask"][far_ok], np.c_[far["xy"][far_ok], far["mask_std"][far_ok]])
-    matched = np.full(shape + (3,), np.nan)
+    magnification = far_magnification(far["mask"], far["xy"], far_ok)
+    interpolate = LinearNDInterpolator(far["mask"][far_ok], np.c_[far["xy"][far_ok], far["mask_std"][far_ok],
+                                                                  magnification[far_ok]])
+    matched = np.full(shape + (4,), np.nan)
     matched[near["ok"]] = interpolate(near["mask"][near["ok"]])
-    no_match = near["ok"] & ~np.all(np.isfinite(matched), axis=-1)
+    no_match = near["ok"] & ~np.all(np.isfinite(matched[..., :3]), axis=-1)
     flag[no_match] = NO_MATCH_FAR
     saturated = (flag == OK) & ~np.isfinite(near["irradiance"])
     flag[saturated] = SATURATED
     good = flag == OK
     x1 = near["xy"]
     origin = np.concatenate([x1, np.full(shape + (1,), z1)], -1)
-    direction = np.concatenate([(matched[..., :2] - x1) / (z2 - z1), np.ones(shape + (1,))], -1)
-    if good.any():
-        # a pixel without its own correspondence (beam edge, dark, a fold) keeps its flux and
-        # takes the direction of the nearest found ray, so no ray tube is dropped
+    measured = np.where(good[..., None], (matched[..., :2] - x1) / (z2 - z1), np.nan)
+    noise = np.where(good, direction_noise(near["mask_std"], matched[..., 2], matched[..., 3], separation_mm=z2 - z1),
+                     np.nan)
+    noise = np.where(np.isfinite(noise) | ~good, noise, np.nanmedian(noise) if np.isfinite(noise).any() else 1.0)
+    if smooth_directions or edge_rays == "fit":
+        fitted = fit_directions(measured, noise)
+    slope, slope_std = measured, noise
+    if smooth_directions:
+        slope, slope_std = fitted["direction"], fitted["direction_std"]
+    edge = ~good
+    if edge_rays == "fit":
+        slope = np.where(edge[..., None], fitted["direction"], slope)
+        slope_std = np.where(edge, fitted["direction_std"], slope_std)
+    elif edge_rays == "nearest" and good.any():
         _, (ri, ci) = distance_transform_edt(~good, return_indices=True)
-        direction = direction[ri, ci]
+        slope = np.where(edge[..., None], slope[ri, ci], slope)
+        slope_std = np.where(edge, slope_std[ri, ci], slope_std)
+    # a ray left without a direction carries no flux; its tube corners (shared with its
+    # neighbours) take the nearest direction so that the neighbours' tubes stay closed
+    carries = np.all(np.isfinite(slope), -1) & (good | (edge_rays != "drop"))
+    if carries.any() and not carries.all():
+        _, (ri, ci) = distance_transform_edt(~np.all(np.isfinite(slope), -1), return_indices=True)
+        slope = slope[ri, ci]
+    direction = np.concatenate([slope, np.ones(shape + (1,))], -1)
     irradiance = np.where(np.isfinite(near["irradiance"]), near["irradiance"], np.nan)
     flux = irradiance * near["area"] * 1e-6
+    flux = np.where(carries, flux, 0.0)
     std = np.hypot(near["mask_std"], matched[..., 2])
     confidence = np.where(good, np.exp(-0.5 * (std / mask_std_scale) ** 2), 0.0)
     mask = np.where(good[..., None], near["mask"], np.nan)
@@ -172,6 +210,7 @@ def rays_dataset(near, far, *, mask_std_scale=0.05):
             "irradiance": (dims2, irradiance, {"units": "lx", "long_name": "near-screen irradiance"}),
             "flux": (dims2, flux, {"units": "lm", "long_name": "flux of the ray tube through the pixel"}),
             "mask": (("row", "col", "mask_axis"), mask, {"units": "mm", "long_name": "mask point of the ray"}),
+            "direction_std": (dims2, slope_std, {"units": "1", "long_name": "per-axis std of the ray direction"}),
             "confidence": (dims2, confidence, {"units": "1", "long_name": "ray confidence from the shadow-time noise"}),
             "flag": (dims2, flag, {"long_name": "ray reason code",
                                    "flag_values": list(REASONS), "flag_meanings": " ".join(REASONS.values())}),

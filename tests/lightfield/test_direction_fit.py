@@ -1,0 +1,75 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from shadowcam.lightfield import direction_fit, rays
+
+
+def _field(shape=(64, 64)):
+    r, c = np.mgrid[:shape[0], :shape[1]].astype(float)
+    return np.stack([0.001 * (c - 32) + 2e-6 * (c - 32) ** 2, 0.0008 * (r - 32) - 1e-6 * (r - 32) * (c - 32)], -1)
+
+
+@settings(max_examples=5, deadline=None)
+@given(seed=st.integers(0, 2**16), bandwidth=st.sampled_from([1.0, 2.0, 3.0]))
+def test_local_linear_error_matches_the_noise_model(seed, bandwidth):
+    rng = np.random.default_rng(seed)
+    true = _field()
+    std = np.where(np.arange(64)[None, :] < 32, 1e-3, 2e-3) * np.ones((64, 1))
+    est, est_std = direction_fit.local_linear_fit(true + rng.normal(size=true.shape) * std[..., None], std,
+                                                  bandwidth=bandwidth)
+    inner = (slice(12, -12), slice(12, -12))
+    z = (est - true)[inner] / est_std[inner][..., None]
+    assert 0.85 < np.std(z) < 1.15                       # the fit's error is its predicted std
+    # inverse-variance weights: interior std ~ 1 / sqrt(sum of weights), well below the raw noise
+    assert np.median(est_std[inner]) < 0.5 * np.median(std[inner])
+
+
+def test_fit_directions_reduces_independent_noise_and_keeps_a_linear_field_exact():
+    rng = np.random.default_rng(3)
+    true = _field()
+    std = np.full((64, 64), 1.5e-3)
+    fit = direction_fit.fit_directions(true + rng.normal(size=true.shape) * std[..., None], std)
+    inner = (slice(8, -8), slice(8, -8))
+    rms = np.sqrt(np.mean((fit["direction"] - true)[inner] ** 2))
+    assert rms < 0.3 * 1.5e-3
+    assert np.sqrt(np.mean(fit["direction_std"][inner] ** 2)) == pytest.approx(rms, rel=0.3)
+    linear = np.stack(np.mgrid[:32, :32].astype(float), -1) * 1e-3
+    exact = direction_fit.fit_directions(linear, np.full((32, 32), 1e-3))["direction"]
+    assert np.allclose(exact, linear, atol=1e-12)        # no bias on a linear field
+
+
+def test_direction_noise_propagates_mask_std():
+    got = direction_fit.direction_noise(np.full((2, 2), 0.03), np.full((2, 2), 0.04), np.full((2, 2), 9.0),
+                                        separation_mm=200.0)
+    assert np.allclose(got, 9.0 * 0.05 / np.sqrt(2) / 200.0)
+    with pytest.raises(ValueError, match="separation_mm"):
+        direction_fit.direction_noise(got, got, got, separation_mm=0.0)
+
+
+def _screen(z, shape=(24, 24), pitch=1.0, hole=None):
+    r, c = np.mgrid[:shape[0], :shape[1]].astype(float)
+    xy = np.stack([(c - 11.5) * pitch, (r - 11.5) * pitch], -1) * z / 100.0
+    mask = xy * 50.0 / z                                  # rays from the origin, mask at 50 mm
+    ok = np.ones(shape, bool)
+    if hole is not None:
+        ok[hole] = False
+    return {"mask": np.where(ok[..., None], mask, np.nan), "mask_std": np.where(ok, 0.01, np.nan), "xy": xy,
+            "area": np.full(shape, (pitch * z / 100.0) ** 2), "irradiance": np.ones(shape), "ok": ok,
+            "position_mm": float(z)}
+
+
+def test_edge_rays_get_the_local_fit_direction_and_are_flagged():
+    hole = (slice(0, 24), slice(0, 3))                    # beam edge: no correspondence on the left
+    ray_set = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="fit")
+    xy = _screen(100.0)["xy"]
+    expected = xy / 100.0                                 # a point source at the origin: d = x / z
+    assert np.all(ray_set["flag"].values[hole] == rays.NO_SHADOW_NEAR)
+    assert np.allclose(ray_set["direction"].values[..., :2], expected, atol=1e-9)  # linear field: exact
+    assert np.all(np.isfinite(ray_set["direction_std"].values[hole]))
+    nearest = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="nearest")
+    assert not np.allclose(nearest["direction"].values[hole][..., :2], expected[hole], atol=1e-3)
+    dropped = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="drop")
+    assert np.all(dropped["flux"].values[hole] == 0) and np.all(dropped["flux"].values[:, 3:] > 0)
+    with pytest.raises(ValueError, match="edge_rays"):
+        rays.rays_dataset(_screen(100.0), _screen(200.0), edge_rays="borrow")
