@@ -177,9 +177,18 @@ class SequenceNormaliser:
             self.gain_lit.append(self._last[1])
             self.gain_sky.append(self._last[2])
             self.kept_lit.append(int(kept))
-        self._recent = (self._recent + [luma / np.float32(gain_sky)])[-3:]
+        if luma is not self.reference_luma:
+            luma /= np.float32(gain_sky)  # a fresh array (translate); in place saves a frame-sized copy
+        else:
+            luma = luma / np.float32(gain_sky)
+        self._recent = (self._recent + [luma])[-3:]
         if len(self._recent) == 3 and k >= self.record_from:
-            smooth = 0.25 * self._recent[0] + 0.5 * self._recent[1] + 0.25 * self._recent[2]
+            # 0.25 a + 0.5 b + 0.25 c with the same float32 operations in the same order, in two buffers
+            smooth = np.multiply(self._recent[0], np.float32(0.25))
+            term = np.multiply(self._recent[1], np.float32(0.5))
+            smooth += term
+            np.multiply(self._recent[2], np.float32(0.25), out=term)
+            smooth += term
             np.minimum(self._shadow_min, smooth, out=self._shadow_min)
         self._k += 1
 

@@ -257,31 +257,36 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
     if weight is None:
-        weight = np.zeros(luma.shape)
+        weight = np.zeros(luma.shape, dtype=np.float32)
         weight[4:-4, 4:-4] = 1.0
-    weight = np.asarray(weight, dtype=np.float64)
+    weight = np.asarray(weight, dtype=np.float32)
     check_same_shape({"luma": luma, "reference_luma": ref, "weight": weight})
-    target = bandpass_log(ref).astype(np.float64)
-    grad_row, grad_col = np.gradient(target)
-    normal = np.array([[np.sum(weight * grad_row**2), np.sum(weight * grad_row * grad_col)],
-                       [np.sum(weight * grad_row * grad_col), np.sum(weight * grad_col**2)]])
+    target = bandpass_log(ref).ravel()
+    grad_row, grad_col = (np.ascontiguousarray(g).ravel() for g in np.gradient(target.reshape(ref.shape)))
+    flat = weight.ravel()
+    weighted = (flat * grad_row, flat * grad_col)
+    normal = np.array([[_dot(weighted[0], grad_row), _dot(weighted[0], grad_col)],
+                       [_dot(weighted[1], grad_row), _dot(weighted[1], grad_col)]])
     start = np.asarray(initial, dtype=np.float64).copy()
     shift = start.copy()
-    if weight.sum() < min_weight or np.linalg.cond(normal) > 1e8:
+    if float(flat.sum(dtype=np.float64)) < min_weight or np.linalg.cond(normal) > 1e8:
         return start, float("nan")
-    error = None
     for _ in range(max_iter):
-        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
-        rhs = -np.array([np.sum(weight * grad_row * error), np.sum(weight * grad_col * error)])
-        step = np.linalg.solve(normal, rhs)
+        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).ravel() - target
+        step = np.linalg.solve(normal, -np.array([_dot(weighted[0], error), _dot(weighted[1], error)]))
         shift += step
         if np.max(np.abs(shift - start)) > max_shift:
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
-    residual = float(np.sqrt(np.sum(weight * error**2) / max(np.sum(weight), 1.0)))
+    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).ravel() - target
+    residual = float(np.sqrt(_dot(flat * error, error) / max(float(flat.sum(dtype=np.float64)), 1.0)))
     return shift, residual
+
+
+def _dot(a, b):
+    """Sum of ``a * b`` over float32 vectors (BLAS: blocked partial sums)."""
+    return float(np.dot(a, b))
 
 
 def pyramid_levels(shape, *, levels, min_size=64):
