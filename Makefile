@@ -30,9 +30,6 @@ BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
 # frames per chunk of the decoded store: one 24 MP frame is 288 MB of float32 RGB, and the
 # streaming passes hold one chunk, so the default 16 would cost 4.6 GB per job
 BENCH_CHUNK ?= 1
-# the sample's shadow edge is a ramp as wide as its upsampling (6000 / 192 = 31 px, ~8 px at the
-# registration's factor 4): mask margin around it 6 + 8 reduced pixels (outdoor.normalise.registration_margin)
-BENCH_MARGIN ?= 14
 # column strips of the edge-tracking pass (outdoor.edge_strips): one job holds all the per-pixel
 # state of a 24 MP frame (~3 GB); each strip job the state of its columns only
 BENCH_STRIPS ?= 4
@@ -94,7 +91,7 @@ bench: $(STAMP)
 bench-outdoor-size: $(STAMP)
 	rm -rf $(BENCH_DIR) && mkdir -p $(BENCH_DIR)/data_manifest
 	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
-	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), edge_strips: $(BENCH_STRIPS), normalise: {registration_margin: $(BENCH_MARGIN)}}\n' > $(BENCH_DIR)/bench.yaml
+	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), edge_strips: $(BENCH_STRIPS)}\n' > $(BENCH_DIR)/bench.yaml
 	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
 	  $(BIN)/shadowcam outdoor-sample --source data_manifest/dev_ridge.yaml --size $(BENCH_SIZE) --frames $$n \
 	    --name bench$$n --outdir $(BENCH_DIR)/data/bench$$n --manifest-out $(BENCH_DIR)/data_manifest/bench$$n.yaml \
