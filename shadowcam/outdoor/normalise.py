@@ -71,9 +71,10 @@ class SequenceNormaliser:
     registration_margin : int, optional
         Pixels of the reduced frames left out around the moving shadow edge
         (:func:`shadowcam.outdoor.registration.static_weight` ``margin``) beyond the
-        shadow's soft edge, whose width (penumbra, optics blur, upsampling) is measured
-        in each frame (:func:`shadowcam.outdoor.registration.soft_shadow`): the band-pass
-        response of a moved edge reaches about twice its outer scale (6) beyond it.
+        shadow's soft edge and beyond the reference's edge with a soft edge on either side,
+        whose width (penumbra, optics blur, upsampling) is measured in each frame
+        (:func:`shadowcam.outdoor.registration.soft_shadow`): the band-pass response of a
+        moved edge reaches about twice its outer scale (6) beyond it.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).
