@@ -84,7 +84,8 @@ bench: $(STAMP)
 
 # The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of dev_ridge
 # upsampled to BENCH_SIZE (14-bit DNG, full-resolution noise) run in a scratch copy of the
-# workflow (2 cores, first pass in parts of BENCH_PART frames); prints per stage s/frame,
+# workflow (2 cores, first pass in parts of BENCH_PART frames, edge tracking in BENCH_STRIPS
+# column strips); prints per stage s/frame,
 # frames/s, MP/s, peak RSS (and its growth from the half run), the 1000-frame extrapolation, and
 # the scale targets side by side (store / RAW bytes, end-to-end and first pass / decode-only time
 # of the same frames timed in this run, peak RSS per job and its 1000 / 100 frames ratio).
