@@ -30,9 +30,9 @@ BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
 # frames per chunk of the decoded store: one 24 MP frame is 288 MB of float32 RGB, and the
 # streaming passes hold one chunk, so the default 16 would cost 4.6 GB per job
 BENCH_CHUNK ?= 1
-# the sample's shadow edge is a ramp as wide as its upsampling (6000 / 192 = 31 px, ~8 px at the
-# registration's factor 4): mask margin around it 6 + 8 reduced pixels (outdoor.normalise.registration_margin)
-BENCH_MARGIN ?= 14
+# column strips of the edge-tracking pass (outdoor.edge_strips): one job holds all the per-pixel
+# state of a 24 MP frame (~3 GB); each strip job the state of its columns only
+BENCH_STRIPS ?= 4
 
 CMD ?=
 
@@ -84,14 +84,15 @@ bench: $(STAMP)
 
 # The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of dev_ridge
 # upsampled to BENCH_SIZE (14-bit DNG, full-resolution noise) run in a scratch copy of the
-# workflow (2 cores, first pass in parts of BENCH_PART frames); prints per stage s/frame,
+# workflow (2 cores, first pass in parts of BENCH_PART frames, edge tracking in BENCH_STRIPS
+# column strips); prints per stage s/frame,
 # frames/s, MP/s, peak RSS (and its growth from the half run), the 1000-frame extrapolation, and
 # the scale targets side by side (store / RAW bytes, end-to-end and first pass / decode-only time
 # of the same frames timed in this run, peak RSS per job and its 1000 / 100 frames ratio).
 bench-outdoor-size: $(STAMP)
 	rm -rf $(BENCH_DIR) && mkdir -p $(BENCH_DIR)/data_manifest
 	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
-	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), normalise: {registration_margin: $(BENCH_MARGIN)}}\n' > $(BENCH_DIR)/bench.yaml
+	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), edge_strips: $(BENCH_STRIPS)}\n' > $(BENCH_DIR)/bench.yaml
 	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
 	  $(BIN)/shadowcam outdoor-sample --source data_manifest/dev_ridge.yaml --size $(BENCH_SIZE) --frames $$n \
 	    --name bench$$n --outdir $(BENCH_DIR)/data/bench$$n --manifest-out $(BENCH_DIR)/data_manifest/bench$$n.yaml \

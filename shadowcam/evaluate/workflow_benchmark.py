@@ -56,7 +56,8 @@ def read_benchmarks(directory, *, clock="wall"):
     for path in files:
         with path.open() as handle:
             rows = list(csv.DictReader(handle, delimiter="\t"))
-        stage = re.sub(r"_part[^_]*$", "_parts", path.stem)
+        # the jobs of a stage run in time parts or column strips count as one stage
+        stage = re.sub(r"_(part|strip)[^_]*$", lambda match: f"_{match.group(1)}s", path.stem)
         for row in rows[-1:]:
             rss = float(row["max_rss"]) if row["max_rss"] not in ("", "NA", "-") else float("nan")
             stages.setdefault(stage, []).append((float(row[column]), rss))

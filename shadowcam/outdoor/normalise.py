@@ -71,9 +71,10 @@ class SequenceNormaliser:
     registration_margin : int, optional
         Pixels of the reduced frames left out around the moving shadow edge
         (:func:`shadowcam.outdoor.registration.static_weight` ``margin``) beyond the
-        shadow's soft edge, whose width (penumbra, optics blur, upsampling) is measured
-        in each frame (:func:`shadowcam.outdoor.registration.soft_shadow`): the band-pass
-        response of a moved edge reaches about twice its outer scale (6) beyond it.
+        shadow's soft edge and beyond the reference's edge with a soft edge on either side,
+        whose width (penumbra, optics blur, upsampling) is measured in each frame
+        (:func:`shadowcam.outdoor.registration.soft_shadow`): the band-pass response of a
+        moved edge reaches about twice its outer scale (6) beyond it.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).
@@ -177,9 +178,18 @@ class SequenceNormaliser:
             self.gain_lit.append(self._last[1])
             self.gain_sky.append(self._last[2])
             self.kept_lit.append(int(kept))
-        self._recent = (self._recent + [luma / np.float32(gain_sky)])[-3:]
+        if luma is not self.reference_luma:
+            luma /= np.float32(gain_sky)  # a fresh array (translate); in place saves a frame-sized copy
+        else:
+            luma = luma / np.float32(gain_sky)
+        self._recent = (self._recent + [luma])[-3:]
         if len(self._recent) == 3 and k >= self.record_from:
-            smooth = 0.25 * self._recent[0] + 0.5 * self._recent[1] + 0.25 * self._recent[2]
+            # 0.25 a + 0.5 b + 0.25 c with the same float32 operations in the same order, in two buffers
+            smooth = np.multiply(self._recent[0], np.float32(0.25))
+            term = np.multiply(self._recent[1], np.float32(0.5))
+            smooth += term
+            np.multiply(self._recent[2], np.float32(0.25), out=term)
+            smooth += term
             np.minimum(self._shadow_min, smooth, out=self._shadow_min)
         self._k += 1
 

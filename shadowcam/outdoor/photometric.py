@@ -151,9 +151,9 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
     ratio = luma[use] / ref[use]
     if ratio.size < 10:
         return float(prior), int(ratio.size)
-    starts = (float(prior), float(np.percentile(ratio, 90)))
-    for start in starts:
-        gain, kept = start, 0
+    for attempt in range(2):
+        # the 90th percentile of the ratios only when the prior fails (a partition less per frame)
+        gain, kept = (float(prior) if attempt == 0 else float(np.percentile(ratio, 90))), 0
         for _ in range(iterations):
             keep = (ratio > min_ratio * gain) & (ratio < gain / min_ratio)
             kept = int(keep.sum())

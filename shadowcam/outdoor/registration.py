@@ -86,8 +86,8 @@ def soft_shadow(luma, reference_luma, *, lit_reference, gain, valid=None, max_ra
     shadow : (H, W) bool ndarray
         Core plus the soft edge connected to it (8-neighbourhood).
     width_px : float
-        Mean width of the soft edge: soft pixels per core boundary pixel (NaN without a
-        core).
+        Mean width of the soft edge: soft pixels per pixel of the shadow's boundary with
+        the lit pixels (NaN without a core).
     """
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
@@ -110,7 +110,9 @@ def soft_shadow(luma, reference_luma, *, lit_reference, gain, valid=None, max_ra
     touching[np.unique(labels[core])] = True
     touching[0] = False
     shadow = touching[labels]
-    boundary = core & (cv2.dilate((~core).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
+    # per pixel of the shadow's lit-facing boundary: while the edge has moved less than its own
+    # width the core is a few pixels, and the soft band is as long as the edge itself
+    boundary = shadow & (cv2.dilate((lit & ~shadow).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
     return shadow, float((shadow & ~core).sum() / max(int(boundary.sum()), 1))
 
 
@@ -143,15 +145,22 @@ def static_weight(luma, reference_luma, *, lit_reference, gain, valid=None, max_
     -------
     (H, W) float32 ndarray of 0 / 1
         Zero on changed pixels (the moving shadow edge with its penumbra), on the
-        reference's lit / shadow boundary, on invalid pixels and the border, each
-        widened by `margin`; static shadows and static lit parts are kept.
+        reference's lit / shadow boundary with a penumbra on either side (twice the
+        soft-edge width :func:`soft_shadow` measures in this frame), on invalid pixels
+        and the border, each widened by `margin`; static shadows and static lit parts
+        are kept.
     """
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
     lit = np.asarray(lit_reference, dtype=bool)
-    changed, _ = soft_shadow(luma, ref, lit_reference=lit, gain=gain, max_ratio=max_ratio)
-    # the reference's own shadow edge: a small move of it changes pixels less than max_ratio
-    changed |= lit & (cv2.dilate((~lit).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0)
+    changed, width = soft_shadow(luma, ref, lit_reference=lit, gain=gain, max_ratio=max_ratio)
+    # the reference's own shadow edge and its soft edge, whose shadow-side half is not lit in the
+    # reference (not seen by the ratio test) and changes as the shadow moves on: the penumbra
+    # spans about twice the lit-side width measured in this frame (the same sun), on either side
+    reach = 1 + 2 * int(np.ceil(2 * width)) if np.isfinite(width) else 3
+    kernel = np.ones((reach, reach), np.uint8)
+    changed |= cv2.dilate((lit & (cv2.dilate((~lit).astype(np.uint8), np.ones((3, 3), np.uint8)) > 0))
+                          .astype(np.uint8), kernel) > 0
     if valid is not None:
         changed |= ~np.asarray(valid, dtype=bool)
     size = 2 * int(margin) + 1
@@ -257,31 +266,36 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     luma = np.asarray(luma, dtype=np.float32)
     ref = np.asarray(reference_luma, dtype=np.float32)
     if weight is None:
-        weight = np.zeros(luma.shape)
+        weight = np.zeros(luma.shape, dtype=np.float32)
         weight[4:-4, 4:-4] = 1.0
-    weight = np.asarray(weight, dtype=np.float64)
+    weight = np.asarray(weight, dtype=np.float32)
     check_same_shape({"luma": luma, "reference_luma": ref, "weight": weight})
-    target = bandpass_log(ref).astype(np.float64)
-    grad_row, grad_col = np.gradient(target)
-    normal = np.array([[np.sum(weight * grad_row**2), np.sum(weight * grad_row * grad_col)],
-                       [np.sum(weight * grad_row * grad_col), np.sum(weight * grad_col**2)]])
+    target = bandpass_log(ref).ravel()
+    grad_row, grad_col = (np.ascontiguousarray(g).ravel() for g in np.gradient(target.reshape(ref.shape)))
+    flat = weight.ravel()
+    weighted = (flat * grad_row, flat * grad_col)
+    normal = np.array([[_dot(weighted[0], grad_row), _dot(weighted[0], grad_col)],
+                       [_dot(weighted[1], grad_row), _dot(weighted[1], grad_col)]])
     start = np.asarray(initial, dtype=np.float64).copy()
     shift = start.copy()
-    if weight.sum() < min_weight or np.linalg.cond(normal) > 1e8:
+    if float(flat.sum(dtype=np.float64)) < min_weight or np.linalg.cond(normal) > 1e8:
         return start, float("nan")
-    error = None
     for _ in range(max_iter):
-        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
-        rhs = -np.array([np.sum(weight * grad_row * error), np.sum(weight * grad_col * error)])
-        step = np.linalg.solve(normal, rhs)
+        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).ravel() - target
+        step = np.linalg.solve(normal, -np.array([_dot(weighted[0], error), _dot(weighted[1], error)]))
         shift += step
         if np.max(np.abs(shift - start)) > max_shift:
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).astype(np.float64) - target
-    residual = float(np.sqrt(np.sum(weight * error**2) / max(np.sum(weight), 1.0)))
+    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).ravel() - target
+    residual = float(np.sqrt(_dot(flat * error, error) / max(float(flat.sum(dtype=np.float64)), 1.0)))
     return shift, residual
+
+
+def _dot(a, b):
+    """Sum of ``a * b`` over float32 vectors (BLAS: blocked partial sums)."""
+    return float(np.dot(a, b))
 
 
 def pyramid_levels(shape, *, levels, min_size=64):

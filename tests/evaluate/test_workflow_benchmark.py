@@ -103,3 +103,11 @@ def test_time_decode_reads_every_frame_with_the_pipeline_reader(tmp_path):
     assert decode["direct"]  # lossless-JPEG DNGs the writer makes are read directly, as the pipeline does
     with pytest.raises(ValueError, match="at least one"):
         time_decode([])
+
+
+def test_column_strip_jobs_are_one_stage_apart_from_their_merge(tmp_path):
+    _write(tmp_path, "track_edges_strip0", 5.0, 700)
+    _write(tmp_path, "track_edges_strip1", 6.0, 720)
+    _write(tmp_path, "track_edges", 1.0, 900)
+    assert read_benchmarks(tmp_path) == {"track_edges": [(1.0, 900.0)],
+                                         "track_edges_strips": [(5.0, 700.0), (6.0, 720.0)]}

@@ -138,3 +138,21 @@ def test_soft_edge_does_not_bias_the_shift(width_px):
     assert weight[110 - int(width_px / 2) - 5:].sum() == 0  # penumbra + band-pass reach out
     estimate, _ = shift_lucas_kanade_LucasKanade1981(frame, ref, weight=weight)
     np.testing.assert_allclose(estimate, true, atol=0.03)
+
+
+@pytest.mark.parametrize("moved", [(3, -5), (-7, 2), (11, 4), (-4, -13)])
+def test_recovers_an_area_sampled_shift(moved):
+    """Frames integrated over their pixels from one fine texture moved by whole fine pixels
+    (1/8 of a frame pixel): the shift is exact, not made by the estimator's own interpolation."""
+    fine, rows, cols = 8, 96, 128
+    rng = np.random.default_rng(3)
+    texture = cv2.resize(rng.random((rows * 2 + 8, cols * 2 + 8)).astype(np.float32),
+                         ((cols + 4) * fine, (rows + 4) * fine), interpolation=cv2.INTER_CUBIC)
+    texture = np.maximum(cv2.GaussianBlur(texture, (0, 0), fine * 0.5) + 0.2, 0.05)
+
+    def frame(d_row, d_col):
+        crop = texture[2 * fine - d_row:2 * fine - d_row + rows * fine, 2 * fine - d_col:2 * fine - d_col + cols * fine]
+        return cv2.resize(crop, (cols, rows), interpolation=cv2.INTER_AREA)
+
+    estimate, _ = shift_coarse_to_fine(frame(*moved) * 1.2, frame(0, 0), levels=1)
+    np.testing.assert_allclose(estimate, np.divide(moved, fine), atol=0.02)
