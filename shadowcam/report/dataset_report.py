@@ -109,7 +109,8 @@ def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None):
         ``dual_view (v, u, channel)``, ``coverage (v, u)``.
     dual_coords : xarray.Dataset, optional
         Its attrs: the dual grid (``method``, ``scale``, ``offset``, ``plane_window``), the
-        chosen ``model`` and ``model_choice`` (why).
+        camera kind (``projection``, named in the title), the chosen ``model`` and
+        ``model_choice`` (why).
     truth : xarray.Dataset, optional
         Lab ground truth (``reciprocal``, ``dual_cam_visible``).
 
@@ -129,7 +130,9 @@ def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None):
     if visible is not None and visible.any():
         coverage = f"coverage {(covered & visible).sum() / visible.sum():.0%} of what the camera sees"
     model = attrs.get("model", dual_view.attrs.get("dual_coords_model", "?"))
-    title = f"dual view (shadow camera), model {model}\n{coverage}"
+    kind = attrs.get("projection")
+    camera = f"{kind} shadow camera" if kind else "shadow camera"
+    title = f"dual view ({camera}), model {model}\n{coverage}"
     note = attrs.get("model_choice")
     return figures.dual_view_figure(dual, reciprocal=reciprocal, title=title,
                                     reciprocal_title="ground truth: reciprocal render from the light\nresampled onto the same dual grid",
