@@ -148,6 +148,9 @@ def test_reciprocal_panel_is_the_truth_resampled_onto_the_dual_grid():
     assert abs(rows.mean() - 40.5) <= 1 and abs(cols.mean() - 20.5) <= 1
     assert "uniform" in left.get_title() and "coverage" in left.get_title()
     assert "cross-slit shadow camera" in left.get_title()
+    planned = dual_view_report_figure(dual, dual_coords=coords, truth=truth,
+                                      camera_kind="orthographic")
+    assert "orthographic shadow camera" in planned.axes[0].get_title()
 
 
 def test_primal_figure_shows_no_demosaic_colour_fringes_on_a_grey_edge():
