@@ -576,6 +576,8 @@ def _edge_point_truth(scene):
     return {
         "edge_camera_xy": (dims + ("cam_xy",), edges.camera_xy.astype(np.float32), "pixel",
                            "camera (col, row) pixel-centre index of a point on a straight edge"),
+        "edge_world": (dims + ("xyz",), edges.world.astype(np.float32), "scene_unit",
+                       "world position of the edge point"),
         "edge_label": (dims, edges.label, "1", "straight world line of the edge point"),
         "edge_lit": (dims, edges.lit, "1", "edge point faces the light and sees its centre"),
         "edge_through_optics": (dims, edges.through_optics, "1",
