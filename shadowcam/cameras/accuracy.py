@@ -8,7 +8,9 @@ cross-slit camera, against its exact pair of times). Here:
   on the same exact edge points: their camera positions (primal) and the estimated (u, v)
   interpolated at those positions (dual), each by ``cameras.straightness.edge_straightness``.
 * parallelism (orthographic camera, IV, Fig. 7): parallel scene edges at different depths
-  stay parallel in an orthographic view: the spread of the directions of their fitted lines.
+  stay parallel in an orthographic view (the spread of the directions of their fitted lines)
+  and equal objects keep their size whatever their depth (the magnification, dual px per
+  scene unit across a family of parallel edges, of its nearer over its farther half).
 * redundancy: the dual-coordinate RMSE of the linear camera from all sweeps over that from
   two of them.
 * sweep geometry (virtual intrinsics, Fig. 12): the slant and speed of every sweep beyond the
@@ -21,6 +23,9 @@ Offers
 sample_coordinates : estimated (u, v) maps read at sub-pixel camera positions (bilinear).
 straightness_primal_dual : straightness of edges in the primal view and in the estimated dual view.
 line_direction_spread : spread (deg) of the directions of the lines fitted to labelled point sets.
+parallel_edges : parallelism and size ratio at two depths of parallel straight edges in a view.
+PARALLEL_TARGETS : tolerances of the orthographic view's parallelism (deg) and size ratio.
+parallelism_check : the orthographic check on the ground truth's straight edges, with targets.
 redundancy_gain : RMSE ratio of the linear camera from a subset of sweeps over all sweeps.
 SWEEP_GEOMETRY_TARGETS : tolerances of the measured sweep slant (deg) and speed (relative).
 sweep_geometry_errors : measured slant and speed of the extra sweeps against their declaration.
@@ -141,10 +146,131 @@ def line_direction_spread(points, labels, *, min_points=3):
         angles.append(math.atan2(vt[0, 1], vt[0, 0]))
     if len(angles) < 2:
         raise ValueError("labels: at least two edges with min_points points are needed")
+    return _angle_spread(angles)
+
+
+def _angle_spread(angles):
+    """Spread (max - min, degrees) of line angles (radians), modulo 180 deg around their mean."""
     doubled = np.exp(2j * np.array(angles))  # directions modulo 180 deg
     mean = np.angle(doubled.mean())
     offsets = np.angle(doubled * np.exp(-1j * mean)) / 2
     return float(np.degrees(offsets.max() - offsets.min()))
+
+
+def _fit_line(points):
+    """Centroid and unit direction (first principal axis) of (n, d) points."""
+    centre = points.mean(axis=0)
+    _, _, vt = np.linalg.svd(points - centre, full_matrices=False)
+    return centre, vt[0]
+
+
+def _robust_line(points, *, k=4.0, floor=1e-3):
+    """:func:`_fit_line` of the 2-D points within k robust sigmas (1.4826 MAD, at least
+    `floor`) of a first fit: drops points read across a silhouette."""
+    centre, direction = _fit_line(points)
+    normal = np.array([-direction[1], direction[0]])
+    distance = np.abs((points - centre) @ normal)
+    inlier = distance <= max(k * 1.4826 * np.median(distance), floor)
+    return _fit_line(points[inlier]) if inlier.sum() >= 2 else (centre, direction)
+
+
+def parallel_edges(points, world, labels, *, toward_light, light_position=None, min_points=5):
+    """Parallelism and size ratio at two depths of parallel straight scene edges in a view.
+
+    Edges are grouped into families of parallel world lines (world directions within
+    0.5 deg). Each edge's line in the view is fitted to its points within 4 robust sigmas
+    of a first fit (points read across a silhouette are dropped). Per family of two or
+    more edges: the spread of the directions of those lines (as
+    :func:`line_direction_spread`). For the family whose edges span the widest
+    range of depths (along `toward_light`), with four or more edges: its edges are split at
+    the median depth into a near and a far half; in each half the view position of an edge
+    across the family's direction is fitted linearly against its world position across it
+    (the magnification, view px per scene unit); ``size_ratio`` is near over far. An
+    orthographic view has spread 0 and size ratio 1; a perspective view from the light
+    magnifies near edges more (ratio about the depth ratio far / near).
+
+    Parameters
+    ----------
+    points : (N, 2) ndarray
+        View positions of the edge points (e.g. dual (u, v)); NaN rows are dropped.
+    world : (N, 3) ndarray
+        World positions of the same points (exact, on straight edges).
+    labels : (N,) int ndarray
+        Edge of each point (one straight world line per label).
+    toward_light : (3,) array_like
+        Direction from the scene toward the light (depth = distance against it).
+    light_position : (3,) array_like, optional
+        A point light's position, for ``depth_ratio`` (None: a distant light, no ratio).
+    min_points : int
+        Edges with fewer points are not used.
+
+    Returns
+    -------
+    dict
+        ``spread_deg`` (largest over the families), ``n_edges``, ``n_families``,
+        ``size_ratio``, ``depth_ratio`` (mean distance to `light_position` of the far half
+        over the near half; None for a distant light) and ``size_edges`` (edges of the
+        measured family); these three None without a family of four edges.
+    """
+    points = check_array(np.asarray(points, dtype=np.float64), "points", shape=(None, 2))
+    world = check_array(np.asarray(world, dtype=np.float64), "world", shape=(len(points), 3))
+    labels = np.asarray(labels)
+    if labels.shape != (len(points),):
+        raise ValueError(f"labels: expected shape ({len(points)},), got {labels.shape}")
+    axis = np.asarray(toward_light, dtype=np.float64)
+    if axis.shape != (3,) or not np.all(np.isfinite(axis)) or not np.linalg.norm(axis) > 0:
+        raise ValueError(f"toward_light: expected a non-zero 3-vector, got {toward_light!r}")
+    axis = axis / np.linalg.norm(axis)
+    keep = np.all(np.isfinite(points), axis=1) & np.all(np.isfinite(world), axis=1)
+    edges = []  # (label, view centre, view direction, world centre, world direction)
+    for label in np.unique(labels[keep]):
+        sel = keep & (labels == label)
+        if sel.sum() >= int(min_points):
+            edges.append((label, *_robust_line(points[sel]), *_fit_line(world[sel])))
+    if len(edges) < 2:
+        raise ValueError("labels: at least two edges with min_points points are needed")
+    families = []
+    for edge in edges:
+        home = next((f for f in families if abs(f[0][4] @ edge[4]) > math.cos(math.radians(0.5))),
+                    None)
+        if home is None:
+            families.append([edge])
+        else:
+            home.append(edge)
+    spreads = [_angle_spread([math.atan2(e[2][1], e[2][0]) for e in f])
+               for f in families if len(f) >= 2]
+    if not spreads:
+        raise ValueError("labels: no two edges are parallel in the world")
+    out = {"spread_deg": float(max(spreads)), "n_edges": len(edges),
+           "n_families": len(spreads), "size_ratio": None, "depth_ratio": None,
+           "size_edges": None}
+    wide = [f for f in families if len(f) >= 4]
+    if not wide:
+        return out
+    depth_of = lambda f: np.array([-(e[3] @ axis) for e in f])  # noqa: E731
+    family = max(wide, key=lambda f: np.ptp(depth_of(f)))
+    depth = depth_of(family)
+    direction = family[0][4]
+    across = family[-1][3] - family[0][3]
+    across -= (across @ direction) * direction
+    across /= np.linalg.norm(across)
+    mean_dir = _fit_line(np.array([e[2] * np.sign(e[2] @ family[0][2]) for e in family]
+                                  + [-e[2] * np.sign(e[2] @ family[0][2]) for e in family]))[1]
+    normal = np.array([-mean_dir[1], mean_dir[0]])
+    w = np.array([e[3] @ across for e in family])
+    p = np.array([e[1] @ normal for e in family])
+    near = depth <= np.median(depth)
+    if near.sum() < 2 or (~near).sum() < 2:
+        return out
+    slope = [abs(np.polyfit(w[half], p[half], 1)[0]) for half in (near, ~near)]
+    ratio = None
+    if light_position is not None:
+        dist = np.linalg.norm(np.array([e[3] for e in family])
+                              - np.asarray(light_position, dtype=np.float64), axis=1)
+        ratio = float(dist[~near].mean() / dist[near].mean())
+    out.update(size_ratio=float(slope[0] / slope[1]), depth_ratio=ratio,
+               size_edges=len(family))
+    return out
 
 
 def redundancy_gain(errors_subset, errors_all):
@@ -403,6 +529,65 @@ def straightness_check(dual_coords, ground_truth, *, min_points=5):
                     "pass": bool(value <= DUAL_STRAIGHTNESS_TARGET)}
 
 
+#: orthographic view: largest spread of parallel edges' directions (deg), largest |size
+#: ratio - 1| of equal objects at two depths
+PARALLEL_TARGETS = {"dual_parallel_spread_deg": 0.5, "dual_size_ratio_error": 0.01}
+
+
+def parallelism_check(dual_coords, ground_truth, *, min_points=5):
+    """The orthographic check on the ground truth's straight edges, with its targets.
+
+    The lit edge points' estimated (u, v) (read at their exact camera positions) go to
+    :func:`parallel_edges` with their world positions and the light of the ground truth's
+    ``geometry`` attr.
+
+    Parameters
+    ----------
+    dual_coords : xarray.Dataset
+        ``u``, ``v`` over ``(row, col)``.
+    ground_truth : xarray.Dataset
+        ``edge_camera_xy``, ``edge_world``, ``edge_label``, ``edge_lit``; attr ``geometry``.
+    min_points : int
+
+    Returns
+    -------
+    report : dict or None
+        :func:`parallel_edges` of the estimated view and, as ``truth``, of the exact one
+        (the edges' analytic dual coordinates are not stored: the estimate's own edge set);
+        None without edge points.
+    targets : list of dict
+        ``dual_parallel_spread_deg`` and ``dual_size_ratio_error`` rows
+        (:data:`PARALLEL_TARGETS`).
+    """
+    import json
+
+    if "edge_world" not in ground_truth or "geometry" not in ground_truth.attrs:
+        return None, []
+    keep = ground_truth["edge_lit"].values
+    if keep.sum() < 2 * min_points:
+        return None, []
+    light = json.loads(ground_truth.attrs["geometry"])["light"]
+    world = ground_truth["edge_world"].values[keep].astype(np.float64)
+    if "direction" in light and "position" not in light:
+        toward, position = np.asarray(light["direction"], dtype=np.float64), None
+    else:
+        position = np.asarray(light["position"], dtype=np.float64)
+        toward = position - world.mean(axis=0)
+    uv = sample_coordinates(dual_coords["u"].transpose("row", "col").values,
+                            dual_coords["v"].transpose("row", "col").values,
+                            ground_truth["edge_camera_xy"].values[keep])
+    report = parallel_edges(uv, world, ground_truth["edge_label"].values[keep],
+                            toward_light=toward, light_position=position, min_points=min_points)
+    values = {"dual_parallel_spread_deg": report["spread_deg"],
+              "dual_size_ratio_error": (abs(report["size_ratio"] - 1.0)
+                                        if report["size_ratio"] is not None else None)}
+    targets = [{"target": name, "sweep": None, "value": value,
+                "threshold": PARALLEL_TARGETS[name], "comparison": "<=",
+                "pass": bool(value is not None and value <= PARALLEL_TARGETS[name])}
+               for name, value in values.items()]
+    return report, targets
+
+
 def add_camera_checks(report, shadow_time, ground_truth, *, camera_model, description,
                       dual_coords=None):
     """Add the camera-specific checks of a lab capture to an accuracy report (in place).
@@ -410,7 +595,9 @@ def add_camera_checks(report, shadow_time, ground_truth, *, camera_model, descri
     * three or more scene sweeps: ``sweep_geometry`` (:func:`sweep_geometry_errors`, with
       targets) and, for the linear camera, ``redundancy`` (:func:`linear_redundancy`);
     * straight edges seen through optics in the ground truth: ``straightness``
-      (:func:`straightness_check`, with its target).
+      (:func:`straightness_check`, with its target);
+    * the orthographic camera with straight edges in the ground truth: ``parallelism``
+      (:func:`parallelism_check`, with its targets).
 
     Parameters
     ----------
@@ -443,5 +630,10 @@ def add_camera_checks(report, shadow_time, ground_truth, *, camera_model, descri
         if found is not None:
             report["straightness"] = found
             report["targets"].append(target)
+        if camera_model == "orthographic":
+            found, targets = parallelism_check(dual_coords, ground_truth)
+            if found is not None:
+                report["parallelism"] = found
+                report["targets"] += targets
     report["all_targets_pass"] = bool(report["targets"]) and all(t["pass"] for t in report["targets"])
     return report

@@ -18,6 +18,7 @@ Offers ``add_parser(subparsers, name)`` and ``run(args)``.
 import logging
 from pathlib import Path
 
+from shadowcam.io.capture_plan import capture_plan
 from shadowcam.io.datasets import open_dataset
 from shadowcam.io.manifest import load_manifest
 from shadowcam.report.dataset_report import write_report_figures
@@ -59,5 +60,6 @@ def run(args):
     written = write_report_figures(args.outdir, shadow_time=open_dataset(args.shadow_time),
                                    dual_view=open_dataset(args.dual_view), truth=truth,
                                    dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None,
-                                   reference=reference, accuracy_csv=args.accuracy)
+                                   reference=reference, accuracy_csv=args.accuracy,
+                                   camera_kind=capture_plan(args.manifest).camera_model)
     LOG.info("wrote %s", ", ".join(written))

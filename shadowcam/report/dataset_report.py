@@ -96,7 +96,7 @@ def primal_image(shadow_time, reference=None):
     return lit.transpose("row", "col", ...).values
 
 
-def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None):
+def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None, camera_kind=None):
     """The dual view beside its ground truth on the same dual grid, with model and coverage.
 
     The reciprocal render is resampled onto the dual grid exactly as the accuracy
@@ -109,9 +109,12 @@ def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None):
         ``dual_view (v, u, channel)``, ``coverage (v, u)``.
     dual_coords : xarray.Dataset, optional
         Its attrs: the dual grid (``method``, ``scale``, ``offset``, ``plane_window``), the
-        chosen ``model`` and ``model_choice`` (why).
+        camera kind (``projection``, named in the title without `camera_kind`), the chosen
+        ``model`` and ``model_choice`` (why).
     truth : xarray.Dataset, optional
         Lab ground truth (``reciprocal``, ``dual_cam_visible``).
+    camera_kind : str, optional
+        The capture plan's camera model (``CapturePlan.camera_model``), named in the title.
 
     Returns
     -------
@@ -129,14 +132,17 @@ def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None):
     if visible is not None and visible.any():
         coverage = f"coverage {(covered & visible).sum() / visible.sum():.0%} of what the camera sees"
     model = attrs.get("model", dual_view.attrs.get("dual_coords_model", "?"))
-    title = f"dual view (shadow camera), model {model}\n{coverage}"
+    kind = camera_kind or attrs.get("projection")
+    camera = f"{kind.replace('_', '-')} shadow camera" if kind else "shadow camera"
+    title = f"dual view ({camera}), model {model}\n{coverage}"
     note = attrs.get("model_choice")
     return figures.dual_view_figure(dual, reciprocal=reciprocal, title=title,
                                     reciprocal_title="ground truth: reciprocal render from the light\nresampled onto the same dual grid",
                                     note=f"dual model: {note}" if note else None)
 
 
-def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv):
+def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv,
+               camera_kind):
     figures.save_png(figures.primal_figure(primal_image(shadow_time, reference)), outdir / "primal.png")
     times = shadow_time["shadow_time"]
     for sweep in times["sweep"].values:
@@ -153,7 +159,8 @@ def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, ac
                 errors[f"sweep {sweep}"] = error.where(truth["lit"]).values.ravel()
         if errors:
             figures.save_png(figures.error_histogram_figure(errors), outdir / "error_histogram.png")
-    figures.save_png(dual_view_report_figure(dual_view, dual_coords=dual_coords, truth=truth),
+    figures.save_png(dual_view_report_figure(dual_view, dual_coords=dual_coords, truth=truth,
+                                             camera_kind=camera_kind),
                      outdir / "dual_view.png")
     if accuracy_csv:
         from shadowcam.lab.accuracy import GROUND_TRUTH_DEFINITION
@@ -164,7 +171,7 @@ def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, ac
 
 
 def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, truth=None, reference=None,
-                         accuracy_csv=None):
+                         accuracy_csv=None, camera_kind=None):
     """Write the report figures of one dataset into `outdir` (replaced whole, or left as it was).
 
     Parameters
@@ -182,6 +189,8 @@ def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, tr
         Reference frame store for the primal image.
     accuracy_csv : str or Path, optional
         Accuracy table to show as ``accuracy.html``.
+    camera_kind : str, optional
+        The capture plan's camera model, named in the dual-view figure's title.
 
     Returns
     -------
@@ -191,5 +200,6 @@ def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, tr
     if accuracy_csv and not Path(accuracy_csv).is_file():
         raise FileNotFoundError(f"accuracy_csv {accuracy_csv}: no such file")
     with atomic_directory(outdir) as tmp:
-        _write_all(tmp, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv)
+        _write_all(tmp, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv,
+                   camera_kind)
     return sorted(p.name for p in Path(outdir).iterdir())

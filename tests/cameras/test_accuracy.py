@@ -189,3 +189,71 @@ def test_straightness_check_reads_the_ground_truth_edges_and_sets_its_target():
     add_camera_checks(report, None, gt, camera_model="perspective", description={"sweeps": []},
                       dual_coords=coords)
     assert report["straightness"] == found and report["all_targets_pass"]
+
+
+def _squares_capture(light_kind):
+    from shadowcam.synthetic.lab.render import prepare_capture
+    from shadowcam.synthetic.lab.scenes import make_scene
+
+    scene = make_scene("tabletop_squares", seed=3, height=64, width=64, frames=48,
+                       light_kind=light_kind)
+    return scene, prepare_capture(scene, supersample=1, calibration=False).ground_truth
+
+
+@pytest.mark.parametrize("light_kind", ["distant", "point"])
+def test_parallel_edges_of_the_exact_dual_view(light_kind):
+    """Exact dual coordinates of the squares' edges (yawed back plane: edges at different
+    depths): the orthographic dual (distant light) keeps them parallel and equal squares
+    equal; the perspective dual (point light) does neither."""
+    from shadowcam.cameras.accuracy import parallel_edges
+    from shadowcam.synthetic.lab.scene import DistantLight
+
+    from shadowcam.synthetic.lab.scenes import make_scene
+
+    scene = make_scene("tabletop_squares", seed=3, height=64, width=64, frames=48,
+                       light_kind=light_kind)
+    edges = square_edge_points(scene)
+    ok = edges.lit
+    light = scene.light
+    distant = isinstance(light, DistantLight)
+    toward = light.direction if distant else light.center - edges.world[ok].mean(axis=0)
+    found = parallel_edges(edges.dual_uv[ok], edges.world[ok], edges.label[ok],
+                           toward_light=toward, light_position=None if distant else light.center)
+    assert found["n_families"] == 2 and found["size_edges"] >= 8
+    if distant:
+        assert found["spread_deg"] < 1e-6 and abs(found["size_ratio"] - 1) < 1e-6
+        assert found["depth_ratio"] is None
+    else:  # near edges magnified: the ratio exceeds the depth ratio far / near (> 1)
+        assert found["spread_deg"] > 2.0 and found["size_ratio"] > found["depth_ratio"] > 1.05
+    with pytest.raises(ValueError, match="toward_light"):
+        parallel_edges(edges.dual_uv[ok], edges.world[ok], edges.label[ok], toward_light=[0, 0, 0])
+    with pytest.raises(ValueError, match="labels"):
+        parallel_edges(edges.dual_uv[ok][:3], edges.world[ok][:3], edges.label[ok][:3],
+                       toward_light=[0, 0, 1])
+
+
+@pytest.mark.parametrize("light_kind", ["distant", "point"])
+def test_parallelism_check_on_the_truth_times_sets_its_targets(light_kind):
+    """The check reads the ground truth's edges and light; with the analytic times as the
+    estimate (read bilinearly at the edges) the orthographic view passes both targets and
+    the perspective one fails them."""
+    import xarray as xr
+
+    from shadowcam.cameras.accuracy import PARALLEL_TARGETS, add_camera_checks, parallelism_check
+
+    _, gt = _squares_capture(light_kind)
+    coords = xr.Dataset({"u": gt["t_u_all"], "v": gt["t_v_all"]})
+    found, targets = parallelism_check(coords, gt)
+    rows = {t["target"]: t for t in targets}
+    assert set(rows) == set(PARALLEL_TARGETS)
+    if light_kind == "distant":
+        assert rows["dual_parallel_spread_deg"]["value"] <= 0.5
+        assert rows["dual_size_ratio_error"]["value"] <= 0.01
+        assert all(t["pass"] for t in targets)
+        report = {"targets": [], "all_targets_pass": False}
+        add_camera_checks(report, None, gt, camera_model="orthographic",
+                          description={"sweeps": []}, dual_coords=coords)
+        assert report["parallelism"] == found
+    else:
+        assert not any(t["pass"] for t in targets)
+    assert parallelism_check(coords, gt.drop_vars("edge_world")) == (None, [])

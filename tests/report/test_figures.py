@@ -136,7 +136,8 @@ def test_reciprocal_panel_is_the_truth_resampled_onto_the_dual_grid():
                         "dual_cam_visible": (("v", "u"), np.ones((40, 40), bool))})
     # uniform model, two dual pixels per frame: the point lands at (u, v) = (20.5, 40.5)
     coords = xr.Dataset(attrs={"method": "uniform", "model": "uniform", "scale": [2.0, 2.0],
-                               "offset": [0.5, 0.5], "model_choice": "uniform: assumed"})
+                               "offset": [0.5, 0.5], "model_choice": "uniform: assumed",
+                               "projection": "cross-slit"})
     dual = xr.Dataset({"dual_view": (("v", "u", "channel"), np.full((80, 80, 3), 0.5, np.float32)),
                        "coverage": (("v", "u"), np.ones((80, 80), bool))})
     figure = dual_view_report_figure(dual, dual_coords=coords, truth=truth)
@@ -146,6 +147,10 @@ def test_reciprocal_panel_is_the_truth_resampled_onto_the_dual_grid():
     rows, cols = np.nonzero(shown[..., 0] > 0.9 * shown[..., 0].max())
     assert abs(rows.mean() - 40.5) <= 1 and abs(cols.mean() - 20.5) <= 1
     assert "uniform" in left.get_title() and "coverage" in left.get_title()
+    assert "cross-slit shadow camera" in left.get_title()
+    planned = dual_view_report_figure(dual, dual_coords=coords, truth=truth,
+                                      camera_kind="orthographic")
+    assert "orthographic shadow camera" in planned.axes[0].get_title()
 
 
 def test_primal_figure_shows_no_demosaic_colour_fringes_on_a_grey_edge():

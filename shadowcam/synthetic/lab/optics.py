@@ -22,6 +22,8 @@ reflect, refract : mirror reflection ``r = d - 2 (d.n) n`` and Snell's law (with
     internal reflection) for batches of unit directions.
 BentRays, trace_through_optics : follow camera rays through the elements.
 intersect_through_optics : scene hits of camera rays after the elements (``raycast.RayHits``).
+camera_pixels_of_points : the camera pixel whose bent ray meets each given scene point first
+    (the inverse of the bent view; where it exists, the camera sees the point).
 mirror_setup, glass_setup, OPTICS_SETUPS, optics_setup : build a set-up (elements and the
     camera that looks through them) from a capture description ``{"kind": ..., ...}``.
 """
@@ -38,7 +40,7 @@ from shadowcam.synthetic.lab.raycast import (
     intersect_sphere,
     occluded,
 )
-from shadowcam.synthetic.lab.scene import PinholeCamera, look_at_camera
+from shadowcam.synthetic.lab.scene import PinholeCamera, camera_rays, look_at_camera
 
 
 def _vec(value, name):
@@ -375,6 +377,125 @@ def intersect_through_optics(objects, optics, origins, directions, *, max_intera
     hits = RayHits(distance=distance, point=point, normal=normal, object_id=object_id,
                    albedo=albedo)
     return hits, bent
+
+
+def _bent_offset(optics, camera, target, x, y):
+    """Bent rays through pixel-edge (x, y): (N, 3) offset of `target` from the ray's last
+    segment (perpendicular to it), the distance along it, and its origin and direction."""
+    origins, dirs = camera_rays(camera, x, y)
+    bent = trace_through_optics(optics, origins, dirs)
+    rel = target - bent.origins
+    along = np.einsum("nk,nk->n", rel, bent.directions)
+    return rel - along[:, None] * bent.directions, along, bent
+
+
+def _solve_pixel(optics, camera, target, x, y, *, iterations, step):
+    """Gauss-Newton on pixel-edge (x, y) so that the bent ray passes through `target`
+    (N, 3), at most one pixel per step; returns x, y, the ray's miss distance in pixels
+    (inf where the ray is not valid), the distance along it, and the bent rays."""
+    for k in range(iterations + 1):
+        off, along, bent = _bent_offset(optics, camera, target, x, y)
+        jx = (_bent_offset(optics, camera, target, x + step, y)[0] - off) / step
+        jy = (_bent_offset(optics, camera, target, x, y + step)[0] - off) / step
+        jac = np.stack([jx, jy], axis=-1)  # (N, 3, 2)
+        jtj = np.einsum("nki,nkj->nij", jac, jac)
+        with np.errstate(invalid="ignore"):
+            det = np.linalg.det(np.nan_to_num(jtj, nan=0.0))
+        good = np.isfinite(det) & (det > 0) & bent.valid & (along > 0)
+        footprint = np.sqrt(np.sqrt(np.where(good, det, np.nan)))  # scene units per pixel
+        miss_px = np.where(good, np.linalg.norm(off, axis=1) / footprint, np.inf)
+        if k == iterations or not np.any(good & (miss_px > 1e-6)):
+            break  # (x, y) are where miss_px was measured
+        delta = np.zeros((len(target), 2))
+        jtr = np.einsum("nki,nk->ni", jac[good], -off[good])
+        delta[good] = np.linalg.solve(jtj[good], jtr[..., None])[..., 0]
+        delta /= np.maximum(np.linalg.norm(delta, axis=1, keepdims=True), 1.0)
+        x, y = x + delta[:, 0], y + delta[:, 1]
+    return x, y, miss_px, footprint, bent
+
+
+def camera_pixels_of_points(objects, optics, camera, points, *, tolerance=0.01,
+                            iterations=12, step=0.05, starts=4):
+    """Camera pixel whose ray, bent by the optics, meets each scene point first.
+
+    The inverse of the bent view. Per point P, Gauss-Newton on the pixel-edge coordinates
+    x makes the bent ray through x pass through P: it minimises P's offset from the ray's
+    last segment (smooth in x away from the optics' rims), with its Jacobian from finite
+    differences of `step` pixel and steps of at most one pixel. It starts at the pixel
+    centre whose scene hit lies nearest to P, then (if that fails) at the next nearest, up
+    to `starts` of them. P is seen when that ray passes within `tolerance` camera pixel of
+    it (offset / ray footprint ``(det J^T J)^(1/4)``), x lies inside the image, and the
+    ray's first scene hit is P (to the same tolerance): a point hidden behind another
+    object stays unseen. Where several rays see a point (e.g. past and through a glass
+    sphere) the first one found is returned.
+
+    Parameters
+    ----------
+    objects : sequence of scene objects
+    optics : sequence of optical elements
+    camera : PinholeCamera or OrthographicCamera
+        The primal camera whose rays the optics bend.
+    points : (N, 3) ndarray
+        Scene points (NaN rows are never seen).
+    tolerance : float
+        Largest miss in camera pixels for a point to count as seen.
+    iterations : int
+        Gauss-Newton steps.
+    step : float
+        Finite-difference step in pixels.
+    starts : int
+        Pixel centres tried as starts per point.
+
+    Returns
+    -------
+    xy : (N, 2) float64
+        Camera (col, row) pixel-centre index of each point (NaN where not seen).
+    seen : (N,) bool
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"tolerance: must be a positive number of pixels, got {tolerance!r}")
+    if int(iterations) < 1:
+        raise ValueError(f"iterations: must be >= 1, got {iterations!r}")
+    if not (np.isfinite(step) and step > 0):
+        raise ValueError(f"step: must be a positive number of pixels, got {step!r}")
+    if int(starts) < 1:
+        raise ValueError(f"starts: must be >= 1, got {starts!r}")
+    from scipy.spatial import cKDTree
+
+    n = len(points)
+    xy = np.full((n, 2), np.nan)
+    seen = np.zeros(n, dtype=bool)
+    rows, cols = np.mgrid[0:camera.height, 0:camera.width]
+    gx, gy = cols.ravel() + 0.5, rows.ravel() + 0.5
+    origins, dirs = camera_rays(camera, gx, gy)
+    grid, _ = intersect_through_optics(objects, optics, origins, dirs)
+    todo = np.flatnonzero(np.all(np.isfinite(points), axis=1))
+    if not grid.hit.any() or not len(todo):
+        return xy, seen
+    sx, sy = gx[grid.hit], gy[grid.hit]
+    k_starts = min(int(starts), len(sx))
+    _, nearest = cKDTree(grid.point[grid.hit]).query(points[todo], k=k_starts)
+    nearest = nearest.reshape(len(todo), k_starts)
+    for k in range(k_starts):  # the next nearest start for the points not seen yet
+        target = points[todo]
+        x, y, miss_px, footprint, bent = _solve_pixel(
+            optics, camera, target, sx[nearest[:, k]], sy[nearest[:, k]],
+            iterations=int(iterations), step=step)
+        hit = ((miss_px < tolerance) & (x >= 0) & (x <= camera.width) & (y >= 0)
+               & (y <= camera.height))
+        idx = np.flatnonzero(hit)
+        first = intersect_scene(objects, bent.origins[idx], bent.directions[idx])
+        gap = np.linalg.norm(np.nan_to_num(first.point - target[idx], nan=np.inf), axis=1)
+        hit[idx[~(gap < tolerance * footprint[idx])]] = False
+        seen[todo[hit]] = True
+        xy[todo[hit]] = np.stack([x[hit] - 0.5, y[hit] - 0.5], axis=1)
+        todo, nearest = todo[~hit], nearest[~hit]
+        if not len(todo):
+            break
+    return xy, seen
 
 
 # --------------------------------------------------------------------------- set-ups

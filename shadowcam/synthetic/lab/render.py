@@ -42,7 +42,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import xarray as xr
 
-from shadowcam.synthetic.lab.optics import intersect_through_optics
+from shadowcam.synthetic.lab.optics import camera_pixels_of_points, intersect_through_optics
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_scene, occluded, wire_occlusion_interval
 from shadowcam.synthetic.lab.scene import (
     DistantLight, OrthographicCamera, PinholeCamera, PointLight, camera_rays, dual_camera,
@@ -504,9 +504,10 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(),
     ``lab.virtual.SweepPairCamera`` for skewed or cross-slit views) lit by the primal camera
     as a light with the light's intensity (irradiance for a distant light): a point light at
     a pinhole camera's centre, a distant light toward an orthographic camera (Fig. 8). Its
-    pixel grid is the dual grid. The camera's optical elements play no part in it; with
-    `optics` the camera pixel of a dual point has no closed form, so ``dual_cam_visible`` is
-    False and ``dual_cam_xy`` NaN everywhere.
+    pixel grid is the dual grid. The camera's optical elements play no part in the render;
+    with `optics` a dual point is visible when a camera ray bent by them meets it first
+    (``optics.camera_pixels_of_points``, solved to 0.01 camera pixel), and ``dual_cam_xy``
+    is that ray's pixel.
 
     Parameters
     ----------
@@ -526,7 +527,8 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(),
     dict of str to ndarray
         ``reciprocal`` (n_v, n_u, 3) float32; ``dual_P`` (n_v, n_u, 3); ``dual_hit``,
         ``dual_cam_visible`` (n_v, n_u) bool (dual_P faces the camera, is unoccluded from the
-        camera centre and projects inside the image); ``dual_cam_xy`` (n_v, n_u, 2) camera
+        camera centre and projects inside the image; with optics: a bent camera ray meets
+        it first); ``dual_cam_xy`` (n_v, n_u, 2) camera
         (col, row) pixel-centre index of dual_P (NaN where not visible).
     """
     dual = dual_camera(mask, light) if dual is None else dual
@@ -539,11 +541,17 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(),
     hits = intersect_scene(objects, origins, dirs)
     _, cos_c, _, _, visible = _surface_terms(objects, hits.point, hits.normal, hits.hit,
                                              dual, swapped)
-    xy, depth = project(camera, np.nan_to_num(hits.point))
-    inside = ((depth > 0) & (xy[:, 0] >= 0) & (xy[:, 0] <= camera.width)
-              & (xy[:, 1] >= 0) & (xy[:, 1] <= camera.height))
-    visible &= inside & (not optics)
-    cam_xy = np.where(visible[:, None], xy - 0.5, np.nan)
+    if optics:
+        faces_dual = hits.hit & (cos_c > 0)
+        xy, visible = camera_pixels_of_points(objects, optics, camera,
+                                              np.where(faces_dual[:, None], hits.point, np.nan))
+        cam_xy = xy
+    else:
+        xy, depth = project(camera, np.nan_to_num(hits.point))
+        inside = ((depth > 0) & (xy[:, 0] >= 0) & (xy[:, 0] <= camera.width)
+                  & (xy[:, 1] >= 0) & (xy[:, 1] <= camera.height))
+        visible &= inside
+        cam_xy = np.where(visible[:, None], xy - 0.5, np.nan)
     shape = (dual.height, dual.width)
     return {"reciprocal": reciprocal, "dual_P": hits.point.reshape(*shape, 3),
             "dual_hit": hits.hit.reshape(shape), "dual_cam_visible": visible.reshape(shape),
@@ -568,6 +576,8 @@ def _edge_point_truth(scene):
     return {
         "edge_camera_xy": (dims + ("cam_xy",), edges.camera_xy.astype(np.float32), "pixel",
                            "camera (col, row) pixel-centre index of a point on a straight edge"),
+        "edge_world": (dims + ("xyz",), edges.world.astype(np.float32), "scene_unit",
+                       "world position of the edge point"),
         "edge_label": (dims, edges.label, "1", "straight world line of the edge point"),
         "edge_lit": (dims, edges.lit, "1", "edge point faces the light and sees its centre"),
         "edge_through_optics": (dims, edges.through_optics, "1",
@@ -749,7 +759,7 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
         "dual_P": (vu + ("xyz",), recip["dual_P"].astype(f32), "scene_unit",
                    "world point at dual pixel centre"),
         "dual_cam_visible": (vu, recip["dual_cam_visible"], "1",
-                             "dual_P visible from the camera centre and inside the image"),
+                             "dual_P seen by the camera (through its optics, if any), inside the image"),
         "dual_cam_xy": (vu + ("cam_xy",), recip["dual_cam_xy"].astype(f32), "pixel",
                         "camera (col, row) pixel-centre index of dual_P"),
     })
