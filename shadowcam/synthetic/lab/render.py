@@ -765,6 +765,9 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
                                    optics=optics)
     dual = None
     recip_name = "reciprocal render: pinhole at the light, point light at the camera"
+    if optics:
+        recip_name = ("reciprocal render: pinhole at the light, the camera's light through "
+                      "its optics")
     if scene.dual_sweeps is not None:
         from shadowcam.synthetic.lab.virtual import sweep_pair_camera  # builds on scene, sweeps
 
