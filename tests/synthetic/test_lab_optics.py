@@ -13,6 +13,7 @@ from shadowcam.synthetic.lab.optics import (
     GlassSphere,
     PlaneMirror,
     SphereMirror,
+    camera_light_through_optics,
     camera_pixels_of_points,
     intersect_through_optics,
     reflect,
@@ -22,9 +23,13 @@ from shadowcam.synthetic.lab.optics import (
 from shadowcam.synthetic.lab.render import (
     pixel_centre_ground_truth,
     prepare_capture,
+    render_image,
     render_reciprocal,
+    trace_light_paths,
 )
-from shadowcam.synthetic.lab.scene import PinholeCamera, camera_rays, dual_camera, project
+from shadowcam.synthetic.lab.scene import (
+    PinholeCamera, PointLight, camera_rays, dual_camera, project,
+)
 from shadowcam.synthetic.lab.scenes import make_scene
 
 H = W = 32
@@ -236,3 +241,68 @@ def test_camera_pixels_of_points_hides_occluded_points_and_validates():
         camera_pixels_of_points(scene.objects, slab, cam, np.zeros((3, 2)))
     with pytest.raises(ValueError, match="tolerance"):
         camera_pixels_of_points(scene.objects, slab, cam, np.zeros((1, 3)), tolerance=0)
+
+
+def _reciprocal_lit_by(scene, light):
+    """Reciprocal render of `scene`'s dual view lit by `light` (no optics), supersample 1."""
+    paths = trace_light_paths(scene.objects, dual_camera(scene.mask, scene.light), light,
+                              supersample=1)
+    return render_image(paths)
+
+
+def _assert_same_radiance(seen, expected, visible):
+    """Equal to 1e-4 relative where the camera sees the dual point (its pixels emit), on
+    at least 30 % of the dual pixels, with light on most of them."""
+    assert visible.mean() > 0.3
+    scale = expected[visible].max()
+    assert (expected[visible].sum(-1) > 1e-3 * scale).mean() > 0.5
+    np.testing.assert_allclose(seen[visible], expected[visible], atol=1e-4 * scale, rtol=1e-4)
+
+
+def test_reciprocal_light_in_a_flat_mirror_is_the_mirrored_camera_point_light():
+    """The camera's reciprocal light reflected in a plane mirror 0.05 behind it is a point
+    light 0.1 further back (the mirrored centre): same irradiance (the ray-tube Jacobian of
+    a flat mirror is that of the unfolded distance) and the same shadows."""
+    scene = make_scene("tabletop", height=H, width=W, frames=T)
+    cam = scene.camera
+    f = cam.R[2]
+    flip = np.eye(3) - 2 * np.outer(f, f)
+    real = PinholeCamera(cam.K, cam.R @ flip, cam.center, W, H)
+    mirror = PlaneMirror(cam.center - 0.05 * f, f)
+    seen = _dual(scene, real, (mirror,))
+    expected = _reciprocal_lit_by(scene, PointLight(cam.center - 0.1 * f,
+                                                    scene.light.intensity))
+    _assert_same_radiance(seen["reciprocal"], expected, seen["dual_cam_visible"])
+
+
+def test_reciprocal_light_through_a_slab_of_index_one_is_the_direct_one():
+    scene = make_scene("tabletop", height=H, width=W, frames=T)
+    cam = scene.camera
+    slab = GlassSlab(cam.center + 0.1 * cam.R[2], cam.R[2] + 0.4 * cam.R[0], 0.03, 1.0)
+    seen, direct = _dual(scene, optics=(slab,)), _dual(scene)
+    _assert_same_radiance(seen["reciprocal"], direct["reciprocal"], seen["dual_cam_visible"])
+
+
+def test_camera_light_through_optics_gain_is_inverse_square_without_bending():
+    """Through a slab of index 1 each point gets one branch with gain 1/d^2 from the camera
+    centre and the direction back to it; a point behind an occluder gets nothing."""
+    scene = make_scene("tabletop", height=H, width=W, frames=T)
+    cam = scene.camera
+    slab = (GlassSlab(cam.center + 0.1 * cam.R[2], cam.R[2], 0.03, 1.0),)
+    gt = _gt(scene, optics=slab)
+    points = gt["P"][gt["hit"]][::7]
+    to_light, gain, _ = camera_light_through_optics(scene.objects, slab, cam, points)
+    reached = gain > 0
+    assert reached.any(axis=1).mean() > 0.95 and np.all(reached.sum(axis=1) <= 1)
+    g = gain.sum(axis=1)
+    rel = cam.center - points
+    d = np.linalg.norm(rel, axis=1)
+    ok = g > 0
+    np.testing.assert_allclose(g[ok], 1.0 / d[ok] ** 2, rtol=1e-3)
+    direction = np.nansum(np.where(reached[..., None], to_light, 0.0), axis=1)
+    np.testing.assert_allclose(direction[ok], rel[ok] / d[ok, None], atol=1e-6)
+    behind = points[:1] + 0.5 * (points[:1] - cam.center)  # past the surface it lies on
+    _, gain_behind, _ = camera_light_through_optics(scene.objects, slab, cam, behind)
+    assert np.all(gain_behind == 0)
+    with pytest.raises(ValueError, match="points"):
+        camera_light_through_optics(scene.objects, slab, cam, np.zeros((3, 2)))

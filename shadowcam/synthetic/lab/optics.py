@@ -3,8 +3,9 @@
 Paper section V (Fig. 14, 15): a camera that sees the scene reflected in a curved mirror
 (a catadioptric view) or through thick glass gets a distorted image, while the light reaches
 the scene directly, so the dual view from a perspective light is free of that distortion.
-The elements here act on the camera's primary rays only: they are invisible to the light,
-to the scene's shadow rays, to the wire and to the reciprocal render.
+The elements here act on the camera's rays only: they are invisible to the light, to the
+scene's shadow rays and to the wire; the reciprocal render's light is the camera's, so it
+leaves through them (``camera_light_through_optics``).
 
 A primary ray is followed through the elements (nearest surface first) until it leaves all
 of them; it then continues into the scene. A ray that meets no element sees the scene
@@ -24,6 +25,8 @@ BentRays, trace_through_optics : follow camera rays through the elements.
 intersect_through_optics : scene hits of camera rays after the elements (``raycast.RayHits``).
 camera_pixels_of_points : the camera pixel whose bent ray meets each given scene point first
     (the inverse of the bent view; where it exists, the camera sees the point).
+camera_light_through_optics : the primal camera as a light through its optics (Helmholtz
+    reciprocity): direction, exit point and irradiance gain (ray-tube Jacobian) per branch.
 mirror_setup, glass_setup, OPTICS_SETUPS, optics_setup : build a set-up (elements and the
     camera that looks through them) from a capture description ``{"kind": ..., ...}``.
 """
@@ -414,6 +417,21 @@ def _solve_pixel(optics, camera, target, x, y, *, iterations, step):
     return x, y, miss_px, footprint, bent
 
 
+def _seen_from(objects, optics, camera, target, x, y, *, tolerance, iterations, step):
+    """Solve the bent ray through `target` (N, 3) from pixel-edge starts (x, y): returns
+    x, y, seen (the ray passes within `tolerance` pixel, inside the image, and its first
+    scene hit is the target), the ray footprint (scene units per pixel) and the bent rays."""
+    x, y, miss_px, footprint, bent = _solve_pixel(optics, camera, target, x, y,
+                                                  iterations=int(iterations), step=step)
+    hit = ((miss_px < tolerance) & (x >= 0) & (x <= camera.width) & (y >= 0)
+           & (y <= camera.height))
+    idx = np.flatnonzero(hit)
+    first = intersect_scene(objects, bent.origins[idx], bent.directions[idx])
+    gap = np.linalg.norm(np.nan_to_num(first.point - target[idx], nan=np.inf), axis=1)
+    hit[idx[~(gap < tolerance * footprint[idx])]] = False
+    return x, y, hit, footprint, bent
+
+
 def camera_pixels_of_points(objects, optics, camera, points, *, tolerance=0.01,
                             iterations=12, step=0.05, starts=4):
     """Camera pixel whose ray, bent by the optics, meets each scene point first.
@@ -480,22 +498,116 @@ def camera_pixels_of_points(objects, optics, camera, points, *, tolerance=0.01,
     _, nearest = cKDTree(grid.point[grid.hit]).query(points[todo], k=k_starts)
     nearest = nearest.reshape(len(todo), k_starts)
     for k in range(k_starts):  # the next nearest start for the points not seen yet
-        target = points[todo]
-        x, y, miss_px, footprint, bent = _solve_pixel(
-            optics, camera, target, sx[nearest[:, k]], sy[nearest[:, k]],
-            iterations=int(iterations), step=step)
-        hit = ((miss_px < tolerance) & (x >= 0) & (x <= camera.width) & (y >= 0)
-               & (y <= camera.height))
-        idx = np.flatnonzero(hit)
-        first = intersect_scene(objects, bent.origins[idx], bent.directions[idx])
-        gap = np.linalg.norm(np.nan_to_num(first.point - target[idx], nan=np.inf), axis=1)
-        hit[idx[~(gap < tolerance * footprint[idx])]] = False
+        x, y, hit, _, _ = _seen_from(objects, optics, camera, points[todo],
+                                     sx[nearest[:, k]], sy[nearest[:, k]],
+                                     tolerance=tolerance, iterations=iterations, step=step)
         seen[todo[hit]] = True
         xy[todo[hit]] = np.stack([x[hit] - 0.5, y[hit] - 0.5], axis=1)
         todo, nearest = todo[~hit], nearest[~hit]
         if not len(todo):
             break
     return xy, seen
+
+
+def _emitted_per_pixel(camera, x, y):
+    """(N,) measure the camera-as-light emits into per square pixel at pixel-edge (x, y):
+    solid angle ``|det K^-1| / |K^-1 (x, y, 1)|^3`` (sr) for a pinhole, the pixel area
+    ``pixel_size^2`` for an orthographic camera."""
+    if not isinstance(camera, PinholeCamera):
+        return np.full(len(x), float(camera.pixel_size) ** 2)
+    k_inv = np.linalg.inv(camera.K)
+    rays = np.stack([x, y, np.ones_like(x)], axis=1) @ k_inv.T
+    return abs(np.linalg.det(k_inv)) / np.linalg.norm(rays, axis=1) ** 3
+
+
+def _tube_area(optics, camera, target, x, y, step):
+    """(N,) cross-section of the bent ray tube at `target` per square pixel at pixel-edge
+    (x, y): ``|dO/dx x dO/dy|`` of the target's offset O from the ray (central differences)."""
+    def d_offset(dx, dy):
+        plus = _bent_offset(optics, camera, target, x + dx, y + dy)[0]
+        minus = _bent_offset(optics, camera, target, x - dx, y - dy)[0]
+        return (plus - minus) / (2 * step)
+
+    return np.linalg.norm(np.cross(d_offset(step, 0.0), d_offset(0.0, step)), axis=1)
+
+
+def camera_light_through_optics(objects, optics, camera, points, *, tolerance=0.01,
+                                iterations=12, step=0.05, starts=2):
+    """The primal camera as a light seen from scene points, through its optics.
+
+    By Helmholtz reciprocity the camera's reciprocal light leaves its centre (a pinhole)
+    or its image plane along the viewing direction (orthographic) through its image
+    pixels and follows the camera rays bent by the optics (lossless: perfect mirrors, no
+    Fresnel loss). A point P receives it along every bent ray whose first scene hit is P;
+    rays that meet different numbers of element surfaces are different branches (e.g.
+    past and through a glass sphere, or beside and in a mirror), each solved like
+    ``camera_pixels_of_points`` from the nearest pixel centres of its own branch. The
+    ray tube carries the emitted measure of a pixel (``_emitted_per_pixel``) onto the
+    tube's cross-section at P (``_tube_area``, per square pixel, central differences of
+    `step` pixel), so the irradiance on a surface normal to the ray is ``strength * gain``
+    with ``gain = emitted per pixel / cross-section`` (the Jacobian of the optics' area change;
+    without optics ``1 / d^2`` for a pinhole and 1 for an orthographic camera).
+
+    Parameters
+    ----------
+    objects : sequence of scene objects
+    optics : sequence of optical elements
+    camera : PinholeCamera or OrthographicCamera
+    points : (N, 3) ndarray
+        Scene points (NaN rows receive nothing).
+    tolerance, iterations, step : as in ``camera_pixels_of_points``
+    starts : int
+        Pixel centres tried as starts per point and branch.
+
+    Returns
+    -------
+    to_light : (N, B, 3) float64
+        Unit direction from P back along each branch's ray (NaN where it does not reach P).
+    gain : (N, B) float64
+        Irradiance normal to the ray per unit strength (0 where the branch does not reach P).
+    origin : (N, B, 3) float64
+        Where the branch's ray leaves the optics (the camera centre for a direct ray).
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"tolerance: must be a positive number of pixels, got {tolerance!r}")
+    if int(starts) < 1:
+        raise ValueError(f"starts: must be >= 1, got {starts!r}")
+    from scipy.spatial import cKDTree
+
+    n = len(points)
+    rows, cols = np.mgrid[0:camera.height, 0:camera.width]
+    gx, gy = cols.ravel() + 0.5, rows.ravel() + 0.5
+    origins, dirs = camera_rays(camera, gx, gy)
+    grid, bent_grid = intersect_through_optics(objects, optics, origins, dirs)
+    branches = np.unique(bent_grid.interactions[grid.hit])
+    to_light = np.full((n, len(branches), 3), np.nan)
+    gain = np.zeros((n, len(branches)))
+    origin = np.full((n, len(branches), 3), np.nan)
+    finite = np.flatnonzero(np.all(np.isfinite(points), axis=1))
+    for b, count in enumerate(branches):
+        member = grid.hit & (bent_grid.interactions == count)
+        sx, sy = gx[member], gy[member]
+        k_starts = min(int(starts), len(sx))
+        _, nearest = cKDTree(grid.point[member]).query(points[finite], k=k_starts)
+        nearest = nearest.reshape(len(finite), k_starts)
+        todo = finite
+        for k in range(k_starts):
+            x, y, hit, _, bent = _seen_from(
+                objects, optics, camera, points[todo], sx[nearest[:, k]], sy[nearest[:, k]],
+                tolerance=tolerance, iterations=iterations, step=step)
+            hit &= bent.interactions == count
+            idx = todo[hit]
+            to_light[idx, b] = -bent.directions[hit]
+            origin[idx, b] = bent.origins[hit]
+            area = _tube_area(optics, camera, points[idx], x[hit], y[hit], step)
+            gain[idx, b] = _emitted_per_pixel(camera, x[hit], y[hit]) / area
+            todo, nearest = todo[~hit], nearest[~hit]
+            if not len(todo):
+                break
+    return to_light, gain, origin
 
 
 # --------------------------------------------------------------------------- set-ups

@@ -9,8 +9,9 @@ accumulated with a difference array over time (no per-frame ray casting at all).
 wire coverage of a pixel's sub-samples gives a smooth dip.
 
 Optical elements on the camera side (``optics``: mirrors, thick glass; paper section V) bend
-the primary rays only: shading, shadow times and all ground truth follow the bent ray, while
-the light, its shadow rays, the wire and the reciprocal render ignore the elements.
+the camera's rays only: shading, shadow times and all ground truth follow the bent ray, while
+the light, its shadow rays and the wire ignore the elements; the reciprocal render's light,
+the camera's, leaves through them.
 
 Radiometry: radiance ``L = f_r I cos_L / d_L^2`` (point / area samples of intensity I) or
 ``f_r E cos_L`` (distant light, irradiance E), with the reciprocal BRDF of
@@ -42,7 +43,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 import xarray as xr
 
-from shadowcam.synthetic.lab.optics import camera_pixels_of_points, intersect_through_optics
+from shadowcam.synthetic.lab.optics import (
+    camera_light_through_optics, camera_pixels_of_points, intersect_through_optics,
+)
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_scene, occluded, wire_occlusion_interval
 from shadowcam.synthetic.lab.scene import (
     DistantLight, OrthographicCamera, PinholeCamera, PointLight, camera_rays, dual_camera,
@@ -496,6 +499,38 @@ def _reciprocal_light(camera, strength):
     return PointLight(camera.center, strength)
 
 
+def _reciprocal_paths_through_optics(objects, camera, dual, strength, optics, supersample):
+    """LightPaths of the dual view lit by the primal camera through its `optics`: each dual
+    sub-sample's scene point receives ``strength * gain`` along every bent camera ray that
+    reaches it (``optics.camera_light_through_optics``); ``light`` is where that ray leaves
+    the optics."""
+    rows, cols = dual.height, dual.width
+    x, y = _subpixel_grid(rows, cols, supersample)
+    per_pixel = supersample * supersample
+    origins, dirs = camera_rays(dual, x, y)
+    hits = intersect_scene(objects, origins, dirs)
+    sel = np.flatnonzero(hits.hit)
+    points, normal = hits.point[sel], hits.normal[sel]
+    to_view = _view_dirs(dual, points)
+    to_light, gain, exit_point = camera_light_through_optics(objects, optics, camera, points)
+    strength = np.asarray(strength, dtype=np.float64)
+    parts = {"pixel": [], "points": [], "light": [], "radiance": []}
+    for b in range(gain.shape[1]):
+        with np.errstate(invalid="ignore"):
+            cos_l = (normal * to_light[:, b]).sum(axis=1)
+        ok = (gain[:, b] > 0) & (cos_l > 0) & ((normal * to_view).sum(axis=1) > 0)
+        f = _brdf(objects, hits.object_id[sel[ok]], hits.albedo[sel[ok]], normal[ok],
+                  to_light[ok, b], to_view[ok])
+        parts["pixel"].append(sel[ok] // per_pixel)
+        parts["points"].append(points[ok])
+        parts["light"].append(exit_point[ok, b])
+        parts["radiance"].append(f * strength * (gain[ok, b] * cos_l[ok])[:, None] / per_pixel)
+    cat = {k: np.concatenate(v) if v else np.zeros((0, 3)) for k, v in parts.items()}
+    return LightPaths(shape=(rows, cols), pixel=cat["pixel"].astype(np.int64),
+                      points=cat["points"], light=cat["light"], radiance=cat["radiance"],
+                      distant=False)
+
+
 def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(), dual=None):
     """The reciprocal render and the dual-pixel geometry.
 
@@ -504,8 +539,11 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(),
     ``lab.virtual.SweepPairCamera`` for skewed or cross-slit views) lit by the primal camera
     as a light with the light's intensity (irradiance for a distant light): a point light at
     a pinhole camera's centre, a distant light toward an orthographic camera (Fig. 8). Its
-    pixel grid is the dual grid. The camera's optical elements play no part in the render;
-    with `optics` a dual point is visible when a camera ray bent by them meets it first
+    pixel grid is the dual grid. With `optics` the camera's light leaves through them
+    (Helmholtz reciprocity): it reaches the scene along the bent camera rays through the
+    image pixels, with the irradiance their ray tubes carry
+    (``optics.camera_light_through_optics``); a dual point is visible when a camera ray
+    bent by them meets it first
     (``optics.camera_pixels_of_points``, solved to 0.01 camera pixel), and ``dual_cam_xy``
     is that ray's pixel.
 
@@ -534,7 +572,11 @@ def render_reciprocal(objects, camera, light, mask, *, supersample=4, optics=(),
     dual = dual_camera(mask, light) if dual is None else dual
     strength = light.irradiance if isinstance(light, DistantLight) else light.intensity
     swapped = _reciprocal_light(camera, strength)
-    paths = trace_light_paths(objects, dual, swapped, supersample=supersample)
+    if optics:
+        paths = _reciprocal_paths_through_optics(objects, camera, dual, strength, optics,
+                                                 int(supersample))
+    else:
+        paths = trace_light_paths(objects, dual, swapped, supersample=supersample)
     reciprocal = render_image(paths)
     x, y = _pixel_centres(dual)
     origins, dirs = camera_rays(dual, x, y)
@@ -723,6 +765,9 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
                                    optics=optics)
     dual = None
     recip_name = "reciprocal render: pinhole at the light, point light at the camera"
+    if optics:
+        recip_name = ("reciprocal render: pinhole at the light, the camera's light through "
+                      "its optics")
     if scene.dual_sweeps is not None:
         from shadowcam.synthetic.lab.virtual import sweep_pair_camera  # builds on scene, sweeps
 
