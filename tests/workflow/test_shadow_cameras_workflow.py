@@ -72,10 +72,6 @@ def test_every_shadow_camera_runs_from_its_manifest_to_accuracy(tmp_path, workfl
         # the dual image scored where the camera sees the dual point through the optics
         dual_image = report["dual_image"]
         assert dual_image["n_mask"] >= 300 and dual_image["covered_not_visible"] <= 0.03, ds
-    # glass: the reciprocal render's radiometry holds (one gain), as for the direct cameras
-    glass = json.loads((Path(workdir) / "results" / "synthetic_glass" / "accuracy.json")
-                       .read_text())
-    assert glass["dual_image"]["rel_rmse_masked"] <= 0.3, glass["dual_image"]
     # orthographic: parallel edges at different depths measured in the estimated dual view;
     # bounded by half the perspective contrast of the same scene (exact: 6.2 deg, ratio 1.29)
     ortho = json.loads((Path(workdir) / "results" / "synthetic_orthographic" / "accuracy.json")
