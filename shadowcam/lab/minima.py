@@ -8,10 +8,13 @@ passes over the frames, memory independent of their number:
    smoothed local minima (its candidate list); the ``count`` deepest that lie
    more than ``half_window`` frames from each other are the pixel's minima
    (:func:`select_minima`), and one more (``extra_*``) tells whether the pixel
-   has more dips than expected;
-2. a second pass keeps the raw samples around each minimum, and the level and
-   noise of the frames outside every window (noise from first differences, so
-   that a slowly varying lit level, as under a moving light, does not count).
+   has more dips than expected; a minimum between which and a deeper one the
+   signal does not come back to the deeper dip's half depth is part of that dip
+   (a flat or rippled bottom, overlapping shadows) and is dropped;
+2. a second pass keeps the raw samples within ``2 * half_window`` frames of each minimum, and the level and
+   noise of the frames more than ``half_window`` frames from every minimum (noise
+   from first differences, so that a slowly varying lit level, as under a moving
+   light, does not count).
 
 Each minimum is then timed like a single dip: its window is cut where it meets
 the next minimum's (each sample belongs to the nearest minimum), normalised by
@@ -72,14 +75,14 @@ class Minima:
     reason : (K, H, W) int8
         :data:`MINIMUM_REASONS`.
     count : (H, W) int64
-        Minima found (at most K).
+        Significant minima found (neither missing nor low contrast; at most K).
     extra_contrast : (H, W) float64
         Contrast of the deepest further minimum (the (K+1)-th; 0 where none): a
         significant one means the pixel has more dips than K.
     noise : (H, W) float64
         Temporal noise of one raw sample.
     lit_level : (H, W) float64
-        Mean signal outside every window.
+        Mean signal more than ``half_window`` frames from every minimum.
     n_frames : int
     significance : float
         Contrast, in units of the smoothed-sample noise relative to the level,
@@ -174,11 +177,13 @@ def _signal(block):
 
 
 class _WindowPass:
-    """Second pass: raw windows around given frames, lit statistics outside them."""
+    """Second pass: raw windows around given frames, lit statistics more than `lit_gap`
+    frames from all of them."""
 
-    def __init__(self, centres, half_window):
+    def __init__(self, centres, half_window, lit_gap):
         self.centres = centres  # (K, P) int64, -1 = none
         self.h = half_window
+        self.lit_gap = lit_gap
         k, p = centres.shape
         self.window = np.full((k, 2 * half_window + 1, p), np.nan, np.float32)
         self.lit_sum = np.zeros(p)
@@ -198,7 +203,9 @@ class _WindowPass:
             tt, pp = np.nonzero(inside[k])
             self.window[k, offset[k, tt, pp], pp] = flat[tt, pp]
             self.invalid[k] += (inside[k] & ~np.isfinite(flat)).sum(axis=0)
-        outside = ~inside.any(axis=0) & np.isfinite(flat)
+        near = (self.centres[:, None, :] >= 0) & (np.abs(t[None, :, None] - self.centres[:, None, :])
+                                                  <= self.lit_gap)
+        outside = ~near.any(axis=0) & np.isfinite(flat)
         self.lit_sum += np.where(outside, flat, 0.0).sum(axis=0)
         self.lit_count += outside.sum(axis=0)
         before = np.concatenate([self.previous[None] if self.previous is not None
@@ -240,6 +247,42 @@ def _line_level(window, trusted_left, trusted_right):
     return anchor[:, None] + slope[:, None] * (idx - x0[:, None])
 
 
+def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence):
+    """Which minima are dips of their own: (K+1, P) bool.
+
+    A minimum is part of a deeper one's dip (a flat or rippled bottom, two shadows that
+    overlap) when the signal between them never comes back to the deeper dip's half
+    depth; it is then dropped.
+    """
+    present = centres >= 0
+    level = _line_level(window, ~outside_sequence[:, 0], ~outside_sequence[:, -1])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        uncut = window / level
+    lowest = np.nanmin(np.where(np.isfinite(uncut), uncut, np.inf), axis=1)  # (K+1, P)
+    half = 0.5 * (1.0 + lowest)
+    depth_order = np.argsort(np.where(present, smoothed, np.inf), axis=0, kind="stable")
+    w = (window.shape[1] - 1) // 2
+    n = centres.shape[0]
+
+    def of(values, index):
+        return np.take_along_axis(values, index.reshape((1,) + (1,) * (values.ndim - 2) + (-1,)), 0)[0]
+
+    for r_b in range(1, n):
+        b = depth_order[r_b]
+        f_b = of(centres, b)
+        for r_a in range(r_b):
+            a = depth_order[r_a]
+            f_a = of(centres, a)
+            frames_a = of(slot_frame, a)
+            between = ((frames_a >= np.minimum(f_a, f_b)[None]) & (frames_a <= np.maximum(f_a, f_b)[None]))
+            with np.errstate(invalid="ignore"):
+                recovered = np.any(between & (of(uncut, a) >= of(half, a)[None]), axis=0)
+            merged = of(present, a) & of(present, b) & (np.abs(f_b - f_a) <= w) & ~recovered
+            columns = np.flatnonzero(merged)
+            present[b[columns], columns] = False
+    return present
+
+
 def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3):
     """The `count` deepest separated minima of each pixel, timed and classified.
 
@@ -253,7 +296,8 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     count : int
         Minima wanted per pixel (lights, or wires of one family).
     half_window : int
-        Frames kept on each side of a minimum; minima closer than this are one.
+        Minima closer than this many frames are one; each minimum is timed over the
+        ``2 * half_window`` frames on each side of its smoothed minimum.
     method : str
         A key of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS` other than
         ``edge_fit`` (which mixes neighbours' times, possibly of other minima).
@@ -284,20 +328,23 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     order = np.concatenate([order, np.full((p, 1), count)], axis=1)
     centres = np.take_along_axis(chosen, order, 1).T  # (K + 1, P)
     smoothed = np.take_along_axis(smoothed, order, 1).T
-    passing = _WindowPass(centres, h)
+    # the second pass keeps twice the tracker's half window: a flat-bottomed dip's minimum
+    # is its first lowest frame, and its whole width must still fit
+    w = 2 * h
+    passing = _WindowPass(centres, w, h)
     for block in blocks():
         passing.update(_signal(block))
     window = passing.window
+    slot_frame = centres[:, None, :] - w + np.arange(2 * w + 1)[None, :, None]  # (K+1, W, P)
+    outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
+    present = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence)
     # each sample belongs to its nearest minimum: cut the windows where they meet
-    slot_frame = centres[:, None, :] - h + np.arange(2 * h + 1)[None, :, None]  # (K+1, W, P)
-    present = centres >= 0
     distance = np.abs(slot_frame[:, :, None, :] - centres[None, None, :, :])  # (K+1, W, K+1, P)
     distance = np.where(present[None, None], distance, np.iinfo(np.int64).max)
     own = np.abs(slot_frame - centres[:, None, :])
     nearest = (own <= distance.min(axis=2))
     cut = np.where(nearest, window, np.nan)
     cut_by_other = ~nearest & np.isfinite(window)
-    outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
     level = _line_level(cut, ~outside_sequence[:, 0], ~outside_sequence[:, -1]).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         normalised = cut / level
@@ -305,11 +352,11 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         noise = np.where(passing.diff_count > 0, noise, np.nan)
         lit_level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
     k_all = count + 1
-    centre_level = level[:, h, :]
+    centre_level = level[:, w, :]
     lowest = np.nanmin(np.where(np.isfinite(normalised), normalised, np.inf), axis=1)
     contrast = np.where(present, 1.0 - lowest, np.nan)
     summary = DipSummary(
-        window=normalised.transpose(1, 0, 2).astype(np.float32), window_start=centres - h,
+        window=normalised.transpose(1, 0, 2).astype(np.float32), window_start=centres - w,
         minimum_frame=centres, minimum_value=(1.0 - contrast).astype(np.float32),
         second_value=np.full((k_all, p), np.inf, np.float32), second_frame=np.full((k_all, p), -1),
         lit_level=np.ones((k_all, p)), noise=noise[None] / centre_level,
@@ -334,10 +381,16 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     estimate = np.where(present, estimate, np.nan)
     time = np.where(reason == OK, estimate, np.nan)
     extra_contrast = np.where(present[count] & strong[count], contrast[count], 0.0)
-    found = present[:count].sum(axis=0)
+    found = (present & strong)[:count].sum(axis=0)
+
+    # order along the sweep again, minima merged into deeper ones last
+    perm = np.argsort(np.where(present[:count], centres[:count], np.iinfo(np.int64).max), axis=0,
+                      kind="stable")
+    centres = np.where(present, centres, -1)
 
     def image(a):
-        return np.asarray(a)[:count].reshape(count, rows, cols)
+        a = np.broadcast_to(np.asarray(a), (k_all, p))[:count]
+        return np.take_along_axis(a, perm, 0).reshape(count, rows, cols)
 
     return Minima(time=image(time), estimate=image(estimate), frame=image(centres),
                   depth=image(contrast * centre_level), contrast=image(contrast), level=image(centre_level),
