@@ -223,7 +223,8 @@ class _WindowPass:
 def _line_level(window, trusted_left, trusted_right):
     """Lit level at each window slot, ``(K, W, P)``: the line through the means of the first
     and last two valid samples; a side whose window runs past the sequence (untrusted: its
-    first valid samples may lie in the dip) takes the other side's level (NaN if neither)."""
+    first valid samples may lie in the dip) counts only when its samples are within a tenth
+    of the dip's depth of the other side's level, else takes the other side's level (NaN if neither)."""
     n = window.shape[1]
     valid = np.isfinite(window)
     idx = np.arange(n)[None, :, None]
@@ -238,7 +239,13 @@ def _line_level(window, trusted_left, trusted_right):
                     np.where(pick, idx, 0).sum(axis=1) / count)
 
     (left, x_left), (right, x_right) = side(True), side(False)
-    left, right = np.where(trusted_left, left, np.nan), np.where(trusted_right, right, np.nan)
+    # an untrusted side still counts when its samples are within a tenth of the dip's depth
+    # of the trusted side's level (the dip closes inside the sequence, before them)
+    lowest = np.nanmin(np.where(valid, window, np.inf), axis=1)
+    with np.errstate(invalid="ignore"):
+        left_ok = trusted_left | (trusted_right & (left - lowest > 0.9 * (right - lowest)))
+        right_ok = trusted_right | (trusted_left & (right - lowest > 0.9 * (left - lowest)))
+    left, right = np.where(left_ok, left, np.nan), np.where(right_ok, right, np.nan)
     both = np.isfinite(left) & np.isfinite(right) & (x_right > x_left)
     with np.errstate(invalid="ignore", divide="ignore"):
         slope = np.where(both, (right - left) / (x_right - x_left), 0.0)
@@ -247,15 +254,18 @@ def _line_level(window, trusted_left, trusted_right):
     return anchor[:, None] + slope[:, None] * (idx - x0[:, None])
 
 
-def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence):
-    """Which minima are dips of their own: (K+1, P) bool.
+def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence, detectable):
+    """Which minima are dips of their own, and which are deeper than `detectable` (P,).
 
     A minimum is part of a deeper one's dip (a flat or rippled bottom, two shadows that
     overlap) when the signal between them never comes back to the deeper dip's half
-    depth; it is then dropped.
+    depth; it is then dropped (``present`` False). Minima not deeper than `detectable`
+    below their level (``dip`` False) cut no other minimum's window.
     """
     present = centres >= 0
     level = _line_level(window, ~outside_sequence[:, 0], ~outside_sequence[:, -1])
+    with np.errstate(invalid="ignore"):
+        dip = level[:, (window.shape[1] - 1) // 2] - smoothed > detectable[None]
     with np.errstate(invalid="ignore", divide="ignore"):
         uncut = window / level
     lowest = np.nanmin(np.where(np.isfinite(uncut), uncut, np.inf), axis=1)  # (K+1, P)
@@ -280,7 +290,7 @@ def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence):
             merged = of(present, a) & of(present, b) & (np.abs(f_b - f_a) <= w) & ~recovered
             columns = np.flatnonzero(merged)
             present[b[columns], columns] = False
-    return present
+    return present, dip
 
 
 def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3):
@@ -337,10 +347,15 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     window = passing.window
     slot_frame = centres[:, None, :] - w + np.arange(2 * w + 1)[None, :, None]  # (K+1, W, P)
     outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
-    present = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence)
-    # each sample belongs to its nearest minimum: cut the windows where they meet
+    with np.errstate(invalid="ignore", divide="ignore"):
+        noise = np.sqrt(passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0)
+        noise = np.where(passing.diff_count > 0, noise, np.nan)
+    significance = detection_threshold(n_frames, false_alarm=false_alarm) * _SMOOTHED_NOISE
+    present, dip = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence,
+                                      significance * noise)
+    # each sample belongs to its nearest dip: cut the windows where they meet
     distance = np.abs(slot_frame[:, :, None, :] - centres[None, None, :, :])  # (K+1, W, K+1, P)
-    distance = np.where(present[None, None], distance, np.iinfo(np.int64).max)
+    distance = np.where((present & dip)[None, None], distance, np.iinfo(np.int64).max)
     own = np.abs(slot_frame - centres[:, None, :])
     nearest = (own <= distance.min(axis=2))
     cut = np.where(nearest, window, np.nan)
@@ -348,8 +363,6 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     level = _line_level(cut, ~outside_sequence[:, 0], ~outside_sequence[:, -1]).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         normalised = cut / level
-        noise = np.sqrt(passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0)
-        noise = np.where(passing.diff_count > 0, noise, np.nan)
         lit_level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
     k_all = count + 1
     centre_level = level[:, w, :]
@@ -364,7 +377,6 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         invalid_count=passing.invalid, n_frames=n_frames)
     with np.errstate(invalid="ignore", divide="ignore"):
         estimate, entry, exit_, std = (np.asarray(a, np.float64) for a in SHADOW_TIME_METHODS[method](summary))
-    significance = detection_threshold(n_frames, false_alarm=false_alarm) * _SMOOTHED_NOISE
     with np.errstate(invalid="ignore", divide="ignore"):
         # the smoothed minimum's depth against the smoothed-sample noise
         strong = centre_level - smoothed > significance * noise[None]
