@@ -30,6 +30,8 @@ array_accuracy : coordinate RMSE per camera, rectification and disparity against
     renderer's wire times, and the views against the reciprocal renders.
 """
 
+import warnings
+
 import numpy as np
 import xarray as xr
 
@@ -80,7 +82,8 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     # identical wires cast dips of like depth: a minimum less than half as deep as the
     # pixel's deepest (the lit level's own variation under the moving light) is no wire's
     significant = (minima.reason != _m.MISSING) & (minima.reason != _m.LOW_CONTRAST)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # pixels without minima
         deepest = np.nanmax(np.where(significant, minima.contrast, np.nan), axis=0)
         wire_like = significant & (minima.contrast >= 0.5 * deepest)
         extra = minima.extra_contrast >= 0.5 * deepest
@@ -92,7 +95,8 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     reason[(found != n_wires) | extra] = MINIMA_COUNT
     if n_wires > 1:
         gaps = np.diff(estimate, axis=0)
-        with np.errstate(invalid="ignore"):
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # pixels without minima
             uneven = ((np.nanmax(gaps, axis=0) - np.nanmin(gaps, axis=0) > tolerance)
                       | (np.nanmin(gaps, axis=0) < spacing_frames - tolerance))
         reason[(reason == OK) & uneven] = UNEVEN_GAPS
@@ -110,7 +114,8 @@ def _place_partial(times, reason, est, found, n_frames, n_wires, spacing_frames,
     candidates = (found >= 2) & (found < n_wires) & ~extra & (reason == MINIMA_COUNT)
     if not candidates.any():
         return
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # pixels without minima
         gaps = np.diff(est, axis=0)
         even = ((np.nanmax(gaps, axis=0) - np.nanmin(gaps, axis=0) <= tolerance)
                 & (np.nanmin(gaps, axis=0) >= spacing_frames - tolerance))
@@ -226,8 +231,9 @@ def array_accuracy(array, t_vertical_wire, t_horizontal_wire, *, reciprocal=None
         them by construction, so the array is rectified to this error); ``u_rmse_per_column``
         (m): the same for the u of array column j; ``disparity_rmse``: RMS of the
         estimated neighbouring-camera gaps against the depth law (when `depth` given);
-        ``view_rmse`` (n, m): RMS of the view after the gain over the reciprocal's RMS
-        (when `reciprocal` given).
+        ``view_rmse`` (n, m): RMS of the view after the gain over the reciprocal's RMS,
+        ``view_coverage`` and ``reciprocal_coverage`` (n, m): fractions of the dual grid
+        each covers (when `reciprocal` given).
     """
     u, v = array["u"].values.astype(np.float64), array["v"].values.astype(np.float64)
     tu, tv = np.asarray(t_vertical_wire, np.float64), np.asarray(t_horizontal_wire, np.float64)
@@ -260,4 +266,52 @@ def array_accuracy(array, t_vertical_wire, t_horizontal_wire, *, reciprocal=None
                 row.append(float(np.sqrt(np.mean((gain * a[ok] - b[ok]) ** 2)) / np.sqrt(np.mean(b[ok] ** 2))))
             rel.append(row)
         out["view_rmse"] = rel
+        out["view_coverage"] = array["coverage"].values.mean(axis=(2, 3)).tolist()
+        out["reciprocal_coverage"] = (truth.sum(-1) > 0).mean(axis=(2, 3)).tolist()
     return out
+
+
+def camera_array_of_capture(capture, *, tolerance=0.5, method="mesh"):
+    """:func:`camera_array` of a capture dataset (:func:`shadowcam.synthetic.lab.array_capture.render_array_capture`).
+
+    Parameters
+    ----------
+    capture : xarray.Dataset
+        With ``frames_horizontal``, ``frames_vertical``, ``crossing_images`` and attr
+        ``spacing_frames``.
+    tolerance, method
+        See :func:`camera_array`.
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    missing = {"frames_horizontal", "frames_vertical", "crossing_images"} - set(capture)
+    if missing or "spacing_frames" not in capture.attrs:
+        raise ValueError(f"capture: not a camera-array capture (missing {sorted(missing) or 'spacing_frames'}); "
+                         "render it with the render-array step")
+    return camera_array(capture["frames_horizontal"].values, capture["frames_vertical"].values,
+                        capture["crossing_images"].values, spacing_frames=float(capture.attrs["spacing_frames"]),
+                        tolerance=tolerance, method=method)
+
+
+def capture_accuracy(array, capture):
+    """:func:`array_accuracy` against a rendered capture's ground truth.
+
+    Parameters
+    ----------
+    array : xarray.Dataset
+        From :func:`camera_array`.
+    capture : xarray.Dataset
+        The rendered capture (exact wire times, ``reciprocal``, ``depth``, attrs
+        ``spacing_frames`` and ``light_mask_distance``).
+
+    Returns
+    -------
+    dict
+        :func:`array_accuracy`'s figures.
+    """
+    s = float(capture.attrs["spacing_frames"])
+    return array_accuracy(array, capture["t_vertical_wire"].values, capture["t_horizontal_wire"].values,
+                          reciprocal=capture["reciprocal"].values, depth=capture["depth"].values,
+                          disparity_per_inverse_depth=(s, s * float(capture.attrs["light_mask_distance"])))

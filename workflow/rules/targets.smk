@@ -11,6 +11,11 @@ def dataset_targets(ds):
     plan = capture(ds)
     if plan.is_lightfield:
         return lightfield_targets(ds)  # workflow/rules/lightfield.smk
+    if plan.camera_array is not None:  # workflow/rules/array.smk
+        return [
+            f"results/{ds}/array/{name}"
+            for name in ("camera_array.nc", "accuracy.json", "views.png")
+        ]
     if plan.is_outdoor:
         targets = [
             f"results/{ds}/outdoor/arrival.nc",
