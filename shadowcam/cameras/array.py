@@ -77,7 +77,8 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     if frames.ndim not in (3, 4):
         raise ValueError(f"frames must be (T, H, W[, C]); got shape {frames.shape}")
     h = max(1, int(spacing_frames // 2)) if half_window is None else int(half_window)
-    minima = _m.find_minima(frames, frames.shape[1:3], count=int(n_wires), half_window=h)
+    minima = _m.find_minima(frames, frames.shape[1:3], count=int(n_wires), half_window=h,
+                            steady_level=False)  # the light moves: its level varies
     reason = np.full(minima.count.shape, OK, np.int8)
     # identical wires cast dips of like depth: a minimum less than half as deep as the
     # pixel's deepest (the lit level's own variation under the moving light) is no wire's

@@ -293,7 +293,8 @@ def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence, 
     return present, dip
 
 
-def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3):
+def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3,
+                steady_level=True):
     """The `count` deepest separated minima of each pixel, timed and classified.
 
     Parameters
@@ -313,6 +314,11 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         ``edge_fit`` (which mixes neighbours' times, possibly of other minima).
     false_alarm : float
         Probability that pure noise makes a minimum (sets ``significance``).
+    steady_level : bool
+        The lit level is the same all along the sweep (a static light): a window whose
+        ends stay more than a tenth of the dip's depth below the level of the frames far
+        from every minimum has not reached the lit level (``wide_dip``, or
+        ``overlapping`` when cut by another minimum). False under a moving light.
 
     Returns
     -------
@@ -383,7 +389,14 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     width = exit_ - entry
     reason = np.full((k_all, p), OK, np.int8)
     reason[~strong] = LOW_CONTRAST
-    open_dip = ~np.isfinite(width)
+    # under a steady level the window's ends must reach the level of the frames far from
+    # every minimum (within a tenth of the dip's depth): else the dip is wider than the
+    # window, or runs into the next one, and its crossings are not its own
+    raw_lowest = (1.0 - contrast) * centre_level
+    with np.errstate(invalid="ignore"):
+        end_level = np.minimum(level[:, 0, :], level[:, -1, :])
+        unlit_ends = ~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest))
+    open_dip = ~np.isfinite(width) | (unlit_ends if steady_level else False)
     # a cut window whose dip does not close: another minimum closer than their widths
     reason[strong & open_dip & cut_by_other.any(axis=1)] = OVERLAPPING
     reason[strong & open_dip & outside_sequence.any(axis=1)] = AT_END

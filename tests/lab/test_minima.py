@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from shadowcam.lab.minima import (
-    AT_END, INVALID, LOW_CONTRAST, MISSING, OK, OVERLAPPING, find_minima, select_minima,
+    AT_END, INVALID, LOW_CONTRAST, MISSING, OK, OVERLAPPING, WIDE, find_minima, select_minima,
 )
 
 
@@ -124,3 +124,15 @@ def test_select_minima_is_greedy_and_separated():
     np.testing.assert_allclose(value, [[0.1, 0.2, 0.3]])
     with pytest.raises(ValueError, match="count"):
         select_minima(values, frames, 0, separation=4)
+
+
+@pytest.mark.parametrize("width", [12.0, 20.0])
+def test_a_dip_wider_than_the_window_is_flagged_not_timed(width):
+    """Under a steady lit level a window whose ends stay in the dip (half_window 3: 6
+    frames each side of the minimum) cannot time it: wide_dip, no time."""
+    frames = box_dips(90, [45.0], [width], [0.3])
+    m = find_minima(frames, frames.shape[1:], count=1, half_window=3)
+    assert np.all(m.reason == WIDE) and np.all(np.isnan(m.time))
+    # a window that holds it times it
+    m = find_minima(frames, frames.shape[1:], count=1, half_window=int(width // 2) + 2)
+    np.testing.assert_allclose(m.time, 45.0, atol=1 / (8 * width) + 2e-3)
