@@ -160,6 +160,10 @@ class CapturePlan:
         ``cols``, ``spacing_frames``, ``radius_frames``) and the scene's ``frames`` (the
         light's steps across the mask plane), else None; such a capture has
         no wire sweeps to decode: its stages are ``camera_array`` only.
+    light_set : mapping or None
+        ``lights`` (the ``synthetic.lights`` entries) and ``frames`` of a rendered capture
+        lit by several lights, else None; its stages are ``light_views`` only (one shadow
+        camera per light).
     """
 
     name: str
@@ -183,6 +187,7 @@ class CapturePlan:
     strip_halo: int = 0
     lightfield: MappingProxyType = None
     camera_array: MappingProxyType = None
+    light_set: MappingProxyType = None
 
     @property
     def is_lightfield(self):
@@ -491,6 +496,24 @@ def _camera_array_plan(manifest):
     )
 
 
+def _light_set_plan(manifest):
+    synthetic = manifest["synthetic"]
+    if manifest["kind"] != "lab" or "camera" in synthetic:
+        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.lights' needs kind: lab "
+                         "and the standard u, v sweeps (no synthetic.camera block)")
+    return CapturePlan(
+        name=manifest["name"],
+        manifest_path=manifest["manifest_path"],
+        kind="lab",
+        rendered=True,
+        frame_shape=(int(synthetic["height"]), int(synthetic["width"])),
+        has_reference=True,
+        has_ground_truth=True,
+        stages=("light_views",),
+        light_set=MappingProxyType({"lights": tuple(synthetic["lights"]), "frames": int(synthetic["frames"])}),
+    )
+
+
 def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
     """Read a manifest into the plan of its capture.
 
@@ -528,6 +551,8 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         return _lightfield_plan(manifest)
     if "camera_array" in manifest.get("synthetic", {}):
         return _camera_array_plan(manifest)
+    if "lights" in manifest.get("synthetic", {}):
+        return _light_set_plan(manifest)
     path = manifest["manifest_path"]
     rendered = "synthetic" in manifest
     if rendered and "camera" in manifest["synthetic"] and manifest["kind"] == "lab":

@@ -1,7 +1,9 @@
 """One shadow camera per light from a capture lit by several lights (paper Fig. 11).
 
 Each sweep's minima are found (:func:`shadowcam.lab.minima.find_minima`) and assigned to
-the lights (:func:`shadowcam.lab.light_assignment.assign_minima`); light k's shadow
+the lights (:func:`shadowcam.lab.light_assignment.assign_minima`) in the order the lights
+sit along the wire's motion (the capture's ``light_along_*``: a light further along the
+motion needs the wire further along to shadow a point, so later); light k's shadow
 times of the u and v sweeps are its dual coordinates (uniform wire motion: the frame is
 the dual coordinate), and the reference image resampled there is the dual view from
 light k.
@@ -29,8 +31,9 @@ def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
     Parameters
     ----------
     capture : xarray.Dataset
-        ``frames_u``, ``frames_v`` (t, y, x, channel), ``reference`` (y, x, channel) and a
-        ``light`` coordinate (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`).
+        ``frames_u``, ``frames_v`` (t, y, x, channel), ``reference`` (y, x, channel), a
+        ``light`` coordinate and ``light_along_u``, ``light_along_v`` (light,): each
+        light's position along the sweep's wire motion, which orders its shadows (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`).
     half_window : int
         Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
         across the wire spreads its shadow over its projection).
@@ -44,7 +47,7 @@ def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
         ``reason`` (sweep, light, y, x) int8 (:data:`~shadowcam.lab.light_assignment.LIGHT_REASONS`),
         ``dual_view`` (light, v, u, channel) and ``coverage`` (light, v, u).
     """
-    missing = {"frames_u", "frames_v", "reference"} - set(capture)
+    missing = {"frames_u", "frames_v", "reference", "light_along_u", "light_along_v"} - set(capture)
     if missing or "light" not in capture.coords:
         raise ValueError(f"capture: not a several-lights capture (missing {sorted(missing) or 'light'}); "
                          "render it with the render-lights step")
@@ -53,7 +56,10 @@ def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
     for name in SWEEPS:
         frames = capture[f"frames_{name}"].values
         minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window)
-        per_sweep[name] = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
+        in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
+        # the k-th shadow along the sweep is the light k-th along the wire's motion
+        order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
+        per_sweep[name] = {key: value[np.argsort(order)] for key, value in in_order.items()}
     reference = capture["reference"].values
     shape = (capture.sizes["t_v"], capture.sizes["t_u"])
     views = np.full((n_lights, *shape, reference.shape[2]), np.nan, np.float32)

@@ -418,3 +418,18 @@ def test_camera_array_plan_has_only_its_stage(tmp_path):
 def test_camera_array_block_needs_its_spacing(tmp_path):
     with pytest.raises(ValueError, match="spacing_frames"):
         capture_plan(_array_manifest(tmp_path, rows=2, cols=3))
+
+
+def test_light_set_plan_has_only_its_stage(tmp_path):
+    doc = {"name": "lit", "kind": "lab", "light": "point",
+           "synthetic": {"scene": "tabletop", "seed": 1, "height": 16, "width": 20, "frames": 12,
+                         "lights": [{"kind": "point"}, {"kind": "tube", "axis": "u", "length": 0.01}]}}
+    path = tmp_path / "lit.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    plan = capture_plan(path)
+    assert plan.stages == ("light_views",) and plan.camera_array is None
+    assert len(plan.light_set["lights"]) == 2 and plan.light_set["frames"] == 12
+    doc["synthetic"]["lights"][1]["kind"] = "strip"
+    path.write_text(yaml.safe_dump(doc))
+    with pytest.raises(ValueError, match="kind"):
+        capture_plan(path)

@@ -222,11 +222,23 @@ def get_array_mem_mb(wildcards, attempt):
     )
 
 
+def get_light_set_mem_mb(wildcards, attempt):
+    """A several-lights step: the u and v sweeps' float32 RGB frames."""
+    frames = capture(wildcards.ds).light_set["frames"]
+    return get_image_mem_mb(wildcards, attempt) + attempt * math.ceil(
+        3 * 2 * frames * _frame_mb(wildcards.ds)
+    )
+
+
 def planned_mem_mb(ds):
     """Memory (MB, first attempt) of the largest job of each kind of dataset `ds`."""
     plan = capture(ds)
     if plan.camera_array is not None:
         return {"camera-array steps": get_array_mem_mb(_PlanningWildcards(ds=ds), 1)}
+    if plan.light_set is not None:
+        return {
+            "several-lights steps": get_light_set_mem_mb(_PlanningWildcards(ds=ds), 1)
+        }
     if plan.is_lightfield:
         wildcards = _PlanningWildcards(ds=ds)
         return {

@@ -16,6 +16,11 @@ def dataset_targets(ds):
             f"results/{ds}/array/{name}"
             for name in ("camera_array.nc", "accuracy.json", "views.png")
         ]
+    if plan.light_set is not None:  # workflow/rules/lights.smk
+        return [
+            f"results/{ds}/lights/{name}"
+            for name in ("light_views.nc", "accuracy.json", "lights.png")
+        ]
     if plan.is_outdoor:
         targets = [
             f"results/{ds}/outdoor/arrival.nc",

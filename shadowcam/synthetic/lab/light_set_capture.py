@@ -66,7 +66,9 @@ def render_light_set_capture(synthetic, *, light="point"):
         ``frames_u`` (t_u, y, x, channel), ``frames_v`` (t_v, y, x, channel), ``reference``
         (y, x, channel), and per sweep s the ground truth ``t_center_s``, ``t_first_s``,
         ``t_last_s`` (light, y, x) and ``share`` (light, y, x)
-        (:func:`~shadowcam.synthetic.lab.light_sets.light_set_ground_truth`).
+        (:func:`~shadowcam.synthetic.lab.light_sets.light_set_ground_truth`), and
+        ``light_along_s`` (light,): each light's centre along sweep s's wire velocity (the
+        order in which its shadows pass a point; part of the capture description).
     """
     if "lights" not in synthetic:
         raise ValueError("synthetic: no lights block; add lights: [{kind: point}, ...]")
@@ -84,5 +86,10 @@ def render_light_set_capture(synthetic, *, light="point"):
         for key in ("t_center", "t_first", "t_last"):
             data[f"{key}_{name}"] = (("light", "y", "x"), truth[key])
         data["share"] = (("light", "y", "x"), truth["share"])
+        # where each light sits along the wire's motion: its shadows pass in that order
+        direction = sweep.velocity / np.linalg.norm(sweep.velocity)
+        data[f"light_along_{name}"] = (("light",), np.array(
+            [float(np.dot(getattr(light, "center", getattr(light, "position", None)), direction))
+             for light in lights]))
     return xr.Dataset(data, coords={"channel": ["R", "G", "B"], "light": np.arange(len(lights))},
                       attrs={"lights": str(list(synthetic["lights"]))})
