@@ -195,28 +195,28 @@ class _WindowPass:
         self.next = 0
 
     def update(self, signal):
-        t = self.next + np.arange(signal.shape[0])
+        """Feed the next frames, one at a time (memory ``O(K P)`` besides the windows)."""
         flat = signal.reshape(signal.shape[0], -1)
-        offset = t[None, :, None] - (self.centres[:, None, :] - self.h)  # (K, T, P)
-        inside = (self.centres[:, None, :] >= 0) & (offset >= 0) & (offset <= 2 * self.h)
-        for k in range(self.centres.shape[0]):
-            tt, pp = np.nonzero(inside[k])
-            self.window[k, offset[k, tt, pp], pp] = flat[tt, pp]
-            self.invalid[k] += (inside[k] & ~np.isfinite(flat)).sum(axis=0)
-        near = (self.centres[:, None, :] >= 0) & (np.abs(t[None, :, None] - self.centres[:, None, :])
-                                                  <= self.lit_gap)
-        outside = ~near.any(axis=0) & np.isfinite(flat)
-        self.lit_sum += np.where(outside, flat, 0.0).sum(axis=0)
-        self.lit_count += outside.sum(axis=0)
-        before = np.concatenate([self.previous[None] if self.previous is not None
-                                 else np.full((1, flat.shape[1]), False), outside[:-1]])
-        values = np.concatenate([self.previous_value[None] if self.previous is not None
-                                 else np.zeros((1, flat.shape[1]), np.float32), flat[:-1]])
-        pair = outside & before
-        with np.errstate(invalid="ignore"):
-            self.diff_sq += np.where(pair, (flat.astype(np.float64) - values) ** 2, 0.0).sum(axis=0)
-        self.diff_count += pair.sum(axis=0)
-        self.previous, self.previous_value = outside[-1], flat[-1]
+        present = self.centres >= 0
+        columns = np.arange(flat.shape[1])
+        for index, frame in enumerate(flat):
+            t = self.next + index
+            offset = t - (self.centres - self.h)  # (K, P)
+            inside = present & (offset >= 0) & (offset <= 2 * self.h)
+            finite = np.isfinite(frame)
+            for k in range(self.centres.shape[0]):
+                cols = columns[inside[k]]
+                self.window[k, offset[k, cols], cols] = frame[cols]
+            self.invalid += inside & ~finite
+            outside = ~(present & (np.abs(t - self.centres) <= self.lit_gap)).any(axis=0) & finite
+            self.lit_sum += np.where(outside, frame, 0.0)
+            self.lit_count += outside
+            if self.previous is not None:
+                pair = outside & self.previous
+                with np.errstate(invalid="ignore"):
+                    self.diff_sq += np.where(pair, (frame.astype(np.float64) - self.previous_value) ** 2, 0.0)
+                self.diff_count += pair
+            self.previous, self.previous_value = outside, frame
         self.next += signal.shape[0]
 
 
@@ -360,10 +360,11 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     present, dip = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence,
                                       significance * noise)
     # each sample belongs to its nearest dip: cut the windows where they meet
-    distance = np.abs(slot_frame[:, :, None, :] - centres[None, None, :, :])  # (K+1, W, K+1, P)
-    distance = np.where((present & dip)[None, None], distance, np.iinfo(np.int64).max)
-    own = np.abs(slot_frame - centres[:, None, :])
-    nearest = (own <= distance.min(axis=2))
+    own = np.abs(slot_frame - centres[:, None, :])  # (K+1, W, P)
+    nearest = np.ones(own.shape, bool)
+    for other in range(centres.shape[0]):
+        cuts = (present & dip)[other]
+        nearest &= ~cuts[None, None] | (own <= np.abs(slot_frame - centres[other][None, None]))
     cut = np.where(nearest, window, np.nan)
     cut_by_other = ~nearest & np.isfinite(window)
     level = _line_level(cut, ~outside_sequence[:, 0], ~outside_sequence[:, -1]).astype(np.float64)
