@@ -38,7 +38,8 @@ import yaml
 REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 WORKFLOW_FILES = ("Snakefile", "workflow", "config", "profiles")
-SYNTHETIC_MANIFESTS = ("synthetic_tiny.yaml", "synthetic_lab.yaml")
+SYNTHETIC_MANIFESTS = ("synthetic_tiny.yaml", "synthetic_lab.yaml", "synthetic_array.yaml",
+                       "synthetic_lights.yaml")
 
 
 # --------------------------------------------------------------------------- paths

@@ -155,6 +155,15 @@ class CapturePlan:
         :data:`PLANNED_SHIFT_COLUMNS` of camera shake (outdoor only; 0 for lab).
     lightfield : mapping or None
         :func:`lightfield_facts` of a ``kind: lightfield`` capture (else None).
+    camera_array : mapping or None
+        The ``synthetic.camera_array`` block of a rendered virtual camera array (``rows``,
+        ``cols``, ``spacing_frames``, ``radius_frames``) and the scene's ``frames`` (the
+        light's steps across the mask plane), else None; such a capture has
+        no wire sweeps to decode: its stages are ``camera_array`` only.
+    light_set : mapping or None
+        ``lights`` (the ``synthetic.lights`` entries) and ``frames`` of a rendered capture
+        lit by several lights, else None; its stages are ``light_views`` only (one shadow
+        camera per light).
     """
 
     name: str
@@ -177,6 +186,8 @@ class CapturePlan:
     outdoor_sweep: str = None
     strip_halo: int = 0
     lightfield: MappingProxyType = None
+    camera_array: MappingProxyType = None
+    light_set: MappingProxyType = None
 
     @property
     def is_lightfield(self):
@@ -466,6 +477,43 @@ def _lightfield_plan(manifest):
     )
 
 
+def _camera_array_plan(manifest):
+    synthetic = manifest["synthetic"]
+    if manifest["kind"] != "lab":
+        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.camera_array' needs "
+                         f"kind: lab; got kind: {manifest['kind']}")
+    array = {"radius_frames": 0.6, **synthetic["camera_array"], "frames": int(synthetic["frames"])}
+    return CapturePlan(
+        name=manifest["name"],
+        manifest_path=manifest["manifest_path"],
+        kind="lab",
+        rendered=True,
+        frame_shape=(int(synthetic["height"]), int(synthetic["width"])),
+        has_reference=True,
+        has_ground_truth=True,
+        stages=("camera_array",),
+        camera_array=MappingProxyType(array),
+    )
+
+
+def _light_set_plan(manifest):
+    synthetic = manifest["synthetic"]
+    if manifest["kind"] != "lab" or "camera" in synthetic:
+        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.lights' needs kind: lab "
+                         "and the standard u, v sweeps (no synthetic.camera block)")
+    return CapturePlan(
+        name=manifest["name"],
+        manifest_path=manifest["manifest_path"],
+        kind="lab",
+        rendered=True,
+        frame_shape=(int(synthetic["height"]), int(synthetic["width"])),
+        has_reference=True,
+        has_ground_truth=True,
+        stages=("light_views",),
+        light_set=MappingProxyType({"lights": tuple(synthetic["lights"]), "frames": int(synthetic["frames"])}),
+    )
+
+
 def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
     """Read a manifest into the plan of its capture.
 
@@ -501,6 +549,10 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
     manifest = load_manifest(manifest_path)
     if manifest["kind"] == "lightfield":
         return _lightfield_plan(manifest)
+    if "camera_array" in manifest.get("synthetic", {}):
+        return _camera_array_plan(manifest)
+    if "lights" in manifest.get("synthetic", {}):
+        return _light_set_plan(manifest)
     path = manifest["manifest_path"]
     rendered = "synthetic" in manifest
     if rendered and "camera" in manifest["synthetic"] and manifest["kind"] == "lab":

@@ -396,3 +396,40 @@ def test_cross_slit_request_is_a_camera_or_a_clear_error(delta, offset):
         assert plan is None and "needs two sweeps, each with its own light" in error
     elif abs(math.sin(math.radians(delta))) > math.sin(math.radians(15.0)) + 1e-9:
         assert error is None and plan.camera_model == "cross_slit"
+
+
+def _array_manifest(tmp_path, **array):
+    doc = {"name": "arr", "kind": "lab", "light": "point",
+           "synthetic": {"scene": "tabletop", "seed": 1, "height": 16, "width": 20, "frames": 12,
+                         "camera_array": array}}
+    path = tmp_path / "arr.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    return path
+
+
+def test_camera_array_plan_has_only_its_stage(tmp_path):
+    plan = capture_plan(_array_manifest(tmp_path, rows=2, cols=3, spacing_frames=5))
+    assert plan.stages == ("camera_array",) and plan.rendered and plan.has_ground_truth
+    assert dict(plan.camera_array) == {"rows": 2, "cols": 3, "spacing_frames": 5, "radius_frames": 0.6,
+                                       "frames": 12}
+    assert plan.frame_shape == (16, 20) and plan.sweeps == {}
+
+
+def test_camera_array_block_needs_its_spacing(tmp_path):
+    with pytest.raises(ValueError, match="spacing_frames"):
+        capture_plan(_array_manifest(tmp_path, rows=2, cols=3))
+
+
+def test_light_set_plan_has_only_its_stage(tmp_path):
+    doc = {"name": "lit", "kind": "lab", "light": "point",
+           "synthetic": {"scene": "tabletop", "seed": 1, "height": 16, "width": 20, "frames": 12,
+                         "lights": [{"kind": "point"}, {"kind": "tube", "axis": "u", "length": 0.01}]}}
+    path = tmp_path / "lit.yaml"
+    path.write_text(yaml.safe_dump(doc))
+    plan = capture_plan(path)
+    assert plan.stages == ("light_views",) and plan.camera_array is None
+    assert len(plan.light_set["lights"]) == 2 and plan.light_set["frames"] == 12
+    doc["synthetic"]["lights"][1]["kind"] = "strip"
+    path.write_text(yaml.safe_dump(doc))
+    with pytest.raises(ValueError, match="kind"):
+        capture_plan(path)

@@ -209,9 +209,36 @@ def get_lightfield_export_mem_mb(wildcards, attempt):
     return get_lightfield_mem_mb(wildcards, attempt) + attempt * LIGHTFIELD_FAR_FIELD_MB
 
 
+def get_array_mem_mb(wildcards, attempt):
+    """A camera-array step: both experiments' float32 RGB frames and the crossing images."""
+    plan = capture(wildcards.ds)
+    array = plan.camera_array
+    spread = (
+        float(array["spacing_frames"]) * (max(array["rows"], array["cols"]) - 1) + 1
+    )
+    images = 2 * (array["frames"] + spread) + array["rows"] * array["cols"]
+    return get_image_mem_mb(wildcards, attempt) + attempt * math.ceil(
+        3 * images * _frame_mb(wildcards.ds)
+    )
+
+
+def get_light_set_mem_mb(wildcards, attempt):
+    """A several-lights step: the u and v sweeps' float32 RGB frames."""
+    frames = capture(wildcards.ds).light_set["frames"]
+    return get_image_mem_mb(wildcards, attempt) + attempt * math.ceil(
+        3 * 2 * frames * _frame_mb(wildcards.ds)
+    )
+
+
 def planned_mem_mb(ds):
     """Memory (MB, first attempt) of the largest job of each kind of dataset `ds`."""
     plan = capture(ds)
+    if plan.camera_array is not None:
+        return {"camera-array steps": get_array_mem_mb(_PlanningWildcards(ds=ds), 1)}
+    if plan.light_set is not None:
+        return {
+            "several-lights steps": get_light_set_mem_mb(_PlanningWildcards(ds=ds), 1)
+        }
     if plan.is_lightfield:
         wildcards = _PlanningWildcards(ds=ds)
         return {

@@ -11,6 +11,16 @@ def dataset_targets(ds):
     plan = capture(ds)
     if plan.is_lightfield:
         return lightfield_targets(ds)  # workflow/rules/lightfield.smk
+    if plan.camera_array is not None:  # workflow/rules/array.smk
+        return [
+            f"results/{ds}/array/{name}"
+            for name in ("camera_array.nc", "accuracy.json", "views.png")
+        ]
+    if plan.light_set is not None:  # workflow/rules/lights.smk
+        return [
+            f"results/{ds}/lights/{name}"
+            for name in ("light_views.nc", "accuracy.json", "lights.png")
+        ]
     if plan.is_outdoor:
         targets = [
             f"results/{ds}/outdoor/arrival.nc",

@@ -1,0 +1,50 @@
+"""``shadowcam light-accuracy``: score per-light shadow times against the renderer and draw them.
+
+Writes ``accuracy.json`` (per light and sweep: p95 error, RMSE, coverage, contrast,
+reason counts; :func:`shadowcam.lab.light_views.light_set_accuracy`) and a figure with
+a row per light: estimated and exact times of each sweep and the light's dual view
+(:func:`shadowcam.report.light_set_figure.light_set_mosaic`).
+
+Example::
+
+    shadowcam light-accuracy --capture results/synthetic_lights/lights/capture.nc \\
+        --views results/synthetic_lights/lights/light_views.nc \\
+        --out-json results/synthetic_lights/lights/accuracy.json \\
+        --out-png results/synthetic_lights/lights/lights.png
+
+Offers
+------
+add_parser : register the step and its options.
+run : score and draw.
+"""
+
+import json
+
+import numpy as np
+import xarray as xr
+
+from shadowcam._shared.atomic import atomic_path
+from shadowcam.io.images import write_png
+from shadowcam.lab.light_views import SWEEPS, light_set_accuracy
+from shadowcam.report.light_set_figure import light_set_mosaic
+
+
+def add_parser(subparsers, name):
+    """Register ``light-accuracy`` on `subparsers`; return its parser."""
+    parser = subparsers.add_parser(name, help="score and draw per-light shadow times")
+    parser.add_argument("--capture", required=True, help="capture.nc written by render-lights")
+    parser.add_argument("--views", required=True, help="light_views.nc written by light-views")
+    parser.add_argument("--out-json", required=True, help="results/<ds>/lights/accuracy.json")
+    parser.add_argument("--out-png", required=True, help="results/<ds>/lights/lights.png")
+    return parser
+
+
+def run(args):
+    """Write the accuracy JSON and the figure."""
+    with xr.open_dataset(args.capture) as a, xr.open_dataset(args.views) as b:
+        capture, views = a.load(), b.load()
+    with atomic_path(args.out_json) as tmp:
+        tmp.write_text(json.dumps(light_set_accuracy(views, capture), indent=2))
+    truths = np.stack([capture[f"t_center_{s}"].values for s in SWEEPS])
+    with atomic_path(args.out_png) as tmp:
+        write_png(tmp, light_set_mosaic(views["time"].values, truths, views["dual_view"].values))

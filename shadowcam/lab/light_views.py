@@ -1,0 +1,130 @@
+"""One shadow camera per light from a capture lit by several lights (paper Fig. 11).
+
+Each sweep's minima are found (:func:`shadowcam.lab.minima.find_minima`) and assigned to
+the lights (:func:`shadowcam.lab.light_assignment.assign_minima`) in the order the lights
+sit along the wire's motion (the capture's ``light_along_*``: a light further along the
+motion needs the wire further along to shadow a point, so later); light k's shadow
+times of the u and v sweeps are its dual coordinates (uniform wire motion: the frame is
+the dual coordinate), and the reference image resampled there is the dual view from
+light k.
+
+Offers
+------
+light_set_views : a several-lights capture -> per-light shadow times, reasons, contrast,
+    confidence and dual views.
+light_set_accuracy : per-light, per-sweep error and coverage against the renderer.
+"""
+
+import numpy as np
+import xarray as xr
+
+from shadowcam.cameras.dual_view import resample_dual_view
+from shadowcam.lab.light_assignment import LIGHT_REASONS, assign_minima
+from shadowcam.lab.minima import find_minima
+
+SWEEPS = ("u", "v")
+
+
+def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
+    """Per-light shadow times and dual views.
+
+    Parameters
+    ----------
+    capture : xarray.Dataset
+        ``frames_u``, ``frames_v`` (t, y, x, channel), ``reference`` (y, x, channel), a
+        ``light`` coordinate and ``light_along_u``, ``light_along_v`` (light,): each
+        light's position along the sweep's wire motion, which orders its shadows (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`).
+    half_window : int
+        Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
+        across the wire spreads its shadow over its projection).
+    radius, tolerance
+        Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``time``, ``contrast``, ``confidence``, ``time_std`` (sweep, light, y, x) float32,
+        ``reason`` (sweep, light, y, x) int8 (:data:`~shadowcam.lab.light_assignment.LIGHT_REASONS`),
+        ``dual_view`` (light, v, u, channel) and ``coverage`` (light, v, u).
+    """
+    missing = {"frames_u", "frames_v", "reference", "light_along_u", "light_along_v"} - set(capture)
+    if missing or "light" not in capture.coords:
+        raise ValueError(f"capture: not a several-lights capture (missing {sorted(missing) or 'light'}); "
+                         "render it with the render-lights step")
+    n_lights = capture.sizes["light"]
+    per_sweep = {}
+    for name in SWEEPS:
+        frames = capture[f"frames_{name}"].values
+        minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window)
+        in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
+        # the k-th shadow along the sweep is the light k-th along the wire's motion
+        order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
+        per_sweep[name] = {key: value[np.argsort(order)] for key, value in in_order.items()}
+    reference = capture["reference"].values
+    shape = (capture.sizes["t_v"], capture.sizes["t_u"])
+    views = np.full((n_lights, *shape, reference.shape[2]), np.nan, np.float32)
+    coverage = np.zeros((n_lights, *shape), bool)
+    for k in range(n_lights):
+        views[k], coverage[k] = resample_dual_view(reference, per_sweep["u"]["time"][k],
+                                                   per_sweep["v"]["time"][k], shape=shape)
+    dims = ("sweep", "light", "y", "x")
+
+    def stacked(key, dtype):
+        return (dims, np.stack([per_sweep[s][key] for s in SWEEPS]).astype(dtype))
+
+    return xr.Dataset(
+        {"time": stacked("time", np.float32), "contrast": stacked("contrast", np.float32),
+         "confidence": stacked("confidence", np.float32), "time_std": stacked("time_std", np.float32),
+         "reason": stacked("reason", np.int8),
+         "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage)},
+        coords={"sweep": list(SWEEPS), "light": capture["light"].values, "channel": capture["channel"].values},
+        attrs={"reasons": str(LIGHT_REASONS), "half_window": int(half_window), "radius": int(radius),
+               "tolerance": float(tolerance)})
+
+
+def light_set_accuracy(views, capture, *, min_level=0.2):
+    """Per-light, per-sweep accuracy against the renderer's per-light times.
+
+    Parameters
+    ----------
+    views : xarray.Dataset
+        From :func:`light_set_views`.
+    capture : xarray.Dataset
+        With ``t_center_s``, ``t_first_s``, ``t_last_s`` (light, y, x) and ``reference``.
+    min_level : float
+        Pixels darker than this fraction of the median reference are not scored.
+
+    Returns
+    -------
+    dict
+        ``lights``: one entry per light with, per sweep, ``p95_error``, ``rmse`` and
+        ``max_error`` (frames, over its timed scored pixels), ``coverage`` (timed fraction
+        of the scored pixels: lit, the light's shadow entirely inside the sweep),
+        ``n_scored``, ``contrast`` (median) and ``reasons`` (name -> count).
+    """
+    level = capture["reference"].values.sum(-1)
+    lit = level > min_level * np.median(level)
+    out = []
+    for k in range(capture.sizes["light"]):
+        entry = {}
+        for s, name in enumerate(SWEEPS):
+            n = capture.sizes[f"t_{name}"]
+            truth = capture[f"t_center_{name}"].values[k]
+            scored = (lit & np.isfinite(truth) & (capture[f"t_first_{name}"].values[k] > 2)
+                      & (capture[f"t_last_{name}"].values[k] < n - 3))
+            time = views["time"].values[s, k]
+            reason = views["reason"].values[s, k]
+            err = np.abs(time - truth)[scored]
+            timed = np.isfinite(err)
+            contrast = views["contrast"].values[s, k][scored]
+            entry[name] = {
+                "p95_error": float(np.percentile(err[timed], 95)) if timed.any() else None,
+                "rmse": float(np.sqrt(np.mean(err[timed] ** 2))) if timed.any() else None,
+                "max_error": float(err[timed].max()) if timed.any() else None,
+                "coverage": float(timed.mean()) if scored.any() else 0.0,
+                "n_scored": int(scored.sum()),
+                "contrast": float(np.nanmedian(contrast)) if np.isfinite(contrast).any() else None,
+                "reasons": {label: int(np.sum(reason[scored] == code)) for code, label in LIGHT_REASONS.items()},
+            }
+        out.append(entry)
+    return {"lights": out}

@@ -1,0 +1,426 @@
+"""Several intensity dips per pixel: the K deepest separated minima of a sweep.
+
+Under several lights (paper Fig. 11) or a mask of several wires (paper Fig. 6) a
+pixel's signal dips once per shadow. The minima are found in two streaming
+passes over the frames, memory independent of their number:
+
+1. the :class:`~shadowcam.lab.dip_tracker.DipTracker` keeps each pixel's deepest
+   smoothed local minima (its candidate list); the ``count`` deepest that lie
+   more than ``half_window`` frames from each other are the pixel's minima
+   (:func:`select_minima`), and one more (``extra_*``) tells whether the pixel
+   has more dips than expected; a minimum between which and a deeper one the
+   signal does not come back to the deeper dip's half depth is part of that dip
+   (a flat or rippled bottom, overlapping shadows) and is dropped;
+2. a second pass keeps the raw samples within ``2 * half_window`` frames of each minimum, and the level and
+   noise of the frames more than ``half_window`` frames from every minimum (noise
+   from first differences, so that a slowly varying lit level, as under a moving
+   light, does not count).
+
+Each minimum is then timed like a single dip: its window is cut where it meets
+the next minimum's (each sample belongs to the nearest minimum), normalised by
+the lit level interpolated between the window's ends (a straight line), and
+passed to a timing method of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS`.
+
+Offers
+------
+MINIMUM_REASONS : reason code -> meaning, per minimum.
+Minima : per-minimum times, depths, widths, uncertainties and reasons.
+select_minima : the K deepest separated minima among candidate lists.
+find_minima : two streaming passes over a sweep's frames -> :class:`Minima`.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from shadowcam._shared.validation import check_in, check_positive
+from shadowcam.lab.dip_tracker import DipSummary, DipTracker
+from shadowcam.lab.shadow_time import _SMOOTHED_NOISE, SHADOW_TIME_METHODS, detection_threshold
+
+#: reason code -> meaning, per minimum (0 = a reliable time)
+MINIMUM_REASONS = {
+    0: "ok",
+    1: "missing",
+    2: "low_contrast",
+    3: "overlapping",
+    4: "dip_at_sweep_end",
+    5: "invalid_input",
+    6: "wide_dip",
+}
+OK, MISSING, LOW_CONTRAST, OVERLAPPING, AT_END, INVALID, WIDE = range(7)
+
+
+@dataclass
+class Minima:
+    """The minima of each pixel, ordered along the sweep (earliest first).
+
+    Attributes
+    ----------
+    time : (K, H, W) float64
+        Sub-frame time of each minimum; NaN where its reason is not ``ok``.
+    estimate : (K, H, W) float64
+        The timing method's value whatever the reason (NaN where missing).
+    frame : (K, H, W) int64
+        Frame of the smoothed minimum (-1 = missing).
+    depth : (K, H, W) float64
+        Lit level minus the lowest raw sample of the minimum's window.
+    contrast : (K, H, W) float64
+        ``depth / level``: the fraction of the pixel's light the shadow removes.
+    level : (K, H, W) float64
+        Lit level at the minimum (line through its window's ends).
+    width : (K, H, W) float64
+        Frames between the half-depth entry and exit crossings (NaN where open).
+    time_std : (K, H, W) float64
+        Noise standard deviation of `estimate`, frames.
+    reason : (K, H, W) int8
+        :data:`MINIMUM_REASONS`.
+    count : (H, W) int64
+        Significant minima found (neither missing nor low contrast; at most K).
+    extra_contrast : (H, W) float64
+        Contrast of the deepest further minimum (the (K+1)-th; 0 where none): a
+        significant one means the pixel has more dips than K.
+    noise : (H, W) float64
+        Temporal noise of one raw sample.
+    lit_level : (H, W) float64
+        Mean signal more than ``half_window`` frames from every minimum.
+    n_frames : int
+    significance : float
+        Contrast, in units of the smoothed-sample noise relative to the level,
+        below which a minimum is ``low_contrast``.
+    """
+
+    time: np.ndarray
+    estimate: np.ndarray
+    frame: np.ndarray
+    depth: np.ndarray
+    contrast: np.ndarray
+    level: np.ndarray
+    width: np.ndarray
+    time_std: np.ndarray
+    reason: np.ndarray
+    count: np.ndarray
+    extra_contrast: np.ndarray
+    noise: np.ndarray
+    lit_level: np.ndarray
+    n_frames: int
+    significance: float
+
+
+def select_minima(values, frames, count, *, separation):
+    """The `count` deepest candidates that lie more than `separation` frames from each other.
+
+    Parameters
+    ----------
+    values : (P, N) array_like
+        Candidate smoothed minima (non-finite = empty slot).
+    frames : (P, N) array_like of int
+        Their frames.
+    count : int
+    separation : int
+        Minimum distance, in frames, between selected minima (exclusive).
+
+    Returns
+    -------
+    frame : (P, count) int64
+        Selected frames, deepest first; -1 where fewer were found.
+    value : (P, count) float64
+        Their values (NaN where missing).
+
+    Notes
+    -----
+    Greedy in (value, frame) order, like
+    :func:`shadowcam.lab.dip_kernels.select_dips` for ``count = 2``: equal values
+    go to the earlier frame.
+    """
+    values = np.asarray(values, dtype=np.float64)
+    frames = np.asarray(frames, dtype=np.int64)
+    if values.shape != frames.shape or values.ndim != 2:
+        raise ValueError(f"values and frames must be (P, N) arrays of one shape; got "
+                         f"{values.shape} and {frames.shape}")
+    if int(count) < 1:
+        raise ValueError(f"count must be >= 1; got {count!r}")
+    n_p = values.shape[0]
+    finite = np.isfinite(values)
+    order = np.lexsort((frames, np.where(finite, values, np.inf)), axis=-1)
+    sorted_values = np.take_along_axis(values, order, -1)
+    sorted_frames = np.take_along_axis(frames, order, -1)
+    sorted_ok = np.take_along_axis(finite, order, -1)
+    out_frame = np.full((n_p, int(count)), -1, np.int64)
+    out_value = np.full((n_p, int(count)), np.nan)
+    taken = np.zeros(n_p, np.int64)
+    rows = np.arange(n_p)
+    for n in range(values.shape[1]):
+        f = sorted_frames[:, n]
+        far = np.all((out_frame < 0) | (np.abs(out_frame - f[:, None]) > separation), axis=1)
+        take = sorted_ok[:, n] & far & (taken < count)
+        slot = np.minimum(taken, count - 1)
+        out_frame[rows[take], slot[take]] = f[take]
+        out_value[rows[take], slot[take]] = sorted_values[take, n]
+        taken += take
+    return out_frame, out_value
+
+
+def _as_blocks(frames):
+    """A callable giving the frame blocks again for each pass."""
+    if callable(frames):
+        return frames
+    array = np.asarray(frames)
+    if array.ndim not in (3, 4):
+        raise ValueError(f"frames must be (T, H, W[, C]) or a callable giving such blocks; got "
+                         f"shape {array.shape}")
+    return lambda: (array[i:i + 64] for i in range(0, array.shape[0], 64))
+
+
+def _signal(block):
+    block = np.asarray(block, dtype=np.float32)
+    return block.sum(axis=-1) if block.ndim == 4 else block
+
+
+class _WindowPass:
+    """Second pass: raw windows around given frames, lit statistics more than `lit_gap`
+    frames from all of them."""
+
+    def __init__(self, centres, half_window, lit_gap):
+        self.centres = centres  # (K, P) int64, -1 = none
+        self.h = half_window
+        self.lit_gap = lit_gap
+        k, p = centres.shape
+        self.window = np.full((k, 2 * half_window + 1, p), np.nan, np.float32)
+        self.lit_sum = np.zeros(p)
+        self.lit_count = np.zeros(p, np.int64)
+        self.diff_sq = np.zeros(p)
+        self.diff_count = np.zeros(p, np.int64)
+        self.invalid = np.zeros((k, p), np.int64)
+        self.previous = None
+        self.next = 0
+
+    def update(self, signal):
+        """Feed the next frames, one at a time (memory ``O(K P)`` besides the windows)."""
+        flat = signal.reshape(signal.shape[0], -1)
+        present = self.centres >= 0
+        columns = np.arange(flat.shape[1])
+        for index, frame in enumerate(flat):
+            t = self.next + index
+            offset = t - (self.centres - self.h)  # (K, P)
+            inside = present & (offset >= 0) & (offset <= 2 * self.h)
+            finite = np.isfinite(frame)
+            for k in range(self.centres.shape[0]):
+                cols = columns[inside[k]]
+                self.window[k, offset[k, cols], cols] = frame[cols]
+            self.invalid += inside & ~finite
+            outside = ~(present & (np.abs(t - self.centres) <= self.lit_gap)).any(axis=0) & finite
+            self.lit_sum += np.where(outside, frame, 0.0)
+            self.lit_count += outside
+            if self.previous is not None:
+                pair = outside & self.previous
+                with np.errstate(invalid="ignore"):
+                    self.diff_sq += np.where(pair, (frame.astype(np.float64) - self.previous_value) ** 2, 0.0)
+                self.diff_count += pair
+            self.previous, self.previous_value = outside, frame
+        self.next += signal.shape[0]
+
+
+def _line_level(window, trusted_left, trusted_right):
+    """Lit level at each window slot, ``(K, W, P)``: the line through the means of the first
+    and last two valid samples; a side whose window runs past the sequence (untrusted: its
+    first valid samples may lie in the dip) counts only when its samples are within a tenth
+    of the dip's depth of the other side's level, else takes the other side's level (NaN if neither)."""
+    n = window.shape[1]
+    valid = np.isfinite(window)
+    idx = np.arange(n)[None, :, None]
+
+    def side(from_left):
+        rank = np.cumsum(valid if from_left else valid[:, ::-1], axis=1)
+        rank = rank if from_left else rank[:, ::-1]
+        pick = valid & (rank <= 2)
+        count = pick.sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return (np.where(pick, window, 0).sum(axis=1) / count,
+                    np.where(pick, idx, 0).sum(axis=1) / count)
+
+    (left, x_left), (right, x_right) = side(True), side(False)
+    # an untrusted side still counts when its samples are within a tenth of the dip's depth
+    # of the trusted side's level (the dip closes inside the sequence, before them)
+    lowest = np.nanmin(np.where(valid, window, np.inf), axis=1)
+    with np.errstate(invalid="ignore"):
+        left_ok = trusted_left | (trusted_right & (left - lowest > 0.9 * (right - lowest)))
+        right_ok = trusted_right | (trusted_left & (right - lowest > 0.9 * (left - lowest)))
+    left, right = np.where(left_ok, left, np.nan), np.where(right_ok, right, np.nan)
+    both = np.isfinite(left) & np.isfinite(right) & (x_right > x_left)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slope = np.where(both, (right - left) / (x_right - x_left), 0.0)
+    anchor = np.where(np.isfinite(left), left, right)
+    x0 = np.where(np.isfinite(left), x_left, x_right)
+    return anchor[:, None] + slope[:, None] * (idx - x0[:, None])
+
+
+def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence, detectable):
+    """Which minima are dips of their own, and which are deeper than `detectable` (P,).
+
+    A minimum is part of a deeper one's dip (a flat or rippled bottom, two shadows that
+    overlap) when the signal between them never comes back to the deeper dip's half
+    depth; it is then dropped (``present`` False). Minima not deeper than `detectable`
+    below their level (``dip`` False) cut no other minimum's window.
+    """
+    present = centres >= 0
+    level = _line_level(window, ~outside_sequence[:, 0], ~outside_sequence[:, -1])
+    with np.errstate(invalid="ignore"):
+        dip = level[:, (window.shape[1] - 1) // 2] - smoothed > detectable[None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        uncut = window / level
+    lowest = np.nanmin(np.where(np.isfinite(uncut), uncut, np.inf), axis=1)  # (K+1, P)
+    half = 0.5 * (1.0 + lowest)
+    depth_order = np.argsort(np.where(present, smoothed, np.inf), axis=0, kind="stable")
+    w = (window.shape[1] - 1) // 2
+    n = centres.shape[0]
+
+    def of(values, index):
+        return np.take_along_axis(values, index.reshape((1,) + (1,) * (values.ndim - 2) + (-1,)), 0)[0]
+
+    for r_b in range(1, n):
+        b = depth_order[r_b]
+        f_b = of(centres, b)
+        for r_a in range(r_b):
+            a = depth_order[r_a]
+            f_a = of(centres, a)
+            frames_a = of(slot_frame, a)
+            between = ((frames_a >= np.minimum(f_a, f_b)[None]) & (frames_a <= np.maximum(f_a, f_b)[None]))
+            with np.errstate(invalid="ignore"):
+                recovered = np.any(between & (of(uncut, a) >= of(half, a)[None]), axis=0)
+            merged = of(present, a) & of(present, b) & (np.abs(f_b - f_a) <= w) & ~recovered
+            columns = np.flatnonzero(merged)
+            present[b[columns], columns] = False
+    return present, dip
+
+
+def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3,
+                steady_level=True):
+    """The `count` deepest separated minima of each pixel, timed and classified.
+
+    Parameters
+    ----------
+    frames : (T, H, W[, C]) array_like, or callable
+        The sweep's frames, or a callable returning an iterable of consecutive
+        ``(t, H, W[, C])`` blocks (called twice: two passes). Channels are summed.
+    shape : (int, int)
+        ``(H, W)``.
+    count : int
+        Minima wanted per pixel (lights, or wires of one family).
+    half_window : int
+        Minima closer than this many frames are one; each minimum is timed over the
+        ``2 * half_window`` frames on each side of its smoothed minimum.
+    method : str
+        A key of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS` other than
+        ``edge_fit`` (which mixes neighbours' times, possibly of other minima).
+    false_alarm : float
+        Probability that pure noise makes a minimum (sets ``significance``).
+    steady_level : bool
+        The lit level is the same all along the sweep (a static light): a window whose
+        ends stay more than a tenth of the dip's depth below the level of the frames far
+        from every minimum has not reached the lit level (``wide_dip``, or
+        ``overlapping`` when cut by another minimum). False under a moving light.
+
+    Returns
+    -------
+    Minima
+    """
+    check_positive(count, "count")
+    if int(count) != count:
+        raise ValueError(f"count must be an integer >= 1; got {count!r}")
+    check_in(method, "method", tuple(m for m in SHADOW_TIME_METHODS if m != "edge_fit"))
+    blocks = _as_blocks(frames)
+    count, h = int(count), int(half_window)
+    tracker = DipTracker(tuple(shape), half_window=h)
+    for block in blocks():
+        tracker.update(_signal(block))
+    partial = tracker.partial()
+    n_frames = partial.end
+    rows, cols = partial.top_value.shape[:2]
+    p = rows * cols
+    chosen, smoothed = select_minima(partial.top_value.reshape(p, -1), partial.top_frame.reshape(p, -1),
+                                     count + 1, separation=h)
+    # the K deepest in order along the sweep (missing last), then the extra one
+    order = np.argsort(np.where(chosen[:, :count] < 0, np.iinfo(np.int64).max, chosen[:, :count]), axis=1)
+    order = np.concatenate([order, np.full((p, 1), count)], axis=1)
+    centres = np.take_along_axis(chosen, order, 1).T  # (K + 1, P)
+    smoothed = np.take_along_axis(smoothed, order, 1).T
+    # the second pass keeps twice the tracker's half window: a flat-bottomed dip's minimum
+    # is its first lowest frame, and its whole width must still fit
+    w = 2 * h
+    passing = _WindowPass(centres, w, h)
+    for block in blocks():
+        passing.update(_signal(block))
+    window = passing.window
+    slot_frame = centres[:, None, :] - w + np.arange(2 * w + 1)[None, :, None]  # (K+1, W, P)
+    outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        noise = np.sqrt(passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0)
+        noise = np.where(passing.diff_count > 0, noise, np.nan)
+    significance = detection_threshold(n_frames, false_alarm=false_alarm) * _SMOOTHED_NOISE
+    present, dip = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence,
+                                      significance * noise)
+    # each sample belongs to its nearest dip: cut the windows where they meet
+    own = np.abs(slot_frame - centres[:, None, :])  # (K+1, W, P)
+    nearest = np.ones(own.shape, bool)
+    for other in range(centres.shape[0]):
+        cuts = (present & dip)[other]
+        nearest &= ~cuts[None, None] | (own <= np.abs(slot_frame - centres[other][None, None]))
+    cut = np.where(nearest, window, np.nan)
+    cut_by_other = ~nearest & np.isfinite(window)
+    level = _line_level(cut, ~outside_sequence[:, 0], ~outside_sequence[:, -1]).astype(np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        normalised = cut / level
+        lit_level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
+    k_all = count + 1
+    centre_level = level[:, w, :]
+    lowest = np.nanmin(np.where(np.isfinite(normalised), normalised, np.inf), axis=1)
+    contrast = np.where(present, 1.0 - lowest, np.nan)
+    summary = DipSummary(
+        window=normalised.transpose(1, 0, 2).astype(np.float32), window_start=centres - w,
+        minimum_frame=centres, minimum_value=(1.0 - contrast).astype(np.float32),
+        second_value=np.full((k_all, p), np.inf, np.float32), second_frame=np.full((k_all, p), -1),
+        lit_level=np.ones((k_all, p)), noise=noise[None] / centre_level,
+        lit_count=np.broadcast_to(passing.lit_count, (k_all, p)), mean_level=np.ones((k_all, p)),
+        invalid_count=passing.invalid, n_frames=n_frames)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        estimate, entry, exit_, std = (np.asarray(a, np.float64) for a in SHADOW_TIME_METHODS[method](summary))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # the smoothed minimum's depth against the smoothed-sample noise
+        strong = centre_level - smoothed > significance * noise[None]
+    width = exit_ - entry
+    reason = np.full((k_all, p), OK, np.int8)
+    reason[~strong] = LOW_CONTRAST
+    # under a steady level the window's ends must reach the level of the frames far from
+    # every minimum (within a tenth of the dip's depth): else the dip is wider than the
+    # window, or runs into the next one, and its crossings are not its own
+    raw_lowest = (1.0 - contrast) * centre_level
+    with np.errstate(invalid="ignore"):
+        end_level = np.minimum(level[:, 0, :], level[:, -1, :])
+        unlit_ends = ~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest))
+    open_dip = ~np.isfinite(width) | (unlit_ends if steady_level else False)
+    # a cut window whose dip does not close: another minimum closer than their widths
+    reason[strong & open_dip & cut_by_other.any(axis=1)] = OVERLAPPING
+    reason[strong & open_dip & outside_sequence.any(axis=1)] = AT_END
+    reason[(reason == OK) & open_dip] = WIDE
+    reason[passing.invalid > 0] = INVALID
+    reason[~present] = MISSING
+    estimate = np.where(present, estimate, np.nan)
+    time = np.where(reason == OK, estimate, np.nan)
+    extra_contrast = np.where(present[count] & strong[count], contrast[count], 0.0)
+    found = (present & strong)[:count].sum(axis=0)
+
+    # order along the sweep again, minima merged into deeper ones last
+    perm = np.argsort(np.where(present[:count], centres[:count], np.iinfo(np.int64).max), axis=0,
+                      kind="stable")
+    centres = np.where(present, centres, -1)
+
+    def image(a):
+        a = np.broadcast_to(np.asarray(a), (k_all, p))[:count]
+        return np.take_along_axis(a, perm, 0).reshape(count, rows, cols)
+
+    return Minima(time=image(time), estimate=image(estimate), frame=image(centres),
+                  depth=image(contrast * centre_level), contrast=image(contrast), level=image(centre_level),
+                  width=image(width), time_std=image(std), reason=image(reason),
+                  count=found.reshape(rows, cols), extra_contrast=extra_contrast.reshape(rows, cols),
+                  noise=noise.reshape(rows, cols), lit_level=lit_level.reshape(rows, cols),
+                  n_frames=n_frames, significance=significance)

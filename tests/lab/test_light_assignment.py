@@ -1,0 +1,142 @@
+"""Minima assigned to lights (paper Fig. 11): per-light shadow times against the renderer."""
+
+import numpy as np
+import pytest
+
+from shadowcam.lab.light_assignment import (
+    AMBIGUOUS_ORDER, MINIMA_COUNT, OK, assign_minima, light_summary,
+)
+from shadowcam.lab.minima import MISSING, OK as MIN_OK, Minima, find_minima
+from shadowcam.lab.shadow_time import sweep_shadow_times
+from shadowcam.synthetic.lab.light_sets import TubeLight, light_set_ground_truth, trace_light_set
+from shadowcam.synthetic.lab.render import render_image, sweep_frames
+from shadowcam.synthetic.lab.scene import PointLight
+from shadowcam.synthetic.lab.scenes import make_scene
+
+
+def _minima(times, *, extra=None):
+    """Minima with the given (K, H, W) times (NaN = missing), full contrast, no noise."""
+    times = np.asarray(times, np.float64)
+    present = np.isfinite(times)
+    reason = np.where(present, MIN_OK, MISSING).astype(np.int8)
+    shape = times.shape[1:]
+    return Minima(time=times, estimate=times, frame=np.where(present, np.rint(np.nan_to_num(times)), -1),
+                  depth=np.where(present, 0.5, np.nan), contrast=np.where(present, 0.5, np.nan),
+                  level=np.ones_like(times), width=np.where(present, 2.0, np.nan),
+                  time_std=np.where(present, 0.05, np.nan), reason=reason,
+                  count=present.sum(axis=0), extra_contrast=np.zeros(shape) if extra is None else extra,
+                  noise=np.full(shape, 0.01), lit_level=np.ones(shape), n_frames=80, significance=3.0)
+
+
+def _planes(shape=(12, 12)):
+    y, x = np.indices(shape)
+    return np.stack([10.0 + 0.5 * x + 0.1 * y, 40.0 + 0.5 * x + 0.1 * y])
+
+
+def test_order_along_the_sweep_gives_each_light_its_map():
+    truth = _planes()
+    a = assign_minima(_minima(truth), 2)
+    np.testing.assert_array_equal(a["reason"], OK)
+    np.testing.assert_allclose(a["time"], truth)
+
+
+def test_a_missing_dip_is_assigned_by_continuity_or_flagged():
+    truth = _planes()
+    times = truth.copy()
+    # light 0 hidden at (5, 5): its only minimum is light 1's; light 1 missing at (7, 7)
+    times[:, 5, 5] = [truth[1, 5, 5], np.nan]
+    times[1, 7, 7] = np.nan
+    a = assign_minima(_minima(times), 2)
+    assert a["reason"][0, 5, 5] == MINIMA_COUNT and np.isnan(a["time"][0, 5, 5])
+    assert a["reason"][1, 5, 5] == OK and a["time"][1, 5, 5] == truth[1, 5, 5]
+    assert a["reason"][0, 7, 7] == OK and a["time"][0, 7, 7] == truth[0, 7, 7]
+    assert a["reason"][1, 7, 7] == MINIMA_COUNT
+
+
+def test_a_time_that_jumps_to_another_lights_neighbourhood_is_flagged():
+    truth = _planes()
+    times = truth.copy()
+    # a spurious early dip and light 0's dip: light 0's slot holds the spurious time, light
+    # 1's slot holds light 0's time (nearer to light 0's neighbours than to light 1's)
+    times[:, 6, 6] = [2.0, truth[0, 6, 6]]
+    a = assign_minima(_minima(times), 2)
+    assert a["reason"][1, 6, 6] == AMBIGUOUS_ORDER and np.isnan(a["time"][1, 6, 6])
+    ok = a["reason"] == OK
+    np.testing.assert_allclose(a["time"][ok], truth[ok])
+    with pytest.raises(ValueError, match="n_lights"):
+        assign_minima(_minima(truth), 3)
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return make_scene("tabletop", height=32, width=32, frames=48)
+
+
+def _render(scene, lights):
+    sweep = scene.sweeps["u"]
+    paths, source = trace_light_set(scene.objects, scene.camera, lights, supersample=2)
+    frames = sweep_frames(paths, sweep, scene.mask)
+    reference = render_image(paths).sum(-1)
+    gt = light_set_ground_truth(scene.objects, scene.camera, lights, sweep, paths, source)
+    return frames, reference, gt
+
+
+def _smooth(t):
+    """Pixels whose time map is locally planar (not on an object's outline)."""
+    pad = np.pad(t, 1, constant_values=np.nan)
+    centre = pad[1:-1, 1:-1]
+    with np.errstate(invalid="ignore"):
+        return ((np.abs(pad[:-2, 1:-1] + pad[2:, 1:-1] - 2 * centre) < 0.5)
+                & (np.abs(pad[1:-1, :-2] + pad[1:-1, 2:] - 2 * centre) < 0.5))
+
+
+def _valid(gt, reference, k, n):
+    return ((reference > 0.2 * np.median(reference)) & _smooth(gt["t_center"][k])
+            & (gt["t_first"][k] > 2) & (gt["t_last"][k] < n - 3))
+
+
+def test_two_point_lights_each_get_their_shadow_time_map(scene):
+    first = scene.light
+    lights = [first, PointLight(first.position + 0.012 * scene.mask.e_u, first.intensity)]
+    frames, reference, gt = _render(scene, lights)
+    n = frames.shape[0]
+    a = assign_minima(find_minima(frames, frames.shape[1:3], count=2), 2)
+    for k in range(2):
+        alone, _, gt_alone = _render(scene, [lights[k]])
+        # the same timing method on light k's shadow alone: the bound set by the method
+        single = sweep_shadow_times([alone], alone.shape[1:3], method="dip_centroid")["shadow_time"]
+        valid = _valid(gt, reference, k, n)
+        assert valid.sum() > 400
+        err = np.abs(a["time"][k] - gt["t_center"][k])[valid]
+        timed = np.isfinite(err)
+        assert timed.mean() > 0.98
+        p95_single = np.nanpercentile(np.abs(single - gt_alone["t_center"][0])[valid], 95)
+        assert np.percentile(err[timed], 95) <= p95_single + 0.05
+        # never a confident time from the other light's shadow
+        assert np.all(err[timed] < 1.0)
+        summary = light_summary(a, valid=valid)[k]
+        assert summary["contrast"] == pytest.approx(np.nanmedian(gt["share"][k][valid]), abs=0.05)
+
+
+def test_tube_across_the_wire_has_lower_contrast_and_confidence_than_along(scene):
+    centre, half = scene.light.position, 0.006
+    tubes = {"along": TubeLight(centre - half * scene.mask.e_v, centre + half * scene.mask.e_v),
+             "across": TubeLight(centre - half * scene.mask.e_u, centre + half * scene.mask.e_u)}
+    out = {}
+    for name, tube in tubes.items():
+        frames, reference, gt = _render(scene, [tube])
+        spread = np.nanmedian(gt["t_last"][0] - gt["t_first"][0])
+        # the dip spans the tube's projection plus the wire: half_window must hold half of it
+        half_window = int(np.ceil(spread / 2 + 2))
+        a = assign_minima(find_minima(frames, frames.shape[1:3], count=1, half_window=half_window), 1)
+        valid = _valid(gt, reference, 0, frames.shape[0])
+        err = np.abs(a["time"][0] - gt["t_center"][0])[valid]
+        out[name] = (light_summary(a, valid=valid)[0], np.nanpercentile(err, 95),
+                     np.nanmedian(a["confidence"][0][valid]), np.nanmax(err))
+    along, across = out["along"], out["across"]
+    assert across[0]["contrast"] < 0.3 * along[0]["contrast"]
+    assert along[0]["coverage"] > 0.98 and across[0]["coverage"] > 0.9
+    assert along[1] < 0.35 and across[1] < 0.35
+    assert across[3] < 1.0
+    # in a noise-free render both are far above the detection level
+    assert along[2] == 1.0 and across[2] == 1.0

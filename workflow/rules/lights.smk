@@ -1,0 +1,65 @@
+# Stage: several lights under the wire sweeps (datasets whose manifest has
+# synthetic.lights): render the u and v sweeps, find each pixel's minima and assign them
+# to the lights (one shadow-time map and one dual view per light), then score them against
+# the renderer's per-light times (accuracy.json) and draw them beside it (lights.png).
+
+
+rule lights_render:
+    input:
+        "data_manifest/{ds}.yaml",
+    output:
+        "results/{ds}/lights/capture.nc",
+    log:
+        "logs/{ds}/lights_render.log",
+    benchmark:
+        "benchmarks/{ds}/lights_render.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_light_set_mem_mb,
+        runtime=30,
+    shell:
+        "shadowcam render-lights --manifest {input} --out {output} > {log} 2>&1"
+
+
+rule light_views:
+    input:
+        "results/{ds}/lights/capture.nc",
+    output:
+        "results/{ds}/lights/light_views.nc",
+    log:
+        "logs/{ds}/light_views.log",
+    benchmark:
+        "benchmarks/{ds}/light_views.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_light_set_mem_mb,
+        runtime=30,
+    shell:
+        "shadowcam light-views --capture {input} --out {output} > {log} 2>&1"
+
+
+rule light_accuracy:
+    input:
+        capture="results/{ds}/lights/capture.nc",
+        views="results/{ds}/lights/light_views.nc",
+    output:
+        json="results/{ds}/lights/accuracy.json",
+        png=report(
+            "results/{ds}/lights/lights.png",
+            caption="../report/light_set.rst",
+            category="Several lights",
+        ),
+    log:
+        "logs/{ds}/light_accuracy.log",
+    benchmark:
+        "benchmarks/{ds}/light_accuracy.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_light_set_mem_mb,
+        runtime=15,
+    shell:
+        "shadowcam light-accuracy --capture {input.capture} --views {input.views}"
+        " --out-json {output.json} --out-png {output.png} > {log} 2>&1"
