@@ -42,6 +42,6 @@ def test_yaml_syntax_error_names_the_line(tmp_path, workflow_copy, snakemake):
 def test_nested_command_line_values_are_read_as_yaml(tmp_path, workflow_copy, snakemake):
     workdir = workflow_copy(tmp_path / "wf")
     result = _dry_run(snakemake, workdir, "decode={chunk_frames: 32, chunks_per_job: 2}",
-                      "dual_view={width: null, params: {k: 4}}")
+                      "dual_view={width: null, params: {k: 4}, viewpoints: [centre, 0.25]}")
     assert result.returncode == 0, result.stdout[-3000:]
     assert "Job stats" in result.stdout

@@ -46,6 +46,16 @@ def _schema_types(schema):
     return {types} if isinstance(types, str) else set(types)
 
 
+def _takes_string(schema, value):
+    """Whether `schema` (or one of its anyOf / oneOf alternatives) accepts string `value`."""
+    for alternative in schema.get("anyOf") or schema.get("oneOf") or [schema]:
+        types = _schema_types(alternative)
+        if types is None or "string" in types:
+            if "enum" not in alternative or value in alternative["enum"]:
+                return True
+    return False
+
+
 def _from_command_line(value, schema):
     """`value` with command-line strings read as YAML where `schema` wants another type."""
     if isinstance(value, dict):
@@ -56,8 +66,7 @@ def _from_command_line(value, schema):
     if isinstance(value, list):
         items = schema.get("items", {})
         return [_from_command_line(v, items) for v in value]
-    types = _schema_types(schema)
-    if isinstance(value, str) and types is not None and "string" not in types:
+    if isinstance(value, str) and not _takes_string(schema, value):
         try:
             parsed = yaml.safe_load(value)
         except yaml.YAMLError:
