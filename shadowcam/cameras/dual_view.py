@@ -8,10 +8,16 @@ them into an image, neither of them last-write-wins splatting:
 * ``mesh``: forward mesh warp. The camera pixel grid is split into triangles
   (two per 2x2 pixel quad), their vertices moved to ``(u, v)`` and each
   triangle rasterised at the dual pixel centres it covers with barycentric
-  colour interpolation. Triangles with a vertex without valid coordinates or
-  an edge longer than ``max_edge`` dual pixels (they span a depth or shadow
-  discontinuity) are dropped. Where several triangles cover a dual pixel their
-  colours are averaged. Fully vectorised (triangles are expanded to candidate
+  colour interpolation. Which triangles to keep is decided on the camera
+  side: their three pixels must have dual coordinates (all timed) and none of
+  their edges may straddle a discontinuity. The dual coordinates are smooth
+  functions of the shadow times, so on one continuous surface the dual step
+  between neighbouring camera pixels changes little from one pixel to the next
+  (however much the optics magnify); a step across a depth or shadow-time
+  discontinuity differs from the steps before and after it along the same
+  camera line (`continuous_steps`). Steps up to ``max_edge`` dual pixels are
+  below the timing noise's reach and always kept. Where several triangles
+  cover a dual pixel their colours are averaged. Fully vectorised (triangles are expanded to candidate
   pixels of their bounding boxes, in bounded-memory chunks).
 * ``idw``: inverse-distance weighting of the ``k`` nearest camera samples
   within ``radius`` dual pixels (``scipy.spatial.cKDTree``).
@@ -21,6 +27,7 @@ Dual pixels without a sample stay NaN and ``coverage`` is False there.
 Offers
 ------
 DUAL_VIEW_METHODS : name -> resampler, ``mesh`` and ``idw``.
+continuous_steps : camera-side test that a neighbour step does not straddle a discontinuity.
 dual_view_mesh : forward mesh warp.
 dual_view_idw : k-nearest inverse-distance weighting.
 resample_dual_view : dispatch through `DUAL_VIEW_METHODS` with input checks.
@@ -55,7 +62,70 @@ def _grid_triangles(rows, cols):
     return np.concatenate([np.stack([tl, tr, bl], 1), np.stack([br, bl, tr], 1)])
 
 
-def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, eps=1e-9):
+def continuous_steps(u, v, *, valid, step, max_edge=2.0, smooth_tol=2.0 / 3.0):
+    """Whether the dual step between each camera pixel and its neighbour is continuous.
+
+    The step ``d_i`` from pixel ``p`` to ``p + step`` is compared with the steps
+    ``d_{i-1}`` (from ``p - step``) and ``d_{i+1}`` (from ``p + step`` to
+    ``p + 2 step``) along the same camera line. It is continuous when
+    ``|d_i| <= max_edge`` or when every neighbouring step with both pixels valid
+    agrees with it, ``|d_i - d_n| <= smooth_tol * max(|d_i|, |d_n|)``, and at
+    least one does. A step across a discontinuity is much longer (or turned)
+    than the steps on either side; a step on a surface that the optics magnify
+    is long, but so are its neighbours.
+
+    Parameters
+    ----------
+    u, v : (rows, cols) ndarray
+        Dual coordinates of the camera pixel centres (dual pixels).
+    valid : (rows, cols) bool ndarray, keyword-only
+        Pixels with usable dual coordinates.
+    step : (int, int)
+        Camera neighbour offset ``(d_row, d_col)``, e.g. ``(0, 1)`` or ``(1, 0)``.
+    max_edge : float
+        Steps up to this length (dual pixels) are always continuous.
+    smooth_tol : float
+        Largest change of a step relative to its neighbour, in ``(0, 1)``.
+
+    Returns
+    -------
+    (rows, cols) bool ndarray
+        True at ``p`` when ``p`` and ``p + step`` are valid and the step between them is
+        continuous; False where ``p + step`` is outside the grid.
+    """
+    rows, cols = u.shape
+    dr, dc = (int(s) for s in step)
+    ok = valid & np.isfinite(u) & np.isfinite(v)
+    pad = 3 * max(abs(dr), abs(dc))
+    pu = np.pad(np.asarray(u, dtype=np.float64), pad, constant_values=np.nan)
+    pv = np.pad(np.asarray(v, dtype=np.float64), pad, constant_values=np.nan)
+    pok = np.pad(ok, pad, constant_values=False)
+    pu[~pok] = np.nan
+    pv[~pok] = np.nan
+
+    def shifted(a, k):  # a[p + k step] over the camera grid
+        return a[pad + k * dr : pad + k * dr + rows, pad + k * dc : pad + k * dc + cols]
+
+    def d(k):  # step from p + k step to p + (k + 1) step, NaN unless both valid
+        return shifted(pu, k + 1) - shifted(pu, k), shifted(pv, k + 1) - shifted(pv, k)
+
+    du, dv = d(0)
+    length = np.hypot(du, dv)
+    agree_all = np.ones((rows, cols), dtype=bool)
+    any_neighbour = np.zeros((rows, cols), dtype=bool)
+    for k in (-1, 1):
+        nu, nv = d(k)
+        n_len = np.hypot(nu, nv)
+        present = np.isfinite(n_len)
+        with np.errstate(invalid="ignore"):
+            agree = np.hypot(du - nu, dv - nv) <= smooth_tol * np.maximum(length, n_len)
+        agree_all &= agree | ~present
+        any_neighbour |= present
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(length) & ((length <= max_edge) | (agree_all & any_neighbour))
+
+
+def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 / 3.0, eps=1e-9):
     """Forward mesh warp of camera colours into the dual grid.
 
     Parameters
@@ -69,8 +139,10 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, eps=1e-9):
     shape : (int, int)
         ``(height, width)`` of the dual grid.
     max_edge : float
-        Triangles with an edge longer than this (dual pixels) are dropped as
-        spanning a discontinuity.
+        Edges up to this length (dual pixels) are always kept (see `continuous_steps`).
+    smooth_tol : float
+        Largest relative change of a longer edge's dual step from the neighbouring
+        steps along the same camera line (see `continuous_steps`).
     eps : float
         Barycentric tolerance for pixel centres on triangle edges.
 
@@ -80,23 +152,22 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, eps=1e-9):
         NaN where no triangle covers the dual pixel centre.
     coverage : (height, width) bool ndarray
     """
+    check_in_interval(smooth_tol, "smooth_tol", 0.0, 1.0, closed="neither")
     rows, cols, n_ch = colours.shape
     height, width = shape
+    across = continuous_steps(u, v, valid=valid, step=(0, 1), max_edge=max_edge, smooth_tol=smooth_tol).ravel()
+    down = continuous_steps(u, v, valid=valid, step=(1, 0), max_edge=max_edge, smooth_tol=smooth_tol).ravel()
     tri = _grid_triangles(rows, cols)
+    # (tl, tr, bl): edges tl->tr, tl->bl; (br, bl, tr): edges bl->br, tr->br. Two continuous
+    # edges put the third vertex on the same surface, so the diagonal needs no test.
+    upper = tri[:, 0] + 1 == tri[:, 1]
+    tri = tri[np.where(upper, across[tri[:, 0]] & down[tri[:, 0]], across[tri[:, 1]] & down[tri[:, 2]])]
     uf, vf = u.ravel().astype(np.float64), v.ravel().astype(np.float64)
-    ok_vertex = valid.ravel() & np.isfinite(uf) & np.isfinite(vf)
-    keep = ok_vertex[tri].all(axis=1)
-    tri = tri[keep]
     pu, pv = uf[tri], vf[tri]  # (n, 3)
-    edge2 = np.stack([
-        (pu[:, 1] - pu[:, 0]) ** 2 + (pv[:, 1] - pv[:, 0]) ** 2,
-        (pu[:, 2] - pu[:, 1]) ** 2 + (pv[:, 2] - pv[:, 1]) ** 2,
-        (pu[:, 0] - pu[:, 2]) ** 2 + (pv[:, 0] - pv[:, 2]) ** 2,
-    ], 1)
     e1u, e1v = pu[:, 1] - pu[:, 0], pv[:, 1] - pv[:, 0]
     e2u, e2v = pu[:, 2] - pu[:, 0], pv[:, 2] - pv[:, 0]
     det = e1u * e2v - e1v * e2u
-    keep = (edge2.max(axis=1) <= max_edge**2) & (np.abs(det) > 1e-12)
+    keep = np.abs(det) > 1e-12
     i0 = np.maximum(np.ceil(pu.min(axis=1) - eps), 0).astype(np.int64)
     i1 = np.minimum(np.floor(pu.max(axis=1) + eps), width - 1).astype(np.int64)
     j0 = np.maximum(np.ceil(pv.min(axis=1) - eps), 0).astype(np.int64)
@@ -206,7 +277,7 @@ def resample_dual_view(colours, u, v, *, shape, valid=None, method="mesh", **par
     method : str
         Key of `DUAL_VIEW_METHODS`.
     **params
-        Method options (``max_edge`` for mesh; ``k``, ``radius``, ``power`` for idw).
+        Method options (``max_edge``, ``smooth_tol`` for mesh; ``k``, ``radius``, ``power`` for idw).
 
     Returns
     -------

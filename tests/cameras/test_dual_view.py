@@ -6,10 +6,14 @@ import pytest
 import xarray as xr
 from scipy.ndimage import binary_erosion
 
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
 from shadowcam.cameras.dual_coords import apply_homography
 from shadowcam.cameras.dual_view import (
     DUAL_VIEW_METHODS,
     camera_colours,
+    continuous_steps,
     dual_view_dataset,
     resample_dual_view,
 )
@@ -213,3 +217,64 @@ def test_front_function_fails_on_a_nearly_empty_dual_view():
         dual_view_from_coords(coords, shadow_time, reference=reference)
     dataset = dual_view_from_coords(coords, shadow_time, reference=reference, min_coverage=0)
     assert dataset["coverage"].values.sum() < 16
+
+
+def _magnified(scale, angle=0.0, rows=12, cols=12):
+    r, c = np.mgrid[0:rows, 0:cols].astype(float)
+    ca, sa = np.cos(angle), np.sin(angle)
+    return scale * (ca * c - sa * r), scale * (sa * c + ca * r)
+
+
+@settings(max_examples=40, deadline=None)
+@given(scale=st.floats(2.5, 8.0), angle=st.floats(-np.pi, np.pi), jump_col=st.integers(3, 8),
+       jump=st.floats(4.0, 20.0))
+def test_continuous_steps_keep_magnified_surfaces_and_flag_jumps(scale, angle, jump_col, jump):
+    # a surface magnified `scale` times (steps longer than max_edge) is continuous everywhere;
+    # a jump of `jump` steps between columns jump_col - 1 and jump_col is a discontinuity,
+    # and so are the steps next to it (their neighbour across the jump disagrees)
+    u, v = _magnified(scale, angle)
+    valid = np.ones(u.shape, dtype=bool)
+    for step in ((0, 1), (1, 0)):
+        ok = continuous_steps(u, v, valid=valid, step=step)
+        inside = np.zeros(u.shape, dtype=bool)
+        inside[: u.shape[0] - step[0], : u.shape[1] - step[1]] = True
+        assert np.array_equal(ok, inside)
+    u2 = u + np.where(np.arange(u.shape[1]) >= jump_col, jump * scale, 0.0)
+    ok = continuous_steps(u2, v, valid=valid, step=(0, 1))
+    flagged = sorted(set(np.nonzero(~ok[:, :-1])[1].tolist()))
+    assert flagged == [jump_col - 2, jump_col - 1, jump_col]
+    assert continuous_steps(u2, v, valid=valid, step=(1, 0))[:-1].all()
+
+
+def test_continuous_steps_short_steps_and_folds():
+    # steps up to max_edge are always kept; a fold (the step turns back) is a discontinuity
+    u = np.tile(np.array([0, 3, 6, 9, 6, 3, 0], float), (3, 1))
+    v = np.zeros_like(u)
+    valid = np.ones(u.shape, dtype=bool)
+    ok = continuous_steps(u, v, valid=valid, step=(0, 1))
+    assert ok[0, :6].tolist() == [True, True, False, False, True, True]
+    assert continuous_steps(u / 2, v, valid=valid, step=(0, 1), max_edge=2.0)[0, :6].all()
+    valid[0, 1] = False  # a step touching an invalid pixel is never continuous
+    ok = continuous_steps(u, v, valid=valid, step=(0, 1))
+    assert not ok[0, 0] and not ok[0, 1]
+    with pytest.raises(ValueError, match="smooth_tol"):
+        resample_dual_view(np.ones(u.shape + (1,)), u, v, shape=(4, 12), smooth_tol=1.5)
+
+
+def test_mesh_covers_a_magnified_surface_but_not_the_gap_of_a_jump():
+    # camera pixels 3 dual pixels apart (optics magnify): the warp covers every dual pixel of the
+    # magnified grid; a jump of 12 dual pixels between camera columns 5 and 6 leaves that gap empty
+    rows, cols = 10, 12
+    u, v = _magnified(3.0, rows=rows, cols=cols)
+    colours = np.ones((rows, cols, 1))
+    img, cov = resample_dual_view(colours, u, v, shape=(30, 60), method="mesh")
+    expected = np.zeros((30, 60), dtype=bool)
+    expected[: 3 * (rows - 1) + 1, : 3 * (cols - 1) + 1] = True
+    assert np.array_equal(cov, expected)
+    np.testing.assert_allclose(img[cov], 1.0)
+    u2 = u + np.where(np.arange(cols) >= 6, 12.0, 0.0)
+    _, cov2 = resample_dual_view(colours, u2, v, shape=(30, 60), method="mesh")
+    cols_covered = np.nonzero(cov2[: 3 * (rows - 1) + 1].all(axis=0))[0]
+    # kept: camera columns 0..4 (steps before the one next to the jump) and 7..11 shifted by 12
+    assert cols_covered.tolist() == list(range(0, 13)) + list(range(33, 46))
+    assert not cov2[:, 13:33].any()

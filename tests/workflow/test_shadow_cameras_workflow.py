@@ -72,6 +72,8 @@ def test_every_shadow_camera_runs_from_its_manifest_to_accuracy(tmp_path, workfl
         # the dual image scored where the camera sees the dual point through the optics
         dual_image = report["dual_image"]
         assert dual_image["n_mask"] >= 300 and dual_image["covered_not_visible"] <= 0.03, ds
+        # the optics magnify: triangles kept from the camera-side continuity, not their dual size
+        assert dual_image["coverage_of_visible"] >= 0.65, (ds, dual_image)
     # orthographic: parallel edges at different depths measured in the estimated dual view;
     # bounded by half the perspective contrast of the same scene (exact: 6.2 deg, ratio 1.29)
     ortho = json.loads((Path(workdir) / "results" / "synthetic_orthographic" / "accuracy.json")
