@@ -29,6 +29,10 @@ BENCH_SIZE ?= 6000x4000
 BENCH_STRIP_COLS ?= 128
 BENCH_SUPERSAMPLE ?= 1
 BENCH_FRAMES ?= 24
+# sun elevation at the first and last frame (deg): the whole sunset by default (intervals of
+# minutes); a narrow range gives a photographer's cadence (8.0 -> 6.4 with 96 frames: ~5 s)
+BENCH_START_ELEVATION ?= 20.0
+BENCH_END_ELEVATION ?= 1.5
 BENCH_PART ?= 8
 BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
 # frames per chunk of the decoded store: one 24 MP frame is 288 MB of float32 RGB, and the
@@ -103,7 +107,7 @@ bench-outdoor-size: $(STAMP)
 	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
 	  printf '%s\n' "name: bench$$n" "kind: outdoor" "description: sunset time-lapse rendered at $(BENCH_SIZE), a full-height strip of $(BENCH_STRIP_COLS) columns, disc sun" \
 	    "light: distant" "synthetic: {scene: ridge, seed: 3, height: $$rows, width: $$cols, frames: $$n, format: dng, bit_depth: 14, noise: true, supersample: $(BENCH_SUPERSAMPLE), exposure: 0.6," \
-	    "  outdoor: {sun_diameter_deg: 0.53, shake_px: 2.0, dng_compression: ljpeg, window: [0, $$(( (cols - $(BENCH_STRIP_COLS)) / 2 )), $$rows, $(BENCH_STRIP_COLS)]}}" \
+	    "  outdoor: {start_elevation_deg: $(BENCH_START_ELEVATION), end_elevation_deg: $(BENCH_END_ELEVATION), sun_diameter_deg: 0.53, shake_px: 2.0, dng_compression: ljpeg, window: [0, $$(( (cols - $(BENCH_STRIP_COLS)) / 2 )), $$rows, $(BENCH_STRIP_COLS)]}}" \
 	    "provenance: rendered by shadowcam render (make bench-outdoor-size)" "licence: CC0-1.0" \
 	    > $(BENCH_DIR)/data_manifest/bench$$n.yaml; \
 	  (cd $(BENCH_DIR) && PATH="$(CURDIR)/$(BIN):$$PATH" $(CURDIR)/$(SNAKEMAKE) --profile profiles/local --cores 2 \
