@@ -21,10 +21,18 @@ OUTDOOR ?= dev_ridge
 BENCH_ARGS ?=
 # DNG compressions benchmarked: lossless JPEG (what cameras write), none (rawpy's cheapest decode)
 BENCH_COMPRESSION ?= ljpeg none
-# bench-outdoor-size: sample size (COLSxROWS; the small default finishes in a few minutes on
-# 2 shared cores; a 24 MP camera is BENCH_SIZE=6000x4000), frames, frames per first-pass job, scratch dir
-BENCH_SIZE ?= 1536x1024
-BENCH_FRAMES ?= 16
+# bench-outdoor-size: the camera's size (COLSxROWS, 24 MP), the columns of the full-height strip
+# of it that is rendered at that resolution (the renderer's synthetic.outdoor.window; a whole
+# 24 MP frame takes too long to render on 2 shared cores), render samples per pixel side,
+# frames, frames per first-pass job, scratch dir
+BENCH_SIZE ?= 6000x4000
+BENCH_STRIP_COLS ?= 128
+BENCH_SUPERSAMPLE ?= 1
+BENCH_FRAMES ?= 24
+# sun elevation at the first and last frame (deg): the whole sunset by default (intervals of
+# minutes); a narrow range gives a photographer's cadence (8.0 -> 6.4 with 96 frames: ~5 s)
+BENCH_START_ELEVATION ?= 20.0
+BENCH_END_ELEVATION ?= 1.5
 BENCH_PART ?= 8
 BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
 # frames per chunk of the decoded store: one 24 MP frame is 288 MB of float32 RGB, and the
@@ -82,10 +90,12 @@ bench: $(STAMP)
 	    --json results/bench/figures-$$c.json $(BENCH_ARGS) || exit 1; \
 	done
 
-# The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of dev_ridge
-# upsampled to BENCH_SIZE (14-bit DNG, full-resolution noise) run in a scratch copy of the
+# The outdoor pipeline at a camera's size: BENCH_FRAMES and BENCH_FRAMES/2 frames of the ridge
+# sunset rendered at BENCH_SIZE with the disc sun and the sensor model (every nuisance on, shake
+# up to 2 px; 14-bit lossless-JPEG DNG with exact arrival ground truth), a full-height strip of
+# BENCH_STRIP_COLS columns of the frame at its true resolution, run in a scratch copy of the
 # workflow (2 cores, first pass in parts of BENCH_PART frames, edge tracking in BENCH_STRIPS
-# column strips); prints per stage s/frame,
+# column strips); prints the render time (apart), the arrival accuracy, per stage s/frame,
 # frames/s, MP/s, peak RSS (and its growth from the half run), the 1000-frame extrapolation, and
 # the scale targets side by side (store / RAW bytes, end-to-end and first pass / decode-only time
 # of the same frames timed in this run, peak RSS per job and its 1000 / 100 frames ratio).
@@ -93,19 +103,23 @@ bench-outdoor-size: $(STAMP)
 	rm -rf $(BENCH_DIR) && mkdir -p $(BENCH_DIR)/data_manifest
 	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
 	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), edge_strips: $(BENCH_STRIPS)}\n' > $(BENCH_DIR)/bench.yaml
+	cols=$$(echo $(BENCH_SIZE) | cut -dx -f1); rows=$$(echo $(BENCH_SIZE) | cut -dx -f2); \
 	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
-	  $(BIN)/shadowcam outdoor-sample --source data_manifest/dev_ridge.yaml --size $(BENCH_SIZE) --frames $$n \
-	    --name bench$$n --outdir $(BENCH_DIR)/data/bench$$n --manifest-out $(BENCH_DIR)/data_manifest/bench$$n.yaml \
-	    > $(BENCH_DIR)/sample$$n.log 2>&1 || exit 1; \
+	  printf '%s\n' "name: bench$$n" "kind: outdoor" "description: sunset time-lapse rendered at $(BENCH_SIZE), a full-height strip of $(BENCH_STRIP_COLS) columns, disc sun" \
+	    "light: distant" "synthetic: {scene: ridge, seed: 3, height: $$rows, width: $$cols, frames: $$n, format: dng, bit_depth: 14, noise: true, supersample: $(BENCH_SUPERSAMPLE), exposure: 0.6," \
+	    "  outdoor: {start_elevation_deg: $(BENCH_START_ELEVATION), end_elevation_deg: $(BENCH_END_ELEVATION), sun_diameter_deg: 0.53, shake_px: 2.0, dng_compression: ljpeg, window: [0, $$(( (cols - $(BENCH_STRIP_COLS)) / 2 )), $$rows, $(BENCH_STRIP_COLS)]}}" \
+	    "provenance: rendered by shadowcam render (make bench-outdoor-size)" "licence: CC0-1.0" \
+	    > $(BENCH_DIR)/data_manifest/bench$$n.yaml; \
 	  (cd $(BENCH_DIR) && PATH="$(CURDIR)/$(BIN):$$PATH" $(CURDIR)/$(SNAKEMAKE) --profile profiles/local --cores 2 \
 	    --configfile config/config.yaml bench.yaml --config datasets=[bench$$n] --quiet) || exit 1; \
+	  mkdir -p $(BENCH_DIR)/render/bench$$n && mv $(BENCH_DIR)/benchmarks/bench$$n/render.tsv $(BENCH_DIR)/render/bench$$n/; \
 	done
 	$(BIN)/shadowcam bench-report --benchmarks $(BENCH_DIR)/benchmarks/bench$(BENCH_FRAMES) \
 	  --frames $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/frames/timelapse.zarr \
 	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 )) \
-	  --photometry $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/outdoor/photometry.nc \
-	  --shake $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/timestamps.json \
-	  --raw $(BENCH_DIR)/data/bench$(BENCH_FRAMES)/frames
+	  --raw $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/capture/frames \
+	  --accuracy $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/outdoor/accuracy.json \
+	  --render $(BENCH_DIR)/render/bench$(BENCH_FRAMES)
 
 lint: $(STAMP)
 	$(SNAKEMAKE) --lint

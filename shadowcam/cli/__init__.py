@@ -28,7 +28,7 @@ STEPS = {
     "report-figures": "report_figures",
     "evaluate": "evaluate",
     "plan": "plan",
-    "outdoor-normalise": "outdoor_normalise",
+    "outdoor-normalise": "outdoor_normalise", "outdoor-sky-mask": "outdoor_sky_mask",
     "outdoor-merge-photometry": "outdoor_merge_photometry",
     "track-edges": "track_edges",
     "track-edges-strip": "track_edges_strip",

@@ -10,7 +10,9 @@ jobs divide by the cores, and memory is the peak per job (it does not grow with 
 number of frames: compare two runs with ``--compare``) times the jobs that run at
 once. Disk: the decoded frame store per frame. With ``--photometry`` and ``--shake``
 (a sample's sidecar, ``shadowcam outdoor-sample``) it also prints the registration
-error at that size against the applied shake. With ``--raw`` (the run's RAW
+error at that size against the applied shake; with ``--accuracy`` (the run's
+``accuracy.json``) the arrival accuracy against the ground truth; with ``--render``
+the render's time (kept out of the stages). With ``--raw`` (the run's RAW
 frames) it times decoding them with the pipeline's reader and prints the scale
 targets side by side: frame store / RAW bytes, end-to-end / decode-only time,
 first pass / decode-only (in CPU time, a job's cost whatever else loads a shared
@@ -31,7 +33,7 @@ run : print the table.
 import json
 from pathlib import Path
 
-from shadowcam.evaluate.workflow_benchmark import (benchmark_table, directory_bytes, memory_growth, read_benchmarks,
+from shadowcam.evaluate.workflow_benchmark import (accuracy_line, benchmark_table, directory_bytes, memory_growth, read_benchmarks,
                                                   registration_line, scale_targets, time_decode)
 from shadowcam.io.datasets import open_dataset
 from shadowcam.io.frame_store import open_frames
@@ -49,6 +51,10 @@ def add_parser(subparsers, name):
     parser.add_argument("--photometry", default=None, help="the run's results/<ds>/outdoor/photometry.nc (estimated shifts)")
     parser.add_argument("--shake", default=None, help="sidecar JSON with the applied shake_dx_px, shake_dy_px")
     parser.add_argument("--raw", default=None, help="directory of the run's RAW frames (decode-only time, sizes)")
+    parser.add_argument("--accuracy", default=None,
+                        help="the run's results/<ds>/outdoor/accuracy.json (arrival accuracy against the ground truth)")
+    parser.add_argument("--render", default=None,
+                        help="directory of the render's benchmark file, kept apart from the run's stages (render time)")
     return parser
 
 
@@ -71,3 +77,10 @@ def run(args):
                                           clock=clock)))
     if args.photometry and args.shake:
         print(registration_line(open_dataset(args.photometry), json.loads(Path(args.shake).read_text()), shape=shape))
+    if args.accuracy:
+        print(accuracy_line(json.loads(Path(args.accuracy).read_text()), shape=shape))
+    if args.render:
+        for clock in ("wall", "cpu"):
+            spent = sum(s for jobs in read_benchmarks(args.render, clock=clock).values() for s, _ in jobs)
+            print(f"render (not a pipeline stage) {clock}: {spent:.1f} s, {spent / n_frames:.2f} s per frame "
+                  f"of {shape[1]}x{shape[0]}")

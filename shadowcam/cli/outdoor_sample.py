@@ -6,9 +6,10 @@ size, shakes them by a seeded realistic amount (``--shake-px``, sub-pixel to
 2 px), adds full-resolution sensor noise and writes 14-bit RGGB DNGs, a sidecar with
 the frame times and the applied shake (``timestamps.json``: ``times_s``,
 ``shake_dx_px``, ``shake_dy_px``) and a checksummed ``kind: outdoor`` manifest
-(:func:`shadowcam.synthetic.outdoor.sample.write_sample`), for the throughput and memory
-benchmark (``make bench-outdoor-size``), which also measures the registration against
-the recorded shake. No arrival-time ground truth at that size.
+(:func:`shadowcam.synthetic.outdoor.sample.write_sample`), for throughput, memory and
+registration (against the recorded shake) measurements on a real capture's frames made
+large. No arrival-time ground truth at that size: ``make bench-outdoor-size`` renders
+the scene at its real size instead (``synthetic.outdoor.window``).
 
 Example::
 

@@ -24,6 +24,7 @@ read_benchmarks : stage -> list of (seconds, max RSS MB) per job.
 directory_bytes : total size of the files under a directory.
 benchmark_table : the per-stage table and the extrapolation, as text lines.
 registration_line : the registration error at a sample's size against its applied shake, as text.
+accuracy_line : the arrival-time accuracy of a run against its ground truth, as text.
 time_decode : decode-only time and size of RAW frames, with the pipeline's reader.
 memory_growth : per-stage peak RSS extrapolated linearly to two frame counts, and their ratio.
 scale_targets : the four scale ratios of a run against their targets, as text lines.
@@ -149,6 +150,27 @@ def registration_line(photometry, shake, *, shape):
     return (f"registration at {shape[1]}x{shape[0]} against the applied shake "
             f"(up to {errors['true_max_px']:.2f} px from frame 0): rms {errors['rms_px']:.3f} px "
             f"(rows {errors['rms_row_px']:.3f}, cols {errors['rms_col_px']:.3f}), max {errors['max_abs_px']:.3f} px")
+
+
+def accuracy_line(accuracy, *, shape):
+    """The arrival-time accuracy of a run against its ground truth, as text.
+
+    Parameters
+    ----------
+    accuracy : mapping
+        The run's ``outdoor/accuracy.json`` (``shadowcam outdoor-accuracy``): errors in
+        frame intervals of the primary estimator and definition, its targets.
+    shape : (int, int)
+        ``(rows, cols)`` of the frames.
+    """
+    errors = accuracy["errors"][accuracy["primary_estimator"]][accuracy["primary_definition"]]
+    verdict = ", ".join(f"{t['target']} {t['comparison']} {t['threshold']:g} {'pass' if t['pass'] else 'FAIL'}"
+                        for t in accuracy["targets"])
+    return (f"arrival accuracy at {shape[1]}x{shape[0]} ({accuracy['primary_estimator']}, "
+            f"{accuracy['primary_definition']}, {errors['n_evaluated']} pixels, interval "
+            f"{accuracy['interval_s']:.1f} s): median {errors['median_abs']:.3f}, p95 {errors['p95_abs']:.3f} "
+            f"intervals, beyond 5 intervals {100 * errors['frac_over_5']:.2f} %, coverage "
+            f"{100 * errors['coverage']:.1f} % ({verdict})")
 
 
 #: scale targets of an outdoor time-lapse: store / RAW bytes, end-to-end / decode,

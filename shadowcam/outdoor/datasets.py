@@ -9,6 +9,7 @@ photometry_dataset : per-frame shifts and gains, per-pixel masks and levels.
 photometry_arrays : the dict :class:`shadowcam.outdoor.tracking.EdgeTracker` takes, from that dataset.
 photometry_part_dataset : one time part of the first pass (per-frame values, running minimum).
 photometry_part_arrays : the dict :func:`shadowcam.outdoor.normalise.merge_parts` takes, from that dataset.
+sky_mask_dataset : a sweep's sky mask and its source.
 edges_dataset : tracked edges over (time, col), keyframes, interpolation flags.
 pushbroom_dataset : the ridge pushbroom over (time, col, channel).
 """
@@ -128,6 +129,27 @@ def photometry_part_arrays(dataset):
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),
         "reference": dataset["reference"].values if "reference" in dataset else None,
     }
+
+
+def sky_mask_dataset(mask, *, source):
+    """A sweep's sky mask as a dataset.
+
+    Parameters
+    ----------
+    mask : (rows, cols) bool ndarray
+    source : str
+        How it was obtained (``auto`` or the manifest override), attr ``sky_source``.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``sky_mask (row, col)`` uint8 (1 = sky).
+    """
+    mask = np.asarray(mask, dtype=bool)
+    if mask.ndim != 2:
+        raise ValueError(f"mask must be (rows, cols); got shape {mask.shape}")
+    return xr.Dataset({"sky_mask": (("row", "col"), mask.astype(np.uint8), {"long_name": "sky (1) or scene (0)"})},
+                      attrs={"sky_source": str(source)})
 
 
 def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpolated):

@@ -8,6 +8,7 @@ Offers
 ------
 PHOTOMETRY_OPTIONS : options of :func:`photometry_from_frames`.
 sky_mask_from_manifest : the manifest's sky mask override (polygon or image), if any.
+sweep_sky_mask : the sky mask of a sweep, once for all its time parts (override, else automatic).
 photometry_from_frames : frame store -> photometry dataset (or the dataset of one time part).
 merge_photometry_parts : the part datasets -> the photometry dataset of the whole sweep.
 """
@@ -23,7 +24,7 @@ from shadowcam.outdoor.datasets import (
 )
 from shadowcam.outdoor.normalise import PartMerger, normalise_frames, normalise_part, part_frames
 from shadowcam.outdoor.photometric import exposure_gains
-from shadowcam.outdoor.sky_mask import mask_from_image, polygon_mask
+from shadowcam.outdoor.sky_mask import auto_sky_mask, mask_from_image, polygon_mask
 
 PHOTOMETRY_OPTIONS = frozenset({"sky_params", "registration_size", "registration_levels",
                                 "registration_margin", "overlap"})
@@ -49,6 +50,35 @@ def sky_mask_from_manifest(manifest, shape):
     path = manifest["files"]["sky_mask"][0]
     image = read_frame(f"{manifest['root']}/{path}")
     return mask_from_image(image, shape), f"manifest image {path}"
+
+
+def sweep_sky_mask(frames, manifest, *, sky_params=None):
+    """The sky mask of a sweep: the manifest's override, else automatic on its first frame.
+
+    Computed once per sweep, it is what every time part of the first pass uses
+    (:func:`photometry_from_frames` ``sky``): the same mask the pass would compute from
+    the same first frame.
+
+    Parameters
+    ----------
+    frames : xarray.Dataset
+        Frame store (``image (time, row, col, channel)``).
+    manifest : mapping
+        Loaded manifest (its ``sky_mask`` override, if any).
+    sky_params : dict, optional
+        Options of :func:`shadowcam.outdoor.sky_mask.auto_sky_mask`.
+
+    Returns
+    -------
+    mask : (rows, cols) bool ndarray
+    source : str
+        ``"auto"`` or the override's source.
+    """
+    mask, source = sky_mask_from_manifest(manifest, (frames.sizes["row"], frames.sizes["col"]))
+    if mask is None:
+        first = np.asarray(frames["image"].isel(time=0).values, dtype=np.float32)
+        mask = auto_sky_mask(first, **dict(sky_params or {}))
+    return np.asarray(mask, dtype=bool), source
 
 
 def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_metadata=True, part=None,

@@ -42,7 +42,8 @@ OUTDOOR_OPTIONS = {
     "start_elevation_deg": 20.0, "end_elevation_deg": 1.5,
     "auto_exposure": True, "shake_px": 1.0, "cloud": True,
     "irregular_timing": True, "dropped_frames": 2,
-    "base_exposure_s": 0.004, "sun_diameter_deg": 0.0,
+    "base_exposure_s": 0.004, "sun_diameter_deg": 0.0, "window": None,
+    "dng_compression": "none",
 }
 
 

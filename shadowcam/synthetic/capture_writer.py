@@ -53,7 +53,7 @@ CAPTURE_DATE = datetime.date(2025, 1, 21)
 
 
 def write_frame(path, radiance, *, frame_format, noise, sensor, scale, seed, when,
-                exposure_time=None):
+                exposure_time=None, compression="none"):
     """Simulate the sensor on `radiance` and write one frame to `path`.
 
     Parameters
@@ -74,6 +74,8 @@ def write_frame(path, radiance, *, frame_format, noise, sensor, scale, seed, whe
         DateTimeOriginal of a DNG.
     exposure_time : float, optional
         ExposureTime (s) of a DNG.
+    compression : {"none", "ljpeg"}, optional
+        DNG compression (lossless JPEG as cameras write, or none).
     """
     from shadowcam.io.raw_writer import write_dng, write_tiff16
     from shadowcam.synthetic.sensor import raw_to_linear, simulate_raw
@@ -83,7 +85,7 @@ def write_frame(path, radiance, *, frame_format, noise, sensor, scale, seed, whe
     if frame_format == "dng":
         raw = simulate_raw(radiance, sensor=sensor, scale=scale, seed=seed, noise=noise, mosaic=True)
         write_dng(path, raw, bit_depth=sensor.bit_depth, black_level=sensor.black_level,
-                  capture_time=when, exposure_time=exposure_time)
+                  capture_time=when, exposure_time=exposure_time, compression=compression)
     else:
         dn = simulate_raw(radiance, sensor=sensor, scale=scale, seed=seed, noise=noise, mosaic=False)
         linear = raw_to_linear(dn, sensor=sensor)
@@ -264,7 +266,7 @@ def write_outdoor_capture(options, out_dir):
         options["scene"], seed=seed, height=options["height"], width=options["width"],
         latitude_deg=outdoor["latitude_deg"], declination_deg=outdoor["declination_deg"],
         start_elevation_deg=outdoor["start_elevation_deg"],
-        end_elevation_deg=outdoor["end_elevation_deg"])
+        end_elevation_deg=outdoor["end_elevation_deg"], window=outdoor["window"])
     capture = render_outdoor_capture(
         scene, frames=int(options["frames"]), supersample=int(options["supersample"]),
         seed=seed, sun_diameter_deg=outdoor["sun_diameter_deg"],
@@ -288,6 +290,7 @@ def write_outdoor_capture(options, out_dir):
             rel = f"frames/{k:06d}.{ext}"
             when = start + datetime.timedelta(milliseconds=int(round(times[k] * 1000.0)))
             write(tmp / rel, image, seed=[seed, TIMELAPSE_SWEEP_INDEX, k], when=when,
+                  compression=outdoor["dng_compression"],
                   exposure_time=float(exposure_s[k]))
             written.append(rel)
             progress.update(k + 1)

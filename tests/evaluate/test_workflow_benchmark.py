@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from shadowcam.evaluate.workflow_benchmark import (benchmark_table, directory_bytes, memory_growth, read_benchmarks,
+from shadowcam.evaluate.workflow_benchmark import (accuracy_line, benchmark_table, directory_bytes, memory_growth, read_benchmarks,
                                                   scale_targets, time_decode)
 
 HEADER = "s\th:m:s\tmax_rss\tmax_vms\n"
@@ -111,3 +111,15 @@ def test_column_strip_jobs_are_one_stage_apart_from_their_merge(tmp_path):
     _write(tmp_path, "track_edges", 1.0, 900)
     assert read_benchmarks(tmp_path) == {"track_edges": [(1.0, 900.0)],
                                          "track_edges_strips": [(5.0, 700.0), (6.0, 720.0)]}
+
+
+def test_accuracy_line_reports_the_primary_errors_and_every_target_verdict():
+    errors = {"n_evaluated": 5000, "coverage": 0.987, "median_abs": 0.25, "p95_abs": 2.5, "frac_over_5": 0.004}
+    accuracy = {"primary_estimator": "combined", "primary_definition": "pixel_centre", "interval_s": 300.0,
+                "errors": {"combined": {"pixel_centre": errors, "half_coverage": dict(errors, median_abs=9.0)}},
+                "targets": [{"target": "median_abs", "comparison": "<=", "threshold": 0.5, "pass": True},
+                            {"target": "p95_abs", "comparison": "<=", "threshold": 2.0, "pass": False}]}
+    line = accuracy_line(accuracy, shape=(4000, 128))
+    assert line.startswith("arrival accuracy at 128x4000 (combined, pixel_centre, 5000 pixels, interval 300.0 s)")
+    assert "median 0.250, p95 2.500 intervals, beyond 5 intervals 0.40 %, coverage 98.7 %" in line
+    assert line.endswith("(median_abs <= 0.5 pass, p95_abs <= 2 FAIL)")

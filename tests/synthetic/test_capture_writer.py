@@ -109,3 +109,21 @@ def test_a_light_on_the_wire_path_names_the_key_and_writes_nothing(tmp_path):
                                          r"\('v'\).light: lies \(nearly\) in the plane"):
         write_capture(options, tmp_path / "capture")
     assert not (tmp_path / "capture").exists()
+
+
+def test_a_lossless_jpeg_frame_holds_the_same_mosaic_as_an_uncompressed_one(tmp_path):
+    import datetime
+
+    from shadowcam.io.raw_mosaic import read_mosaic
+    from shadowcam.synthetic.capture_writer import write_frame
+    from shadowcam.synthetic.sensor import SensorModel
+
+    radiance = np.random.default_rng(1).uniform(0.0, 1.0, (24, 32, 3)).astype(np.float32)
+    sensor = SensorModel(bit_depth=14)
+    when = datetime.datetime(2026, 1, 15, 16, 0, 0)
+    for compression in ("none", "ljpeg"):
+        write_frame(tmp_path / f"{compression}.dng", radiance, frame_format="dng", noise=True, sensor=sensor,
+                    scale=5000.0, seed=[3, 1, 0], when=when, compression=compression)
+    plain, compressed = read_mosaic(tmp_path / "none.dng")[0], read_mosaic(tmp_path / "ljpeg.dng")[0]
+    np.testing.assert_array_equal(compressed, plain)
+    assert (tmp_path / "ljpeg.dng").stat().st_size < (tmp_path / "none.dng").stat().st_size

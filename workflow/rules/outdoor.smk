@@ -1,5 +1,5 @@
 # Stages of an outdoor time-lapse (manifest kind: outdoor): registration and
-# photometric normalisation (one job per time span of config outdoor.part_frames
+# photometric normalisation (the sky mask once per sweep, then one job per time span of config outdoor.part_frames
 # frames, then an exact merge), shadow-edge tracking with keyframe interpolation
 # (one job per column strip of config outdoor.edge_strips, merged exactly),
 # the per-pixel arrival-time map, the ridge pushbroom, accuracy (datasets with
@@ -7,10 +7,35 @@
 # the shared `decode` rule (results/{ds}/frames/<sweep>.zarr).
 
 
+rule outdoor_sky_mask:
+    input:
+        capture=get_capture_input,
+        frames=get_outdoor_frames,
+    output:
+        "results/{ds}/outdoor/sky_mask.nc",
+    log:
+        "logs/{ds}/outdoor_sky_mask.log",
+    benchmark:
+        "benchmarks/{ds}/outdoor_sky_mask.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    threads: 1
+    resources:
+        mem_mb=get_normalise_mem_mb,
+        runtime=10,
+    params:
+        manifest=get_capture_manifest,
+        options=as_json(config["outdoor"]["normalise"]),
+    shell:
+        "shadowcam outdoor-sky-mask --manifest {params.manifest} --frames {input.frames}"
+        " --params {params.options:q} --out {output} > {log} 2>&1"
+
+
 rule outdoor_normalise_part:
     input:
         capture=get_capture_input,
         frames=get_outdoor_frames,
+        sky="results/{ds}/outdoor/sky_mask.nc",
     output:
         temp("results/{ds}/outdoor/photometry.parts/{span}.nc"),
     log:
@@ -29,7 +54,7 @@ rule outdoor_normalise_part:
         options=as_json(config["outdoor"]["normalise"]),
     shell:
         "shadowcam outdoor-normalise --manifest {params.manifest} --frames {input.frames}"
-        " --part {params.span} --params {params.options:q} --out {output} > {log} 2>&1"
+        " --sky {input.sky} --part {params.span} --params {params.options:q} --out {output} > {log} 2>&1"
 
 
 rule outdoor_normalise:

@@ -27,6 +27,7 @@ Offers
 OutdoorScene : terrain, camera and sun path of a capture.
 make_outdoor_scene : the seeded ``ridge`` scene (camera placed as in dev_ridge).
 OUTDOOR_SCENES : scene name -> factory.
+window_camera : the camera of a window (strip, crop) of a camera's pixels.
 SampleGeometry : per-sample terrain hits, normals, albedo, view directions, horizons.
 trace_samples : intersect view rays through image points and compute their horizons.
 sample_grid : image points of the supersample grid (pixel-major) or of pixel centres.
@@ -44,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from shadowcam._shared.validation import check_in, check_in_interval
-from shadowcam.synthetic.lab.scene import camera_rays, look_at_camera
+from shadowcam.synthetic.lab.scene import PinholeCamera, camera_rays, look_at_camera
 from shadowcam.synthetic.outdoor.sun import SunPath, sun_colour
 from shadowcam.synthetic.outdoor.terrain import horizon_angles, intersect_heightfield, make_ridge_terrain
 
@@ -86,7 +87,7 @@ class OutdoorScene:
 
 def make_outdoor_scene(name="ridge", *, seed=0, height=128, width=192, latitude_deg=35.0,
                        declination_deg=-18.0, start_elevation_deg=20.0, end_elevation_deg=1.5,
-                       hfov_deg=50.0):
+                       hfov_deg=50.0, window=None):
     """Build an outdoor scene by name.
 
     Parameters
@@ -103,6 +104,11 @@ def make_outdoor_scene(name="ridge", *, seed=0, height=128, width=192, latitude_
         Sun elevation at the first and the last frame (setting: start > end).
     hfov_deg : float, keyword-only
         Horizontal field of view.
+    window : (4,) sequence of int or None, keyword-only
+        ``(row0, col0, rows, cols)``: the scene's camera sees only these pixels of the
+        `height` x `width` camera (its principal point moved by ``(col0, row0)``), so that
+        a strip or crop of a real-size frame renders at its true resolution. None: the
+        whole frame.
 
     Returns
     -------
@@ -121,6 +127,8 @@ def make_outdoor_scene(name="ridge", *, seed=0, height=128, width=192, latitude_
     tx, ty = terrain.to_xy(100.0, -150.0)
     camera = look_at_camera((cx, cy, cz), (tx, ty, 720.0), fov_x_deg=hfov_deg,
                             width=int(width), height=int(height), up=(0.0, 0.0, 1.0))
+    if window is not None:
+        camera = window_camera(camera, window)
     sun = SunPath.from_start_elevation(start_elevation_deg, latitude_deg=latitude_deg,
                                        declination_deg=declination_deg)
     return OutdoorScene(terrain=terrain, camera=camera, sun=sun,
@@ -130,6 +138,35 @@ def make_outdoor_scene(name="ridge", *, seed=0, height=128, width=192, latitude_
 
 
 OUTDOOR_SCENES = {"ridge": make_outdoor_scene}
+
+
+def window_camera(camera, window):
+    """The pinhole camera that sees only a window of `camera`'s pixels.
+
+    Parameters
+    ----------
+    camera : shadowcam.synthetic.lab.scene.PinholeCamera
+    window : (4,) sequence of int
+        ``(row0, col0, rows, cols)`` inside ``camera.height`` x ``camera.width``.
+
+    Returns
+    -------
+    PinholeCamera
+        ``rows`` x ``cols``, principal point moved by ``(-col0, -row0)``: its pixel
+        ``(r, c)`` is `camera`'s pixel ``(row0 + r, col0 + c)``.
+    """
+    try:
+        row0, col0, rows, cols = (int(v) for v in window)
+    except (TypeError, ValueError):
+        raise ValueError(f"window: expected (row0, col0, rows, cols); got {window!r}") from None
+    if (row0 < 0 or col0 < 0 or rows < 8 or cols < 8 or row0 + rows > camera.height
+            or col0 + cols > camera.width):
+        raise ValueError(f"window {list(window)}: must lie inside the {camera.width}x{camera.height} "
+                         "frame (row0, col0 >= 0, rows, cols >= 8)")
+    K = camera.K.copy()
+    K[0, 2] -= col0
+    K[1, 2] -= row0
+    return PinholeCamera(K=K, R=camera.R, center=camera.center, width=cols, height=rows)
 
 
 def sample_grid(rows, cols, supersample=None):
