@@ -40,7 +40,7 @@ from shadowcam._shared.progress import Progress
 from shadowcam._shared.validation import check_in, check_positive
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, occluded
 from shadowcam.synthetic.lab.render import (
-    pixel_centre_ground_truth, render_image, render_reciprocal, trace_light_paths,
+    LightPaths, pixel_centre_ground_truth, render_image, render_reciprocal, trace_light_paths,
 )
 from shadowcam.synthetic.lab.scene import PinholeCamera, PointLight
 
@@ -213,7 +213,7 @@ def grid_mask_frames(objects, camera, grid, positions, family, *, supersample=3,
     for position in positions:
         paths = trace_light_paths(objects, camera, PointLight(position), supersample=supersample)
         keep = ~_blocked(paths.points, position, wire_points, direction, grid.radius)
-        frames.append(render_image(type(paths)(
+        frames.append(render_image(LightPaths(
             shape=paths.shape, pixel=paths.pixel[keep], points=paths.points[keep],
             light=paths.light[keep], radiance=paths.radiance[keep], distant=False)))
         if on_frame is not None:
