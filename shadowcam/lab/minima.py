@@ -375,11 +375,15 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     centre_level = level[:, w, :]
     lowest = np.nanmin(np.where(np.isfinite(normalised), normalised, np.inf), axis=1)
     contrast = np.where(present, 1.0 - lowest, np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):  # absent minima: zero level, NaN depth
+        relative_noise = noise[None] / centre_level
+        raw_lowest = (1.0 - contrast) * centre_level
+        depth = contrast * centre_level
     summary = DipSummary(
         window=normalised.transpose(1, 0, 2).astype(np.float32), window_start=centres - w,
         minimum_frame=centres, minimum_value=(1.0 - contrast).astype(np.float32),
         second_value=np.full((k_all, p), np.inf, np.float32), second_frame=np.full((k_all, p), -1),
-        lit_level=np.ones((k_all, p)), noise=noise[None] / centre_level,
+        lit_level=np.ones((k_all, p)), noise=relative_noise,
         lit_count=np.broadcast_to(passing.lit_count, (k_all, p)), mean_level=np.ones((k_all, p)),
         invalid_count=passing.invalid, n_frames=n_frames)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -393,7 +397,6 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     # under a steady level the window's ends must reach the level of the frames far from
     # every minimum (within a tenth of the dip's depth): else the dip is wider than the
     # window, or runs into the next one, and its crossings are not its own
-    raw_lowest = (1.0 - contrast) * centre_level
     with np.errstate(invalid="ignore"):
         end_level = np.minimum(level[:, 0, :], level[:, -1, :])
         unlit_ends = ~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest))
@@ -419,7 +422,7 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         return np.take_along_axis(a, perm, 0).reshape(count, rows, cols)
 
     return Minima(time=image(time), estimate=image(estimate), frame=image(centres),
-                  depth=image(contrast * centre_level), contrast=image(contrast), level=image(centre_level),
+                  depth=image(depth), contrast=image(contrast), level=image(centre_level),
                   width=image(width), time_std=image(std), reason=image(reason),
                   count=found.reshape(rows, cols), extra_contrast=extra_contrast.reshape(rows, cols),
                   noise=noise.reshape(rows, cols), lit_level=lit_level.reshape(rows, cols),
