@@ -39,7 +39,6 @@ capture_plan : read a manifest into a :class:`CapturePlan`.
 
 import inspect
 from dataclasses import dataclass, field
-from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
@@ -477,12 +476,9 @@ def _lightfield_plan(manifest):
     )
 
 
-def _camera_array_plan(manifest):
+def _rendered_lab_plan(manifest, stage, **facts):
+    """The plan of a rendered lab capture that runs one stage of its own (`facts`: its block)."""
     synthetic = manifest["synthetic"]
-    if manifest["kind"] != "lab":
-        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.camera_array' needs "
-                         f"kind: lab; got kind: {manifest['kind']}")
-    array = {"radius_frames": 0.6, **synthetic["camera_array"], "frames": int(synthetic["frames"])}
     return CapturePlan(
         name=manifest["name"],
         manifest_path=manifest["manifest_path"],
@@ -491,9 +487,18 @@ def _camera_array_plan(manifest):
         frame_shape=(int(synthetic["height"]), int(synthetic["width"])),
         has_reference=True,
         has_ground_truth=True,
-        stages=("camera_array",),
-        camera_array=MappingProxyType(array),
+        stages=(stage,),
+        **{key: MappingProxyType(value) for key, value in facts.items()},
     )
+
+
+def _camera_array_plan(manifest):
+    synthetic = manifest["synthetic"]
+    if manifest["kind"] != "lab":
+        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.camera_array' needs "
+                         f"kind: lab; got kind: {manifest['kind']}")
+    array = {"radius_frames": 0.6, **synthetic["camera_array"], "frames": int(synthetic["frames"])}
+    return _rendered_lab_plan(manifest, "camera_array", camera_array=array)
 
 
 def _light_set_plan(manifest):
@@ -501,17 +506,8 @@ def _light_set_plan(manifest):
     if manifest["kind"] != "lab" or "camera" in synthetic:
         raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.lights' needs kind: lab "
                          "and the standard u, v sweeps (no synthetic.camera block)")
-    return CapturePlan(
-        name=manifest["name"],
-        manifest_path=manifest["manifest_path"],
-        kind="lab",
-        rendered=True,
-        frame_shape=(int(synthetic["height"]), int(synthetic["width"])),
-        has_reference=True,
-        has_ground_truth=True,
-        stages=("light_views",),
-        light_set=MappingProxyType({"lights": tuple(synthetic["lights"]), "frames": int(synthetic["frames"])}),
-    )
+    lights = {"lights": tuple(synthetic["lights"]), "frames": int(synthetic["frames"])}
+    return _rendered_lab_plan(manifest, "light_views", light_set=lights)
 
 
 def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):

@@ -43,22 +43,7 @@ from shadowcam.synthetic.lab.raycast import (
     intersect_sphere,
     occluded,
 )
-from shadowcam.synthetic.lab.scene import PinholeCamera, camera_rays, look_at_camera
-
-
-def _vec(value, name):
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name}: expected 3 finite numbers, got {value!r}")
-    return arr
-
-
-def _unit(value, name):
-    arr = _vec(value, name)
-    norm = np.linalg.norm(arr)
-    if norm == 0:
-        raise ValueError(f"{name}: must not be the zero vector")
-    return arr / norm
+from shadowcam.synthetic.lab.scene import PinholeCamera, _unit, _vec, camera_rays, look_at_camera
 
 
 def _positive(value, name):
