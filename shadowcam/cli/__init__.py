@@ -37,7 +37,7 @@ STEPS = {
     "outdoor-accuracy": "outdoor_accuracy",
     "outdoor-figures": "outdoor_figures",
     "bench": "bench",
-    "methods-comparison": "methods_comparison",
+    "methods-comparison": "methods_comparison", "light-methods": "light_methods",
     "outdoor-sample": "outdoor_sample",
     "bench-report": "bench_report", "render-lightfield": "render_lightfield",  # light field: and lightfield-<stage>
     **{f"lightfield-{s}": f"lightfield_{s.replace('-', '_')}" for s in "hdr shadow-times rays render export accuracy report".split()}}

@@ -18,6 +18,7 @@ Offers
 ------
 add_parser : register the step and its options.
 run : measure and write the comparison.
+write_comparison : write a methods dataset, its CSV and its chart.
 """
 
 import logging
@@ -47,7 +48,7 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Measure every method against the ground truth and write table and chart."""
-    from shadowcam.evaluate.methods_comparison import compare_methods, speed_error_figure
+    from shadowcam.evaluate.methods_comparison import compare_methods
     from shadowcam.io.frame_store import open_frames
     from shadowcam.io.ground_truth import load_ground_truth
     from shadowcam.io.manifest import load_manifest
@@ -60,11 +61,18 @@ def run(args):
         load_ground_truth(manifest), {sweep: open_frames(path) for path, sweep in zip(args.frames, args.sweeps)},
         open_dataset(args.shadow_time), open_dataset(args.dual_coords),
         reference=open_frames(args.reference) if args.reference else None, half_window=params.get("half_window", 4))
-    dataset = write_dataset(dataset, args.out, config={"dataset": manifest["name"], **params},
-                            step="methods-comparison")
+    write_comparison(dataset, args, name=manifest["name"], config=params, step="methods-comparison")
+
+
+def write_comparison(dataset, args, *, name, config, step):
+    """Write `dataset` to ``args.out`` (with provenance), its table to ``args.csv`` and its
+    speed-versus-error chart to ``args.figure``."""
+    from shadowcam.evaluate.methods_comparison import speed_error_figure
+
+    dataset = write_dataset(dataset, args.out, config={"dataset": name, **config}, step=step)
     with atomic_path(args.csv) as tmp:
         dataset.to_dataframe().to_csv(tmp)
-    figure = speed_error_figure(dataset, title=f"{manifest['name']}: speed against error")
+    figure = speed_error_figure(dataset, title=f"{name}: speed against error")
     with atomic_path(args.figure) as tmp:
         figure.savefig(tmp, format="png", dpi=110)
     log.info("wrote %s, %s, %s", args.out, args.csv, args.figure)

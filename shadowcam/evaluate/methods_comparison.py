@@ -1,4 +1,4 @@
-"""Speed against error of every shadow-time and dual-view resampling method.
+"""Speed against error of every shadow-time, several-minima and dual-view resampling method.
 
 Every method of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS` and
 :data:`shadowcam.cameras.dual_view.DUAL_VIEW_METHODS` runs on the same scene and is
@@ -11,6 +11,11 @@ accurate) says which defaults the data justify.
   time is the tracking time plus its own; throughput is pixel-frames per
   second of that total; error is the absolute time error (frames) over the
   lit pixels with a true time, p50/p95, and coverage.
+* Several minima (a capture lit by several lights, paper Fig. 11): each timing
+  method the minima accept finds, times and assigns every pixel's minima to the
+  lights (:func:`shadowcam.lab.light_views.light_set_views`); throughput is
+  pixel-frames per second of both sweeps; error is the absolute time error
+  pooled over lights and sweeps on the scored pixels, p50/p95, and coverage.
 * Dual view: each resampling method maps the camera colours to the dual grid;
   throughput is camera pixels per second; error is the gain-fitted relative
   RMSE against the reciprocal render inside the covered, visible mask.
@@ -22,11 +27,13 @@ kernels' own buffers are not counted), and once timed.
 Offers
 ------
 compare_shadow_time_methods : rows of figures, one per shadow-time method.
+compare_minima_methods : rows of figures, one per timing method of several minima.
 compare_dual_view_methods : rows of figures, one per resampling method.
 pareto_front : which rows no other row beats in both speed and error.
 methods_dataset : the rows as an xarray dataset over ``method``.
 speed_error_figure : the speed-versus-error chart with its Pareto front.
 compare_methods : every method on one dataset's frame stores and dual coordinates -> the methods dataset.
+compare_light_set_methods : every several-minima method on one several-lights capture -> the methods dataset.
 """
 
 import logging
@@ -37,6 +44,8 @@ import numpy as np
 
 from shadowcam.lab.accuracy import dual_image_errors, shadow_time_errors
 from shadowcam.cameras.dual_view import DUAL_VIEW_METHODS, resample_dual_view
+from shadowcam.lab.light_views import SWEEPS as LIGHT_SET_SWEEPS
+from shadowcam.lab.light_views import light_set_errors, light_set_views
 from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, summary_shadow_times, track_sweep
 
 log = logging.getLogger(__name__)
@@ -117,6 +126,53 @@ def compare_shadow_time_methods(sweeps, *, methods=None, half_window=4, cfa_patt
     return rows
 
 
+#: timing methods a minimum accepts (edge_fit mixes neighbours' times, possibly of other minima)
+MINIMA_METHODS = tuple(m for m in SHADOW_TIME_METHODS if m != "edge_fit")
+
+
+def compare_minima_methods(capture, *, methods=None, half_window=4):
+    """Speed and per-light error of the timing methods of several minima on one capture.
+
+    Parameters
+    ----------
+    capture : xarray.Dataset
+        A several-lights capture with its per-light truth (see
+        :func:`shadowcam.lab.light_views.light_set_views` and
+        :func:`~shadowcam.lab.light_views.light_set_errors`).
+    methods : sequence of str, optional
+        Default: every method of :data:`MINIMA_METHODS`.
+    half_window : int, optional
+
+    Returns
+    -------
+    list of dict
+        Per method: ``stage`` ("several_minima"), ``method``, ``seconds``,
+        ``throughput`` (pixel-frames/s over both sweeps), ``peak_mib``, ``p50``,
+        ``p95`` (frames, pooled over lights and sweeps), ``coverage`` (timed
+        fraction of the scored pixel-lights).
+    """
+    methods = list(methods or MINIMA_METHODS)
+    unknown = set(methods) - set(MINIMA_METHODS)
+    if unknown:
+        raise ValueError(f"methods: {sorted(unknown)} cannot time several minima; choose from {sorted(MINIMA_METHODS)}")
+    capture = capture.load()
+    pixel_frames = sum(capture[f"frames_{s}"].shape[0] for s in LIGHT_SET_SWEEPS) * capture["reference"][..., 0].size
+    rows = []
+    for method in methods:
+        views, seconds, peak = _measured(lambda: light_set_views(capture, half_window=half_window, method=method))
+        errors = light_set_errors(views, capture)
+        err = np.concatenate([error[scored] for error, scored in errors.values()])
+        timed = err[np.isfinite(err)]
+        rows.append({
+            "stage": "several_minima", "method": method, "seconds": seconds,
+            "throughput": pixel_frames / seconds, "peak_mib": peak,
+            "p50": float(np.median(timed)) if timed.size else np.nan,
+            "p95": float(np.percentile(timed, 95)) if timed.size else np.nan,
+            "coverage": timed.size / err.size if err.size else np.nan,
+        })
+    return rows
+
+
 def compare_dual_view_methods(colours, u, v, *, shape, valid, reciprocal, dual_cam_visible,
                               methods=None):
     """Speed and error of dual-view resampling methods on the same dual coordinates.
@@ -186,7 +242,7 @@ def pareto_front(throughput, error):
 
 _UNITS = {
     "seconds": ("s", "wall time of the method (shadow time: including the shared tracking)"),
-    "throughput": ("1/s", "pixel-frames per second (shadow time) or camera pixels per second (dual view)"),
+    "throughput": ("1/s", "pixel-frames per second (shadow time, several minima) or camera pixels per second (dual view)"),
     "peak_mib": ("MiB", "peak numpy/Python heap during the method (tracemalloc)"),
     "p50": ("frame", "median absolute shadow-time error"),
     "p95": ("frame or 1", "95th percentile absolute shadow-time error; dual view: relative RMSE"),
@@ -256,9 +312,9 @@ def speed_error_figure(dataset, *, title=""):
             ax.annotate(str(label), (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
         if np.nanmax(speed) > 10 * np.nanmin(speed):
             ax.set_xscale("log")
-        unit = "M pixel-frames/s" if name == "shadow_time" else "M camera pixels/s"
+        unit = "M camera pixels/s" if name == "dual_view" else "M pixel-frames/s"
         ax.set_xlabel(f"throughput ({unit}, higher is better)")
-        ax.set_ylabel("p95 |time error| (frames)" if name == "shadow_time" else "relative RMSE")
+        ax.set_ylabel("relative RMSE" if name == "dual_view" else "p95 |time error| (frames)")
         ax.set_title(name.replace("_", " "))
         ax.legend(fontsize=8)
     if title:
@@ -318,8 +374,29 @@ def compare_methods(truth, sweeps, shadow_time, coords, *, reference=None, half_
         valid=coords["valid"].values, reciprocal=truth["reciprocal"].transpose("v", "u", "channel").values,
         dual_cam_visible=truth["dual_cam_visible"].transpose("v", "u").values,
     )
-    dataset = methods_dataset(rows)
+    return _logged(rows, methods_dataset(rows))
+
+
+def _logged(rows, dataset):
     for row, on_front in zip(rows, dataset["pareto"].values):
-        log.info("%-12s %-38s %9.3g /s  p95 %.4f  coverage %.3f  %s", row["stage"], row["method"],
+        log.info("%-14s %-38s %9.3g /s  p95 %.4f  coverage %.3f  %s", row["stage"], row["method"],
                  row["throughput"], row["p95"], row["coverage"], "Pareto" if on_front else "")
     return dataset
+
+
+def compare_light_set_methods(capture, *, half_window=4):
+    """Time every several-minima method on one several-lights capture and score it.
+
+    Parameters
+    ----------
+    capture : xarray.Dataset
+        From the render-lights step (frames, reference, per-light truth).
+    half_window : int
+
+    Returns
+    -------
+    xarray.Dataset
+        :func:`methods_dataset` of every method of :data:`MINIMA_METHODS`.
+    """
+    rows = compare_minima_methods(capture, half_window=half_window)
+    return _logged(rows, methods_dataset(rows))

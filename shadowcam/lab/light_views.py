@@ -12,6 +12,7 @@ Offers
 ------
 light_set_views : a several-lights capture -> per-light shadow times, reasons, contrast,
     confidence and dual views.
+light_set_errors : per-light, per-sweep absolute time errors on the scored pixels.
 light_set_accuracy : per-light, per-sweep error and coverage against the renderer.
 """
 
@@ -25,7 +26,7 @@ from shadowcam.lab.minima import find_minima
 SWEEPS = ("u", "v")
 
 
-def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
+def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, tolerance=2.0):
     """Per-light shadow times and dual views.
 
     Parameters
@@ -37,6 +38,8 @@ def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
     half_window : int
         Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
         across the wire spreads its shadow over its projection).
+    method : str
+        Timing method of each minimum (:func:`~shadowcam.lab.minima.find_minima`).
     radius, tolerance
         Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
 
@@ -55,7 +58,8 @@ def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
     per_sweep = {}
     for name in SWEEPS:
         frames = capture[f"frames_{name}"].values
-        minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window)
+        minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
+                             method=method)
         in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
         # the k-th shadow along the sweep is the light k-th along the wire's motion
         order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
@@ -78,8 +82,45 @@ def light_set_views(capture, *, half_window=4, radius=2, tolerance=2.0):
          "reason": stacked("reason", np.int8),
          "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage)},
         coords={"sweep": list(SWEEPS), "light": capture["light"].values, "channel": capture["channel"].values},
-        attrs={"reasons": str(LIGHT_REASONS), "half_window": int(half_window), "radius": int(radius),
+        attrs={"reasons": str(LIGHT_REASONS), "half_window": int(half_window), "method": method,
+               "radius": int(radius),
                "tolerance": float(tolerance)})
+
+
+def light_set_errors(views, capture, *, min_level=0.2):
+    """Per-light, per-sweep absolute time errors on the pixels that can be scored.
+
+    A pixel is scored for light k and a sweep when it is lit (reference level above
+    `min_level` times its median) and light k's shadow lies entirely inside the sweep
+    (more than two frames from either end).
+
+    Parameters
+    ----------
+    views : xarray.Dataset
+        From :func:`light_set_views`.
+    capture : xarray.Dataset
+        With ``t_center_<sweep>``, ``t_first_<sweep>``, ``t_last_<sweep>`` (light, y, x)
+        and ``reference``.
+    min_level : float
+
+    Returns
+    -------
+    dict of (str, int) to ((y, x) float ndarray, (y, x) bool ndarray)
+        (sweep, light) -> |estimate - truth| (frames; NaN where untimed or unscored) and
+        the scored pixels.
+    """
+    level = capture["reference"].values.sum(-1)
+    lit = level > min_level * np.median(level)
+    out = {}
+    for s, name in enumerate(SWEEPS):
+        n = capture.sizes[f"t_{name}"]
+        for k in range(capture.sizes["light"]):
+            truth = capture[f"t_center_{name}"].values[k]
+            scored = (lit & np.isfinite(truth) & (capture[f"t_first_{name}"].values[k] > 2)
+                      & (capture[f"t_last_{name}"].values[k] < n - 3))
+            error = np.where(scored, np.abs(views["time"].values[s, k] - truth), np.nan)
+            out[name, k] = (error, scored)
+    return out
 
 
 def light_set_accuracy(views, capture, *, min_level=0.2):
@@ -90,7 +131,7 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
     views : xarray.Dataset
         From :func:`light_set_views`.
     capture : xarray.Dataset
-        With ``t_center_s``, ``t_first_s``, ``t_last_s`` (light, y, x) and ``reference``.
+        As for :func:`light_set_errors`.
     min_level : float
         Pixels darker than this fraction of the median reference are not scored.
 
@@ -102,19 +143,14 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
         of the scored pixels: lit, the light's shadow entirely inside the sweep),
         ``n_scored``, ``contrast`` (median) and ``reasons`` (name -> count).
     """
-    level = capture["reference"].values.sum(-1)
-    lit = level > min_level * np.median(level)
+    errors = light_set_errors(views, capture, min_level=min_level)
     out = []
     for k in range(capture.sizes["light"]):
         entry = {}
         for s, name in enumerate(SWEEPS):
-            n = capture.sizes[f"t_{name}"]
-            truth = capture[f"t_center_{name}"].values[k]
-            scored = (lit & np.isfinite(truth) & (capture[f"t_first_{name}"].values[k] > 2)
-                      & (capture[f"t_last_{name}"].values[k] < n - 3))
-            time = views["time"].values[s, k]
+            error, scored = errors[name, k]
+            err = error[scored]
             reason = views["reason"].values[s, k]
-            err = np.abs(time - truth)[scored]
             timed = np.isfinite(err)
             contrast = views["contrast"].values[s, k][scored]
             entry[name] = {

@@ -83,3 +83,27 @@ def test_dataset_marks_the_front_per_stage_and_the_figure_has_a_panel_per_stage(
     assert ds["p95"].attrs["units"]
     figure = speed_error_figure(ds)
     assert len(figure.axes) == 2
+
+
+def test_every_minima_method_is_scored_on_a_two_light_capture():
+    from shadowcam.evaluate.methods_comparison import MINIMA_METHODS, compare_minima_methods
+    from shadowcam.lab.light_views import light_set_accuracy, light_set_views
+    from shadowcam.synthetic.lab.light_set_capture import render_light_set_capture
+
+    capture = render_light_set_capture({
+        "scene": "tabletop", "seed": 2, "height": 24, "width": 24, "frames": 32, "supersample": 1,
+        "lights": [{"kind": "point"}, {"kind": "point", "offset": [0.01, 0.01, 0.0]}]})
+    rows = compare_minima_methods(capture, methods=["dip_centroid", "argmin_parabolic"])
+    assert [r["method"] for r in rows] == ["dip_centroid", "argmin_parabolic"]
+    assert "edge_fit" not in MINIMA_METHODS
+    for row in rows:
+        assert row["stage"] == "several_minima" and row["throughput"] > 0 and row["peak_mib"] > 0
+        assert 0.9 < row["coverage"] <= 1.0
+        assert row["p50"] <= row["p95"] < 1.0  # frames, against the renderer's per-light times
+    # the pooled figures are those of the per-light accuracy: the worst light-sweep p95
+    # bounds the pooled p95 from above, the best from below
+    acc = light_set_accuracy(light_set_views(capture, method="dip_centroid"), capture)["lights"]
+    per_light = [entry[s]["p95_error"] for entry in acc for s in ("u", "v")]
+    assert min(per_light) <= rows[0]["p95"] <= max(per_light)
+    with pytest.raises(ValueError, match="cannot time several minima"):
+        compare_minima_methods(capture, methods=["edge_fit"])

@@ -63,3 +63,36 @@ rule light_accuracy:
     shell:
         "shadowcam light-accuracy --capture {input.capture} --views {input.views}"
         " --out-json {output.json} --out-png {output.png} > {log} 2>&1"
+
+
+# On request (not part of `all`: it reruns every method): speed against error of the
+# timing methods of several minima, results/<ds>/lights/methods/speed_vs_error.png.
+rule light_methods:
+    input:
+        "results/{ds}/lights/capture.nc",
+    output:
+        dataset="results/{ds}/lights/methods/methods.nc",
+        csv=report(
+            "results/{ds}/lights/methods/methods.csv",
+            caption="../report/methods.rst",
+            category="Several lights",
+            labels={"dataset": "{ds}", "table": "methods (CSV)"},
+        ),
+        figure=report(
+            "results/{ds}/lights/methods/speed_vs_error.png",
+            caption="../report/methods.rst",
+            category="Several lights",
+            labels={"dataset": "{ds}", "figure": "speed against error"},
+        ),
+    log:
+        "logs/{ds}/light_methods.log",
+    benchmark:
+        "benchmarks/{ds}/light_methods.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_light_set_mem_mb,
+        runtime=30,
+    shell:
+        "shadowcam light-methods --capture {input} --dataset {wildcards.ds} --out {output.dataset}"
+        " --csv {output.csv} --figure {output.figure} > {log} 2>&1"
