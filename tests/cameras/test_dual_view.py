@@ -278,3 +278,116 @@ def test_mesh_covers_a_magnified_surface_but_not_the_gap_of_a_jump():
     # kept: camera columns 0..4 (steps before the one next to the jump) and 7..11 shifted by 12
     assert cols_covered.tolist() == list(range(0, 13)) + list(range(33, 46))
     assert not cov2[:, 13:33].any()
+
+
+# --------------------------------------------------------------------------- camera-pixel density
+
+
+def _density_view(u, v, colours, shape, **params):
+    return resample_dual_view(colours, u, v, shape=shape, method="mesh", density=True, **params)
+
+
+def test_density_counts_pixel_centres_on_shared_edges_and_vertices_once():
+    # identity map: every dual pixel centre is a mesh vertex shared by up to six triangles
+    r, c = np.mgrid[0:20, 0:20].astype(float)
+    colours = np.ones((20, 20, 3), dtype=np.float32)
+    img, cov = _density_view(c, r, colours, (20, 20))
+    assert cov[:19, :19].all()
+    np.testing.assert_allclose(img[1:19, 1:19], 1.0, rtol=1e-12)  # not 2, 3 or 6 times
+    # and the plain warp is unchanged by the option's default
+    plain, _ = resample_dual_view(colours, c, r, shape=(20, 20), method="mesh")
+    np.testing.assert_allclose(plain[1:19, 1:19], 1.0)
+
+
+@pytest.mark.parametrize("scale", [0.5, 1.7, 3.0])
+def test_density_is_camera_pixels_per_dual_pixel_under_an_affine_map(scale):
+    # u, v = scale * R (col, row): camera pixels per dual pixel = 1 / scale^2 exactly
+    a = np.deg2rad(20.0)
+    r, c = np.mgrid[0:40, 0:40].astype(float)
+    u = scale * (np.cos(a) * c - np.sin(a) * r) + 30.0
+    v = scale * (np.sin(a) * c + np.cos(a) * r) + 2.0
+    colours = np.stack([0.2 + 0.01 * c, 0.5 + 0 * c, 0.1 + 0.002 * r], -1).astype(np.float32)
+    img, cov = _density_view(u, v, colours, (64, 64))
+    colour, _ = resample_dual_view(colours, u, v, shape=(64, 64), method="mesh")
+    np.testing.assert_allclose(img[cov], colour[cov] / scale**2, rtol=1e-5)
+
+
+def test_density_sums_the_branches_and_draws_nothing_across_the_jump():
+    # two camera halves (a direct view and a mirror branch) land on overlapping dual pixels:
+    # the density view is the sum of the two; triangles across the jump between the halves
+    # (a step of 10 dual px between steps of 1) would add to the right branch's pixels
+    r, c = np.mgrid[0:30, 0:30].astype(float)
+    u = np.where(c < 15, c, 39.0 - c)  # right half: u = 24 .. 10, mirrored
+    v = np.where(c < 15, r, r + 5.0)
+    colours = np.stack([0.3 + 0 * c, np.where(c < 15, 1.0, 2.0), 0.1 + 0 * c], -1).astype(np.float32)
+    img, cov = _density_view(u, v, colours, (40, 30))
+    np.testing.assert_allclose(img[6:29, 11:14, 1], 3.0, rtol=1e-9)
+    np.testing.assert_allclose(img[6:34, 15:24, 1], 2.0, rtol=1e-9)
+    np.testing.assert_allclose(img[1:29, 1:10, 1], 1.0, rtol=1e-9)
+    assert not cov[:, 25:].any() and not cov[35:].any()
+
+
+def test_density_needs_the_mesh_warp():
+    from shadowcam.cameras.dual_view import dual_view_from_coords
+
+    coords = xr.Dataset({"u": (("row", "col"), np.zeros((4, 4))), "v": (("row", "col"), np.zeros((4, 4))),
+                         "valid": (("row", "col"), np.ones((4, 4), bool))},
+                        attrs={"dual_height": 4, "dual_width": 4})
+    with pytest.raises(ValueError, match="density"):
+        dual_view_from_coords(coords, None, reference=None, method="idw", density=True)
+
+
+def _plane_hits(optics, focal, size, depth_z, pitch=1e-3):
+    """Dual (u, v) (plane position / `pitch`) of the camera pixel centres of a pinhole at
+    the origin looking along +z (or back along -z after a mirror), through `optics`."""
+    from shadowcam.synthetic.lab.optics import trace_through_optics
+
+    r, c = np.mgrid[0:size, 0:size].astype(float)
+    x, y = (c - (size - 1) / 2) / focal, (r - (size - 1) / 2) / focal
+    dirs = np.stack([x.ravel(), y.ravel(), np.ones(size * size)], 1)
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    bent = trace_through_optics(optics, np.zeros_like(dirs), dirs)
+    s = (depth_z - bent.origins[:, 2]) / bent.directions[:, 2]
+    hit = bent.origins + s[:, None] * bent.directions
+    return hit[:, 0].reshape(size, size) / pitch, hit[:, 1].reshape(size, size) / pitch
+
+
+def test_density_through_a_slab_is_the_slab_magnification():
+    # a plane at depth Z behind a slab (thickness t, index n) perpendicular to the axis is
+    # seen as if at Z - t (1 - 1/n) (paraxial); dual px per camera px m = (Z - t(1 - 1/n)) /
+    # (f pitch), so the density view of a uniform colour is 1 / m^2 (field +-0.5 deg)
+    from shadowcam.synthetic.lab.optics import GlassSlab
+
+    focal, size, depth, thick, index, pitch = 3000.0, 40, 0.5, 0.1, 1.5, 1e-4
+    slab = GlassSlab((0.0, 0.0, 0.2), (0.0, 0.0, 1.0), thick, index)
+    u, v = _plane_hits((slab,), focal, size, depth, pitch)
+    m = (depth - thick * (1 - 1 / index)) / (focal * pitch)
+    np.testing.assert_allclose(np.diff(u, axis=1).mean(), m, rtol=1e-4)
+    colours = np.ones((size, size, 3), dtype=np.float32)
+    img, cov = _density_view(u + 40.0, v + 40.0, colours, (80, 80))
+    assert cov.sum() > 3000
+    np.testing.assert_allclose(img[cov], 1.0 / m**2, rtol=2e-4)
+    direct = _density_view(*(a + 40.0 for a in _plane_hits((), focal, size, depth, pitch)), colours, (80, 80))[0]
+    ratio = np.nanmedian(img[..., 0]) / np.nanmedian(direct[..., 0])
+    np.testing.assert_allclose(ratio, (depth / (depth - thick * (1 - 1 / index))) ** 2, rtol=2e-4)
+
+
+def test_density_in_a_flat_mirror_is_the_mirrored_camera():
+    # a flat mirror at z = D sends the view back to a plane at z = -P: the mirrored camera
+    # (centre at z = 2D) sees it at distance 2D + P, so m = (2D + P) / (f pitch) and the
+    # colour at camera pixel (c, r) lands where the mirrored camera projects it
+    from shadowcam.synthetic.lab.optics import PlaneMirror
+
+    focal, size, dist, back = 500.0, 40, 0.2, 0.3
+    mirror = PlaneMirror((0.0, 0.0, dist), (0.0, 0.0, 1.0))
+    u, v = _plane_hits((mirror,), focal, size, -back)
+    m = (2 * dist + back) / (focal * 1e-3)  # 1.4 dual px per camera px
+    r, c = np.mgrid[0:size, 0:size].astype(float)
+    np.testing.assert_allclose(u, m * (c - (size - 1) / 2), rtol=1e-9, atol=1e-9)
+    colours = np.stack([0.2 + 0.01 * c, 0.4 + 0.005 * r, 0.3 + 0 * c], -1).astype(np.float32)
+    img, cov = _density_view(u + 30.0, v + 30.0, colours, (60, 60))
+    jj, ii = np.mgrid[0:60, 0:60]
+    cc, rr = (ii - 30.0) / m + (size - 1) / 2, (jj - 30.0) / m + (size - 1) / 2  # mirrored camera
+    expect = np.stack([0.2 + 0.01 * cc, 0.4 + 0.005 * rr, 0.3 + 0 * cc], -1) / m**2
+    assert cov.sum() > 1000
+    np.testing.assert_allclose(img[cov], expect[cov], rtol=1e-5)
