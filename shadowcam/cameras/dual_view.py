@@ -130,7 +130,7 @@ def continuous_steps(u, v, *, valid, step, max_edge=2.0, smooth_tol=2.0 / 3.0):
 
 
 def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 / 3.0, density=False,
-                   eps=1e-9):
+                   three_corners=False, eps=1e-9):
     """Forward mesh warp of camera colours into the dual grid.
 
     Parameters
@@ -157,6 +157,11 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
         The image is then the reciprocal image ``T^T 1`` of a uniform camera pattern
         (docs/methods.md) in camera-colour x camera-pixels-per-dual-pixel units. False:
         the colours are averaged (the scene's radiance seen from the light).
+    three_corners : bool
+        Also draw the triangle of a quad's three timed pixels when its untimed one lies on
+        the fixed diagonal (top-right or bottom-left), where neither fixed triangle exists;
+        its two camera edges must be continuous. Where optics magnify, one quad covers
+        several dual pixels, many of them next to silhouettes whose pixels get no time.
     eps : float
         Barycentric tolerance for pixel centres on triangle edges.
 
@@ -176,6 +181,13 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     # edges put the third vertex on the same surface, so the diagonal needs no test.
     upper = tri[:, 0] + 1 == tri[:, 1]
     tri = tri[np.where(upper, across[tri[:, 0]] & down[tri[:, 0]], across[tri[:, 1]] & down[tri[:, 2]])]
+    if three_corners:  # quads whose untimed corner lies on the fixed diagonal: the other diagonal
+        tl = (np.arange(rows - 1)[:, None] * cols + np.arange(cols - 1)).ravel()
+        tr, bl, br = tl + 1, tl + cols, tl + cols + 1
+        ok = valid.ravel() & np.isfinite(u.ravel()) & np.isfinite(v.ravel())
+        no_tr = ~ok[tr] & down[tl] & across[bl]  # (tl, bl, br): edges tl->bl, bl->br
+        no_bl = ~ok[bl] & across[tl] & down[tr]  # (tl, tr, br): edges tl->tr, tr->br
+        tri = np.concatenate([tri, np.stack([tl, bl, br], 1)[no_tr], np.stack([tl, tr, br], 1)[no_bl]])
     uf, vf = u.ravel().astype(np.float64), v.ravel().astype(np.float64)
     pu, pv = uf[tri], vf[tri]  # (n, 3)
     e1u, e1v = pu[:, 1] - pu[:, 0], pv[:, 1] - pv[:, 0]

@@ -391,3 +391,32 @@ def test_density_in_a_flat_mirror_is_the_mirrored_camera():
     expect = np.stack([0.2 + 0.01 * cc, 0.4 + 0.005 * rr, 0.3 + 0 * cc], -1) / m**2
     assert cov.sum() > 1000
     np.testing.assert_allclose(img[cov], expect[cov], rtol=1e-5)
+
+
+@pytest.mark.parametrize("density", [False, True])
+def test_three_corners_leaves_only_the_triangles_of_the_untimed_pixel(density):
+    # identity map x 2, one untimed camera pixel p: the fixed diagonal loses the two quads in
+    # which p lies on the diagonal (p = top-right, bottom-left); with three_corners their other
+    # diagonal's triangle of the three timed pixels is drawn, so only the four triangles with
+    # vertex p stay empty: the open diamond |d_row| + |d_col| < 1 camera px around p
+    r, c = np.mgrid[0:8, 0:8].astype(float)
+    u, v = 2.0 * c, 2.0 * r
+    colours = np.stack([0.1 * c + 0.05 * r, 0.2 + 0 * c, 0.3 + 0 * c], -1).astype(np.float32)
+    valid = np.ones((8, 8), dtype=bool)
+    valid[3, 3] = False
+    plain, cov0 = resample_dual_view(colours, u, v, shape=(15, 15), valid=valid, method="mesh",
+                                     density=density)
+    more, cov1 = resample_dual_view(colours, u, v, shape=(15, 15), valid=valid, method="mesh",
+                                    density=density, three_corners=True)
+    jj, ii = np.mgrid[0:14, 0:14]  # the last camera row and column's edges (u or v = 14)
+    l1 = np.abs(jj / 2 - 3) + np.abs(ii / 2 - 3)  # are owned by no triangle under density
+    if density:  # centres on the diamond's edges belong to the missing triangles or not
+        assert (cov1[:14, :14] | (l1 <= 1)).all() and not (cov1[:14, :14] & (l1 < 1)).any()
+    else:
+        np.testing.assert_array_equal(cov1[:14, :14], l1 >= 1)
+    assert (cov0 <= cov1).all() and (cov1 & ~cov0).any()
+    np.testing.assert_array_equal(more[cov0], plain[cov0])
+    scale = 0.25 if density else 1.0  # 1/4 camera pixel per dual pixel
+    jj, ii = np.mgrid[0:15, 0:15]
+    np.testing.assert_allclose(more[cov1, 0], scale * (0.1 * ii[cov1] / 2 + 0.05 * jj[cov1] / 2),
+                               rtol=1e-6)
