@@ -420,3 +420,36 @@ def test_three_corners_leaves_only_the_triangles_of_the_untimed_pixel(density):
     jj, ii = np.mgrid[0:15, 0:15]
     np.testing.assert_allclose(more[cov1, 0], scale * (0.1 * ii[cov1] / 2 + 0.05 * jj[cov1] / 2),
                                rtol=1e-6)
+
+
+def test_front_function_carries_the_density_for_a_camera_with_optics():
+    # coordinates of a camera with optics (attr `optics`, set by capture_dual_coords) get the
+    # density by default; explicit density=False gives the colours; no optics: the colours
+    from shadowcam.cameras.dual_view import dual_view_from_coords
+    from shadowcam.cameras.models import capture_dual_coords
+
+    rows, cols = np.mgrid[0:12, 0:16].astype(np.float64)
+    colours = np.full(rows.shape + (3,), 0.6, np.float32)
+    coords = xr.Dataset({"u": (("row", "col"), 2.0 * cols), "v": (("row", "col"), 2.0 * rows),
+                         "valid": (("row", "col"), np.ones(rows.shape, bool))},
+                        attrs={"dual_height": 24, "dual_width": 32, "model": "uniform"})
+    reference = xr.Dataset({"image": (("row", "col", "channel"), colours)})
+    shadow_time = xr.Dataset(coords={"sweep": ["u", "v"], "channel": ["R", "G", "B"]})
+    plain = dual_view_from_coords(coords, shadow_time, reference=reference)
+    mirror = coords.assign_attrs(optics="mirror")
+    dense = dual_view_from_coords(mirror, shadow_time, reference=reference)
+    colour = dual_view_from_coords(mirror, shadow_time, reference=reference, density=False)
+    cov = dense["coverage"].values
+    np.testing.assert_allclose(dense["dual_view"].values[cov], 0.6 / 4, rtol=1e-6)  # 1/4 px per dual px
+    np.testing.assert_allclose(colour["dual_view"].values[cov], 0.6, rtol=1e-6)
+    np.testing.assert_array_equal(plain["dual_view"].values, colour["dual_view"].values)
+    assert "camera_pixel_density" in dense.attrs and "camera_pixel_density" not in plain.attrs
+    # the dual-coords front function marks a description with optics, and only that one
+    st = xr.Dataset({"shadow_time": (("sweep", "row", "col"), np.stack([cols, rows]))},
+                    coords={"sweep": ["u", "v"]}, attrs={"n_frames_u": 16, "n_frames_v": 12})
+    description = {"light": "point", "sweeps": [{"name": "u", "angle_deg": 0.0, "speed": 1.0},
+                                                {"name": "v", "angle_deg": 90.0, "speed": 1.0}]}
+    found = capture_dual_coords(st, {**description, "optics": "glass"}, camera_model="perspective")
+    assert found.attrs["optics"] == "glass"
+    assert "optics" not in capture_dual_coords(st, {**description, "optics": "none"},
+                                               camera_model="perspective").attrs
