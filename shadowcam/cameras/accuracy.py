@@ -166,12 +166,32 @@ def _fit_line(points):
 
 def _robust_line(points, *, k=4.0, floor=1e-3):
     """:func:`_fit_line` of the 2-D points within k robust sigmas (1.4826 MAD, at least
-    `floor`) of a first fit: drops points read across a silhouette."""
+    `floor`) of a first fit: drops points read across a silhouette. Returns the centre, the
+    direction and the direction's standard error (radians): RMS residual across the line
+    (``n - 2`` degrees of freedom) over the root sum of squares of the positions along it
+    (NaN with fewer than three inliers)."""
     centre, direction = _fit_line(points)
     normal = np.array([-direction[1], direction[0]])
     distance = np.abs((points - centre) @ normal)
     inlier = distance <= max(k * 1.4826 * np.median(distance), floor)
-    return _fit_line(points[inlier]) if inlier.sum() >= 2 else (centre, direction)
+    if inlier.sum() >= 2:
+        centre, direction = _fit_line(points[inlier])
+    rel = points[inlier] - centre
+    normal = np.array([-direction[1], direction[0]])
+    n = len(rel)
+    se = (math.sqrt(np.sum((rel @ normal) ** 2) / (n - 2) / np.sum((rel @ direction) ** 2))
+          if n >= 3 else float("nan"))
+    return centre, direction, se
+
+
+def _two_depth_groups(depth):
+    """Near mask of the split of `depth` into two groups of at least two with the least
+    within-group sum of squares (two-means in one dimension): the gap between two depth
+    layers, or about the middle of a continuous range of depths."""
+    order = np.sort(depth)
+    costs = [np.var(order[:i]) * i + np.var(order[i:]) * (len(order) - i)
+             for i in range(2, len(order) - 1)]
+    return depth <= order[1 + int(np.argmin(costs))]
 
 
 def parallel_edges(points, world, labels, *, toward_light, light_position=None, min_points=5):
@@ -179,11 +199,13 @@ def parallel_edges(points, world, labels, *, toward_light, light_position=None, 
 
     Edges are grouped into families of parallel world lines (world directions within
     0.5 deg). Each edge's line in the view is fitted to its points within 4 robust sigmas
-    of a first fit (points read across a silhouette are dropped). Per family of two or
+    of a first fit (points read across a silhouette are dropped), with the standard error
+    of its direction from the residuals across it. Per family of two or
     more edges: the spread of the directions of those lines (as
     :func:`line_direction_spread`). For the family whose edges span the widest
-    range of depths (along `toward_light`), with four or more edges: its edges are split at
-    the median depth into a near and a far half; in each half the view position of an edge
+    range of depths (along `toward_light`), with four or more edges: its edges are split
+    into a near and a far group by depth (two-means: two depth layers are separated at their
+    gap, a continuous range about its middle); in each group the view position of an edge
     across the family's direction is fitted linearly against its world position across it
     (the magnification, view px per scene unit); ``size_ratio`` is near over far. An
     orthographic view has spread 0 and size ratio 1; a perspective view from the light
@@ -207,7 +229,9 @@ def parallel_edges(points, world, labels, *, toward_light, light_position=None, 
     Returns
     -------
     dict
-        ``spread_deg`` (largest over the families), ``n_edges``, ``n_families``,
+        ``spread_deg`` (largest over the families), ``spread_se_deg`` (standard error of
+        the difference of two of that family's directions, from the two largest of its
+        edges' direction errors), ``n_edges``, ``n_families``,
         ``size_ratio``, ``depth_ratio`` (mean distance to `light_position` of the far half
         over the near half; None for a distant light) and ``size_edges`` (edges of the
         measured family); these three None without a family of four edges.
@@ -222,7 +246,7 @@ def parallel_edges(points, world, labels, *, toward_light, light_position=None, 
         raise ValueError(f"toward_light: expected a non-zero 3-vector, got {toward_light!r}")
     axis = axis / np.linalg.norm(axis)
     keep = np.all(np.isfinite(points), axis=1) & np.all(np.isfinite(world), axis=1)
-    edges = []  # (label, view centre, view direction, world centre, world direction)
+    edges = []  # (label, view centre, view direction, its standard error, world centre, world direction)
     for label in np.unique(labels[keep]):
         sel = keep & (labels == label)
         if sel.sum() >= int(min_points):
@@ -231,41 +255,43 @@ def parallel_edges(points, world, labels, *, toward_light, light_position=None, 
         raise ValueError("labels: at least two edges with min_points points are needed")
     families = []
     for edge in edges:
-        home = next((f for f in families if abs(f[0][4] @ edge[4]) > math.cos(math.radians(0.5))),
+        home = next((f for f in families if abs(f[0][5] @ edge[5]) > math.cos(math.radians(0.5))),
                     None)
         if home is None:
             families.append([edge])
         else:
             home.append(edge)
-    spreads = [_angle_spread([math.atan2(e[2][1], e[2][0]) for e in f])
-               for f in families if len(f) >= 2]
+    pairs = [f for f in families if len(f) >= 2]
+    spreads = [_angle_spread([math.atan2(e[2][1], e[2][0]) for e in f]) for f in pairs]
     if not spreads:
         raise ValueError("labels: no two edges are parallel in the world")
-    out = {"spread_deg": float(max(spreads)), "n_edges": len(edges),
+    se = np.sort([e[3] for e in pairs[int(np.argmax(spreads))]])[-2:]
+    out = {"spread_deg": float(max(spreads)),
+           "spread_se_deg": float(np.degrees(np.sqrt(np.sum(se**2)))), "n_edges": len(edges),
            "n_families": len(spreads), "size_ratio": None, "depth_ratio": None,
            "size_edges": None}
     wide = [f for f in families if len(f) >= 4]
     if not wide:
         return out
-    depth_of = lambda f: np.array([-(e[3] @ axis) for e in f])  # noqa: E731
+    depth_of = lambda f: np.array([-(e[4] @ axis) for e in f])  # noqa: E731
     family = max(wide, key=lambda f: np.ptp(depth_of(f)))
     depth = depth_of(family)
-    direction = family[0][4]
-    across = family[-1][3] - family[0][3]
+    direction = family[0][5]
+    across = family[-1][4] - family[0][4]
     across -= (across @ direction) * direction
     across /= np.linalg.norm(across)
     mean_dir = _fit_line(np.array([e[2] * np.sign(e[2] @ family[0][2]) for e in family]
                                   + [-e[2] * np.sign(e[2] @ family[0][2]) for e in family]))[1]
     normal = np.array([-mean_dir[1], mean_dir[0]])
-    w = np.array([e[3] @ across for e in family])
+    w = np.array([e[4] @ across for e in family])
     p = np.array([e[1] @ normal for e in family])
-    near = depth <= np.median(depth)
+    near = _two_depth_groups(depth)
     if near.sum() < 2 or (~near).sum() < 2:
         return out
     slope = [abs(np.polyfit(w[half], p[half], 1)[0]) for half in (near, ~near)]
     ratio = None
     if light_position is not None:
-        dist = np.linalg.norm(np.array([e[3] for e in family])
+        dist = np.linalg.norm(np.array([e[4] for e in family])
                               - np.asarray(light_position, dtype=np.float64), axis=1)
         ratio = float(dist[~near].mean() / dist[near].mean())
     out.update(size_ratio=float(slope[0] / slope[1]), depth_ratio=ratio,

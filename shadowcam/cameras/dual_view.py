@@ -19,6 +19,10 @@ them into an image, neither of them last-write-wins splatting:
   below the timing noise's reach and always kept. Where several triangles
   cover a dual pixel their colours are averaged. Fully vectorised (triangles are expanded to candidate
   pixels of their bounding boxes, in bounded-memory chunks).
+  With ``density=True`` each triangle's colour is weighted by the camera-pixel
+  density ``1 / |det d(u, v)/d(col, row)|`` and the triangles covering a dual pixel
+  are summed, not averaged (pixel-transport reciprocity, docs/methods.md): the
+  dual view of a camera behind a mirror or glass, whose branches add up.
 * ``idw``: inverse-distance weighting of the ``k`` nearest camera samples
   within ``radius`` dual pixels (``scipy.spatial.cKDTree``).
 
@@ -125,7 +129,8 @@ def continuous_steps(u, v, *, valid, step, max_edge=2.0, smooth_tol=2.0 / 3.0):
         return np.isfinite(length) & ((length <= max_edge) | (agree_all & any_neighbour))
 
 
-def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 / 3.0, eps=1e-9):
+def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 / 3.0, density=False,
+                   three_corners=False, eps=1e-9):
     """Forward mesh warp of camera colours into the dual grid.
 
     Parameters
@@ -143,6 +148,20 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     smooth_tol : float
         Largest relative change of a longer edge's dual step from the neighbouring
         steps along the same camera line (see `continuous_steps`).
+    density : bool
+        Carry the camera-pixel density of pixel-transport reciprocity: each triangle
+        adds its interpolated colour times ``1 / |det d(u, v)/d(col, row)|`` (camera
+        pixels per dual pixel) and the triangles covering a dual pixel are *summed*
+        (the branches of a mirror or a glass add up), a pixel centre on an edge shared
+        by two triangles counted once (top-left rule on the barycentric gradients).
+        The image is then the reciprocal image ``T^T 1`` of a uniform camera pattern
+        (docs/methods.md) in camera-colour x camera-pixels-per-dual-pixel units. False:
+        the colours are averaged (the scene's radiance seen from the light).
+    three_corners : bool
+        Also draw the triangle of a quad's three timed pixels when its untimed one lies on
+        the fixed diagonal (top-right or bottom-left), where neither fixed triangle exists;
+        its two camera edges must be continuous. Where optics magnify, one quad covers
+        several dual pixels, many of them next to silhouettes whose pixels get no time.
     eps : float
         Barycentric tolerance for pixel centres on triangle edges.
 
@@ -162,6 +181,13 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     # edges put the third vertex on the same surface, so the diagonal needs no test.
     upper = tri[:, 0] + 1 == tri[:, 1]
     tri = tri[np.where(upper, across[tri[:, 0]] & down[tri[:, 0]], across[tri[:, 1]] & down[tri[:, 2]])]
+    if three_corners:  # quads whose untimed corner lies on the fixed diagonal: the other diagonal
+        tl = (np.arange(rows - 1)[:, None] * cols + np.arange(cols - 1)).ravel()
+        tr, bl, br = tl + 1, tl + cols, tl + cols + 1
+        ok = valid.ravel() & np.isfinite(u.ravel()) & np.isfinite(v.ravel())
+        no_tr = ~ok[tr] & down[tl] & across[bl]  # (tl, bl, br): edges tl->bl, bl->br
+        no_bl = ~ok[bl] & across[tl] & down[tr]  # (tl, tr, br): edges tl->tr, tr->br
+        tri = np.concatenate([tri, np.stack([tl, bl, br], 1)[no_tr], np.stack([tl, tr, br], 1)[no_bl]])
     uf, vf = u.ravel().astype(np.float64), v.ravel().astype(np.float64)
     pu, pv = uf[tri], vf[tri]  # (n, 3)
     e1u, e1v = pu[:, 1] - pu[:, 0], pv[:, 1] - pv[:, 0]
@@ -174,6 +200,13 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     j1 = np.minimum(np.floor(pv.max(axis=1) + eps), height - 1).astype(np.int64)
     bw, bh = i1 - i0 + 1, j1 - j0 + 1
     keep &= (bw > 0) & (bh > 0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        weight = 1.0 / np.abs(det) if density else np.ones(len(det))
+        # inward gradients of the barycentrics l1, l2, l0 (dual px^-1): an edge owns the
+        # centres on it when its gradient points to +u (or +v when along u)
+        grads = [(e2v / det, -e2u / det), (-e1v / det, e1u / det)]
+        grads.append((-grads[0][0] - grads[1][0], -grads[0][1] - grads[1][1]))
+    owns = [(gu > 0) | ((gu == 0) & (gv > 0)) for gu, gv in grads]
     sel = np.nonzero(keep)[0]
     flat_col = colours.reshape(-1, n_ch).astype(np.float64)
     sums = np.zeros((height * width, n_ch))
@@ -194,18 +227,25 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
         l1 = (du * e2v[k] - dv * e2u[k]) / det[k]
         l2 = (e1u[k] * dv - e1v[k] * du) / det[k]
         l0 = 1.0 - l1 - l2
-        inside = (l0 >= -eps) & (l1 >= -eps) & (l2 >= -eps)
+        if density:  # counted once: strictly inside, or on an edge the triangle owns
+            inside = np.ones(len(k), dtype=bool)
+            for lam, own in ((l1, owns[0]), (l2, owns[1]), (l0, owns[2])):
+                inside &= (lam > eps) | ((lam >= -eps) & own[k])
+        else:
+            inside = (l0 >= -eps) & (l1 >= -eps) & (l2 >= -eps)
         k, l0, l1, l2 = k[inside], l0[inside], l1[inside], l2[inside]
         pix = j[inside] * width + i[inside]
         vert = tri[k]
         col = (l0[:, None] * flat_col[vert[:, 0]] + l1[:, None] * flat_col[vert[:, 1]]
                + l2[:, None] * flat_col[vert[:, 2]])
+        if density:
+            col *= weight[k, None]
         counts += np.bincount(pix, minlength=height * width)
         for ch in range(n_ch):
             sums[:, ch] += np.bincount(pix, weights=col[:, ch], minlength=height * width)
     coverage = counts > 0
     image = np.full((height * width, n_ch), np.nan, dtype=np.float32)
-    image[coverage] = sums[coverage] / counts[coverage, None]
+    image[coverage] = sums[coverage] if density else sums[coverage] / counts[coverage, None]
     return image.reshape(height, width, n_ch), coverage.reshape(height, width)
 
 
@@ -393,7 +433,7 @@ def dual_view_dataset(image, coverage, *, method, params=None, channels=("R", "G
 
 
 def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh", min_coverage=MIN_COVERAGE,
-                          **params):
+                          density=None, **params):
     """Resample the camera colours into the dual grid of `coords`.
 
     Parameters
@@ -409,6 +449,10 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
         Key of :data:`DUAL_VIEW_METHODS`.
     min_coverage : float
         Smallest fraction of the dual pixels that must receive a colour.
+    density : bool, optional
+        Carry the camera-pixel density (``dual_view_mesh(density=True)``). Default: when
+        the coordinates' camera has optics on its primal path (attr ``optics`` of `coords`,
+        set by ``cameras.models.capture_dual_coords``) and `method` is ``mesh``.
     **params
         Method options.
 
@@ -417,14 +461,24 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     xarray.Dataset
         :func:`dual_view_dataset` with attrs ``colour_source``, ``dual_coords_model``,
         ``resampling_seconds`` (and ``intrinsics_affine``, ``intrinsics`` of `coords` from
-        ``cameras.intrinsics.coords_to_intrinsics``).
+        ``cameras.intrinsics.coords_to_intrinsics``; ``camera_pixel_density`` when the
+        density is carried).
 
     Raises
     ------
     ValueError
-        If the dual view covers less than `min_coverage` of its grid (with the counts).
+        If the dual view covers less than `min_coverage` of its grid (with the counts), or
+        `density` is asked of a method other than ``mesh``.
     """
     check_in_interval(min_coverage, "min_coverage", 0.0, 1.0, closed="both")
+    optics = str(coords.attrs.get("optics", "none"))
+    if density is None:
+        density = optics != "none" and method == "mesh"
+    elif density and method != "mesh":
+        raise ValueError(f"density: the camera-pixel density is carried by the mesh warp only, not by "
+                         f"method {method!r}; set dual_view.method: mesh or drop dual_view.params.density")
+    if density:
+        params = {**params, "density": True}
     if reference is not None:
         reference = reference_image(reference)
     colours = camera_colours(shadow_time, reference=reference)
@@ -451,6 +505,9 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     dataset = dual_view_dataset(image, coverage, method=method, params=params, channels=channels)
     dataset.attrs.update(colour_source="reference" if reference is not None else "mean lit_image of u, v",
                          dual_coords_model=coords.attrs.get("model", ""), resampling_seconds=seconds)
+    if density:
+        dataset.attrs["camera_pixel_density"] = (
+            f"colour x camera pixels per dual pixel, branches summed (primal optics: {optics})")
     for key in ("intrinsics_affine", "intrinsics"):  # the grid of chosen virtual intrinsics
         if key in coords.attrs:
             dataset.attrs[key] = coords.attrs[key]

@@ -703,7 +703,8 @@ def capture_dual_coords(shadow_time, description, *, camera_model, dual_model="u
     -------
     xarray.Dataset
         ``dual_coords.dual_coords_dataset``; attrs ``method`` (``uniform``, ``calibration``
-        or the camera model), ``model_choice``.
+        or the camera model), ``model_choice``, and ``optics`` (``mirror``, ``glass``) when
+        the description's primal path has optics.
 
     Raises
     ------
@@ -711,10 +712,14 @@ def capture_dual_coords(shadow_time, description, *, camera_model, dual_model="u
         Unknown `camera_model`, or fewer than `min_coverage` of the pixels covered.
     """
     check_in(camera_model, "camera_model", tuple(CAMERA_MODELS))
+    optics = str(description.get("optics", "none"))
     if camera_model in FRAME_INDEX_MODELS:
-        return dual_coords_from_shadow_time(
+        ds = dual_coords_from_shadow_time(
             shadow_time, method=dual_model, dual_width=dual_width, dual_height=dual_height,
             min_confidence=min_confidence, min_coverage=min_coverage, **options)
+        if optics != "none":  # the dual view carries the camera-pixel density then
+            ds.attrs["optics"] = optics
+        return ds
     shape = None if dual_width is None or dual_height is None else (int(dual_height), int(dual_width))
     taken = inspect.signature(CAMERA_MODELS[camera_model]).parameters
     ds = camera_coords_from_shadow_time(shadow_time, description, model=camera_model,
@@ -728,4 +733,6 @@ def capture_dual_coords(shadow_time, description, *, camera_model, dual_model="u
                    min_coverage=min_coverage)
     ds.attrs["model_choice"] = (f"{camera_model} camera: chosen by the capture plan from the "
                                 f"sweep geometry (sweeps {ds.attrs['sweeps']})")
+    if optics != "none":
+        ds.attrs["optics"] = optics
     return ds

@@ -39,7 +39,7 @@ def add_parser(subparsers, name):
     parser.add_argument("--method", default="mesh", choices=sorted(DUAL_VIEW_METHODS),
                         help="resampling onto the dual grid (default mesh)")
     parser.add_argument("--params", default="{}",
-                        help="JSON method options: mesh: max_edge, smooth_tol; idw: k, radius, power")
+                        help="JSON method options: mesh: max_edge, smooth_tol, density, three_corners; idw: k, radius, power")
     parser.add_argument("--intrinsics", default="{}",
                         help="JSON virtual intrinsics of the output: skew_deg, aspect, size [height, width]")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/dual_view.nc")

@@ -257,3 +257,60 @@ def test_parallelism_check_on_the_truth_times_sets_its_targets(light_kind):
     else:
         assert not any(t["pass"] for t in targets)
     assert parallelism_check(coords, gt.drop_vars("edge_world")) == (None, [])
+
+
+@pytest.mark.parametrize("light_kind", ["distant", "point"])
+def test_parallel_edges_on_two_depth_layers(light_kind):
+    """Panels scene (a squares panel 0.1 in front of the squares back plane): the near and
+    far groups are the two layers; the orthographic dual keeps the edges parallel and the
+    layers' magnifications equal (exact coordinates), the perspective dual magnifies the
+    near layer by about the depth ratio."""
+    from shadowcam.cameras.accuracy import parallel_edges
+    from shadowcam.synthetic.lab.scene import BackPlane, DistantLight
+    from shadowcam.synthetic.lab.scenes import make_scene
+
+    scene = make_scene("panels", seed=3, height=64, width=64, frames=48, light_kind=light_kind)
+    planes = [o for o in scene.objects if isinstance(o, BackPlane)]
+    assert len(planes) == 2
+    edges = square_edge_points(scene)
+    ok = edges.lit
+    on_near = np.abs((edges.world - planes[1].center) @ planes[1].normal) < 1e-9
+    assert on_near[ok].sum() >= 20 and (~on_near[ok]).sum() >= 20  # edges on both layers
+    light = scene.light
+    distant = isinstance(light, DistantLight)
+    toward = light.direction if distant else light.center - edges.world[ok].mean(axis=0)
+    found = parallel_edges(edges.dual_uv[ok], edges.world[ok], edges.label[ok],
+                           toward_light=toward, light_position=None if distant else light.center)
+    assert found["n_families"] == 2 and found["size_edges"] >= 8
+    assert found["spread_se_deg"] < 1e-6  # exact points: no residual across the lines
+    if distant:
+        assert found["spread_deg"] < 1e-6 and abs(found["size_ratio"] - 1) < 1e-9
+    else:
+        assert found["spread_deg"] > 2.0
+        assert found["depth_ratio"] > 1.2 and abs(found["size_ratio"] / found["depth_ratio"] - 1) < 0.05
+
+
+def test_line_direction_standard_error_matches_the_scatter_of_fits():
+    """The direction's standard error of a line fit equals the scatter of the fitted angle
+    over noisy draws (1000 draws of 30 points, sigma 0.3 px, 30 px long): within 10%."""
+    from shadowcam.cameras.accuracy import _robust_line
+
+    rng = np.random.default_rng(5)
+    t = np.linspace(-15, 15, 30)
+    angles, errors = [], []
+    for _ in range(1000):
+        pts = np.stack([t, 0.3 * rng.standard_normal(30)], axis=1)
+        _, direction, se = _robust_line(pts, k=1e9)
+        angles.append(np.arctan(direction[1] / direction[0]))
+        errors.append(se)
+    expected = 0.3 / np.sqrt(np.sum(t**2))
+    np.testing.assert_allclose(np.std(angles), expected, rtol=0.1)
+    np.testing.assert_allclose(np.sqrt(np.mean(np.square(errors))), expected, rtol=0.1)
+
+
+def test_two_depth_groups_split_layers_at_their_gap():
+    from shadowcam.cameras.accuracy import _two_depth_groups
+
+    depth = np.array([0.31, 0.30, 0.52, 0.29, 0.50, 0.55, 0.51, 0.33])
+    np.testing.assert_array_equal(_two_depth_groups(depth), depth < 0.4)
+    assert _two_depth_groups(np.arange(10.0)).sum() == 5  # a continuous range: its middle

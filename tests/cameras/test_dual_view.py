@@ -278,3 +278,178 @@ def test_mesh_covers_a_magnified_surface_but_not_the_gap_of_a_jump():
     # kept: camera columns 0..4 (steps before the one next to the jump) and 7..11 shifted by 12
     assert cols_covered.tolist() == list(range(0, 13)) + list(range(33, 46))
     assert not cov2[:, 13:33].any()
+
+
+# --------------------------------------------------------------------------- camera-pixel density
+
+
+def _density_view(u, v, colours, shape, **params):
+    return resample_dual_view(colours, u, v, shape=shape, method="mesh", density=True, **params)
+
+
+def test_density_counts_pixel_centres_on_shared_edges_and_vertices_once():
+    # identity map: every dual pixel centre is a mesh vertex shared by up to six triangles
+    r, c = np.mgrid[0:20, 0:20].astype(float)
+    colours = np.ones((20, 20, 3), dtype=np.float32)
+    img, cov = _density_view(c, r, colours, (20, 20))
+    assert cov[:19, :19].all()
+    np.testing.assert_allclose(img[1:19, 1:19], 1.0, rtol=1e-12)  # not 2, 3 or 6 times
+    # and the plain warp is unchanged by the option's default
+    plain, _ = resample_dual_view(colours, c, r, shape=(20, 20), method="mesh")
+    np.testing.assert_allclose(plain[1:19, 1:19], 1.0)
+
+
+@pytest.mark.parametrize("scale", [0.5, 1.7, 3.0])
+def test_density_is_camera_pixels_per_dual_pixel_under_an_affine_map(scale):
+    # u, v = scale * R (col, row): camera pixels per dual pixel = 1 / scale^2 exactly
+    a = np.deg2rad(20.0)
+    r, c = np.mgrid[0:40, 0:40].astype(float)
+    u = scale * (np.cos(a) * c - np.sin(a) * r) + 30.0
+    v = scale * (np.sin(a) * c + np.cos(a) * r) + 2.0
+    colours = np.stack([0.2 + 0.01 * c, 0.5 + 0 * c, 0.1 + 0.002 * r], -1).astype(np.float32)
+    img, cov = _density_view(u, v, colours, (64, 64))
+    colour, _ = resample_dual_view(colours, u, v, shape=(64, 64), method="mesh")
+    np.testing.assert_allclose(img[cov], colour[cov] / scale**2, rtol=1e-5)
+
+
+def test_density_sums_the_branches_and_draws_nothing_across_the_jump():
+    # two camera halves (a direct view and a mirror branch) land on overlapping dual pixels:
+    # the density view is the sum of the two; triangles across the jump between the halves
+    # (a step of 10 dual px between steps of 1) would add to the right branch's pixels
+    r, c = np.mgrid[0:30, 0:30].astype(float)
+    u = np.where(c < 15, c, 39.0 - c)  # right half: u = 24 .. 10, mirrored
+    v = np.where(c < 15, r, r + 5.0)
+    colours = np.stack([0.3 + 0 * c, np.where(c < 15, 1.0, 2.0), 0.1 + 0 * c], -1).astype(np.float32)
+    img, cov = _density_view(u, v, colours, (40, 30))
+    np.testing.assert_allclose(img[6:29, 11:14, 1], 3.0, rtol=1e-9)
+    np.testing.assert_allclose(img[6:34, 15:24, 1], 2.0, rtol=1e-9)
+    np.testing.assert_allclose(img[1:29, 1:10, 1], 1.0, rtol=1e-9)
+    assert not cov[:, 25:].any() and not cov[35:].any()
+
+
+def test_density_needs_the_mesh_warp():
+    from shadowcam.cameras.dual_view import dual_view_from_coords
+
+    coords = xr.Dataset({"u": (("row", "col"), np.zeros((4, 4))), "v": (("row", "col"), np.zeros((4, 4))),
+                         "valid": (("row", "col"), np.ones((4, 4), bool))},
+                        attrs={"dual_height": 4, "dual_width": 4})
+    with pytest.raises(ValueError, match="density"):
+        dual_view_from_coords(coords, None, reference=None, method="idw", density=True)
+
+
+def _plane_hits(optics, focal, size, depth_z, pitch=1e-3):
+    """Dual (u, v) (plane position / `pitch`) of the camera pixel centres of a pinhole at
+    the origin looking along +z (or back along -z after a mirror), through `optics`."""
+    from shadowcam.synthetic.lab.optics import trace_through_optics
+
+    r, c = np.mgrid[0:size, 0:size].astype(float)
+    x, y = (c - (size - 1) / 2) / focal, (r - (size - 1) / 2) / focal
+    dirs = np.stack([x.ravel(), y.ravel(), np.ones(size * size)], 1)
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    bent = trace_through_optics(optics, np.zeros_like(dirs), dirs)
+    s = (depth_z - bent.origins[:, 2]) / bent.directions[:, 2]
+    hit = bent.origins + s[:, None] * bent.directions
+    return hit[:, 0].reshape(size, size) / pitch, hit[:, 1].reshape(size, size) / pitch
+
+
+def test_density_through_a_slab_is_the_slab_magnification():
+    # a plane at depth Z behind a slab (thickness t, index n) perpendicular to the axis is
+    # seen as if at Z - t (1 - 1/n) (paraxial); dual px per camera px m = (Z - t(1 - 1/n)) /
+    # (f pitch), so the density view of a uniform colour is 1 / m^2 (field +-0.5 deg)
+    from shadowcam.synthetic.lab.optics import GlassSlab
+
+    focal, size, depth, thick, index, pitch = 3000.0, 40, 0.5, 0.1, 1.5, 1e-4
+    slab = GlassSlab((0.0, 0.0, 0.2), (0.0, 0.0, 1.0), thick, index)
+    u, v = _plane_hits((slab,), focal, size, depth, pitch)
+    m = (depth - thick * (1 - 1 / index)) / (focal * pitch)
+    np.testing.assert_allclose(np.diff(u, axis=1).mean(), m, rtol=1e-4)
+    colours = np.ones((size, size, 3), dtype=np.float32)
+    img, cov = _density_view(u + 40.0, v + 40.0, colours, (80, 80))
+    assert cov.sum() > 3000
+    np.testing.assert_allclose(img[cov], 1.0 / m**2, rtol=2e-4)
+    direct = _density_view(*(a + 40.0 for a in _plane_hits((), focal, size, depth, pitch)), colours, (80, 80))[0]
+    ratio = np.nanmedian(img[..., 0]) / np.nanmedian(direct[..., 0])
+    np.testing.assert_allclose(ratio, (depth / (depth - thick * (1 - 1 / index))) ** 2, rtol=2e-4)
+
+
+def test_density_in_a_flat_mirror_is_the_mirrored_camera():
+    # a flat mirror at z = D sends the view back to a plane at z = -P: the mirrored camera
+    # (centre at z = 2D) sees it at distance 2D + P, so m = (2D + P) / (f pitch) and the
+    # colour at camera pixel (c, r) lands where the mirrored camera projects it
+    from shadowcam.synthetic.lab.optics import PlaneMirror
+
+    focal, size, dist, back = 500.0, 40, 0.2, 0.3
+    mirror = PlaneMirror((0.0, 0.0, dist), (0.0, 0.0, 1.0))
+    u, v = _plane_hits((mirror,), focal, size, -back)
+    m = (2 * dist + back) / (focal * 1e-3)  # 1.4 dual px per camera px
+    r, c = np.mgrid[0:size, 0:size].astype(float)
+    np.testing.assert_allclose(u, m * (c - (size - 1) / 2), rtol=1e-9, atol=1e-9)
+    colours = np.stack([0.2 + 0.01 * c, 0.4 + 0.005 * r, 0.3 + 0 * c], -1).astype(np.float32)
+    img, cov = _density_view(u + 30.0, v + 30.0, colours, (60, 60))
+    jj, ii = np.mgrid[0:60, 0:60]
+    cc, rr = (ii - 30.0) / m + (size - 1) / 2, (jj - 30.0) / m + (size - 1) / 2  # mirrored camera
+    expect = np.stack([0.2 + 0.01 * cc, 0.4 + 0.005 * rr, 0.3 + 0 * cc], -1) / m**2
+    assert cov.sum() > 1000
+    np.testing.assert_allclose(img[cov], expect[cov], rtol=1e-5)
+
+
+@pytest.mark.parametrize("density", [False, True])
+def test_three_corners_leaves_only_the_triangles_of_the_untimed_pixel(density):
+    # identity map x 2, one untimed camera pixel p: the fixed diagonal loses the two quads in
+    # which p lies on the diagonal (p = top-right, bottom-left); with three_corners their other
+    # diagonal's triangle of the three timed pixels is drawn, so only the four triangles with
+    # vertex p stay empty: the open diamond |d_row| + |d_col| < 1 camera px around p
+    r, c = np.mgrid[0:8, 0:8].astype(float)
+    u, v = 2.0 * c, 2.0 * r
+    colours = np.stack([0.1 * c + 0.05 * r, 0.2 + 0 * c, 0.3 + 0 * c], -1).astype(np.float32)
+    valid = np.ones((8, 8), dtype=bool)
+    valid[3, 3] = False
+    plain, cov0 = resample_dual_view(colours, u, v, shape=(15, 15), valid=valid, method="mesh",
+                                     density=density)
+    more, cov1 = resample_dual_view(colours, u, v, shape=(15, 15), valid=valid, method="mesh",
+                                    density=density, three_corners=True)
+    jj, ii = np.mgrid[0:14, 0:14]  # the last camera row and column's edges (u or v = 14)
+    l1 = np.abs(jj / 2 - 3) + np.abs(ii / 2 - 3)  # are owned by no triangle under density
+    if density:  # centres on the diamond's edges belong to the missing triangles or not
+        assert (cov1[:14, :14] | (l1 <= 1)).all() and not (cov1[:14, :14] & (l1 < 1)).any()
+    else:
+        np.testing.assert_array_equal(cov1[:14, :14], l1 >= 1)
+    assert (cov0 <= cov1).all() and (cov1 & ~cov0).any()
+    np.testing.assert_array_equal(more[cov0], plain[cov0])
+    scale = 0.25 if density else 1.0  # 1/4 camera pixel per dual pixel
+    jj, ii = np.mgrid[0:15, 0:15]
+    np.testing.assert_allclose(more[cov1, 0], scale * (0.1 * ii[cov1] / 2 + 0.05 * jj[cov1] / 2),
+                               rtol=1e-6)
+
+
+def test_front_function_carries_the_density_for_a_camera_with_optics():
+    # coordinates of a camera with optics (attr `optics`, set by capture_dual_coords) get the
+    # density by default; explicit density=False gives the colours; no optics: the colours
+    from shadowcam.cameras.dual_view import dual_view_from_coords
+    from shadowcam.cameras.models import capture_dual_coords
+
+    rows, cols = np.mgrid[0:12, 0:16].astype(np.float64)
+    colours = np.full(rows.shape + (3,), 0.6, np.float32)
+    coords = xr.Dataset({"u": (("row", "col"), 2.0 * cols), "v": (("row", "col"), 2.0 * rows),
+                         "valid": (("row", "col"), np.ones(rows.shape, bool))},
+                        attrs={"dual_height": 24, "dual_width": 32, "model": "uniform"})
+    reference = xr.Dataset({"image": (("row", "col", "channel"), colours)})
+    shadow_time = xr.Dataset(coords={"sweep": ["u", "v"], "channel": ["R", "G", "B"]})
+    plain = dual_view_from_coords(coords, shadow_time, reference=reference)
+    mirror = coords.assign_attrs(optics="mirror")
+    dense = dual_view_from_coords(mirror, shadow_time, reference=reference)
+    colour = dual_view_from_coords(mirror, shadow_time, reference=reference, density=False)
+    cov = dense["coverage"].values
+    np.testing.assert_allclose(dense["dual_view"].values[cov], 0.6 / 4, rtol=1e-6)  # 1/4 px per dual px
+    np.testing.assert_allclose(colour["dual_view"].values[cov], 0.6, rtol=1e-6)
+    np.testing.assert_array_equal(plain["dual_view"].values, colour["dual_view"].values)
+    assert "camera_pixel_density" in dense.attrs and "camera_pixel_density" not in plain.attrs
+    # the dual-coords front function marks a description with optics, and only that one
+    st = xr.Dataset({"shadow_time": (("sweep", "row", "col"), np.stack([cols, rows]))},
+                    coords={"sweep": ["u", "v"]}, attrs={"n_frames_u": 16, "n_frames_v": 12})
+    description = {"light": "point", "sweeps": [{"name": "u", "angle_deg": 0.0, "speed": 1.0},
+                                                {"name": "v", "angle_deg": 90.0, "speed": 1.0}]}
+    found = capture_dual_coords(st, {**description, "optics": "glass"}, camera_model="perspective")
+    assert found.attrs["optics"] == "glass"
+    assert "optics" not in capture_dual_coords(st, {**description, "optics": "none"},
+                                               camera_model="perspective").attrs

@@ -235,3 +235,24 @@ def test_capture_front_runs_the_plans_camera_model(timed_capture):
         capture_dual_coords(shadow_time, description, camera_model="fisheye")
     with pytest.raises(ValueError, match="min_coverage"):
         capture_dual_coords(shadow_time, description, camera_model="linear", min_coverage=1.0)
+
+
+@pytest.mark.parametrize("camera", ["orthographic", "ortho_primal", "cross_slit", "mirror", "glass"])
+def test_raw_variant_plans_the_same_camera_as_its_noise_free_manifest(camera):
+    """data_manifest/synthetic_<camera>_raw.yaml: the same scene, camera and sweeps as the
+    noise-free manifest, rendered as noisy 12-bit DNGs."""
+    from pathlib import Path
+
+    import yaml
+
+    from shadowcam.io.capture_plan import capture_plan
+
+    root = Path(__file__).resolve().parents[2] / "data_manifest"
+    clean, raw = (root / f"synthetic_{camera}.yaml", root / f"synthetic_{camera}_raw.yaml")
+    a, b = capture_plan(clean), capture_plan(raw)
+    assert b.name == f"synthetic_{camera}_raw"
+    assert (a.camera_model, dict(a.camera)) == (b.camera_model, dict(b.camera))
+    ya, yb = (yaml.safe_load(p.read_text())["synthetic"] for p in (clean, raw))
+    assert (yb["format"], yb["bit_depth"], yb["noise"]) == ("dng", 12, True)
+    assert {k: v for k, v in ya.items() if k not in ("format", "noise")} == \
+        {k: v for k, v in yb.items() if k not in ("format", "noise")}

@@ -306,3 +306,31 @@ def test_camera_light_through_optics_gain_is_inverse_square_without_bending():
     assert np.all(gain_behind == 0)
     with pytest.raises(ValueError, match="points"):
         camera_light_through_optics(scene.objects, slab, cam, np.zeros((3, 2)))
+
+
+@pytest.mark.parametrize("inside_px", [0.01, 0.03])
+def test_ray_tube_at_a_mirror_rim_is_the_branch_density_not_the_jump(inside_px):
+    # a disc mirror's rim cuts the ray tube: a ray inside it by less than the difference
+    # step must get the tube of the mirrored camera (the whole-plane mirror), to the first-order
+    # error of a one-sided difference (1e-4), not a difference taken across the rim (the ray
+    # beside the mirror goes elsewhere)
+    from shadowcam.synthetic.lab.optics import _bent_offset, _tube_area
+
+    focal, dist, radius, step = 400.0, 0.2, 0.02, 0.05
+    cam = PinholeCamera(K=[[focal, 0, 32.0], [0, focal, 32.0], [0, 0, 1]], R=np.eye(3),
+                        center=(0.0, 0.0, 0.0), width=64, height=64)
+    disc = PlaneMirror((0.0, 0.0, dist), (0.0, 0.0, 1.0), radius)
+    plane = PlaneMirror((0.0, 0.0, dist), (0.0, 0.0, 1.0))
+    x = np.array([32.0 + focal * radius / dist - inside_px, 32.0])
+    y = np.array([32.0, 32.0 - focal * radius / dist + inside_px])
+    _, _, bent = _bent_offset((disc,), cam, np.zeros((2, 3)), x, y)
+    assert (bent.interactions == 1).all()
+    target = bent.origins + 0.3 * bent.directions
+    rim = _tube_area((disc,), cam, target, x, y, step)
+    whole = _tube_area((plane,), cam, target, x, y, step)
+    np.testing.assert_allclose(rim, whole, rtol=1e-4)
+    # the mirrored camera's tube at distance L = dist / cos + 0.3 from its centre: L^2 times
+    # the solid angle per pixel cos^3 / f^2
+    cos = focal / np.hypot(focal, np.hypot(x - 32.0, y - 32.0))
+    length = dist / cos + 0.3
+    np.testing.assert_allclose(whole, length**2 * cos**3 / focal**2, rtol=1e-6)

@@ -74,12 +74,14 @@ def test_every_shadow_camera_runs_from_its_manifest_to_accuracy(tmp_path, workfl
         assert dual_image["n_mask"] >= 300 and dual_image["covered_not_visible"] <= 0.03, ds
         # the optics magnify: triangles kept from the camera-side continuity, not their dual size
         assert dual_image["coverage_of_visible"] >= 0.65, (ds, dual_image)
-    # orthographic: parallel edges at different depths measured in the estimated dual view;
-    # bounded by half the perspective contrast of the same scene (exact: 6.2 deg, ratio 1.29)
+    # orthographic: long parallel edges on two depth layers (panels scene) measured in the
+    # estimated dual view: the targets (0.5 deg, 1%) against the perspective contrast of the
+    # same scene (exact: 6.0 deg, ratio 1.24); the spread within 5 of its standard errors
     ortho = json.loads((Path(workdir) / "results" / "synthetic_orthographic" / "accuracy.json")
                        .read_text())
     found = ortho["parallelism"]
     assert found["n_families"] == 2 and found["size_edges"] >= 8, found
-    assert found["spread_deg"] <= 3.1 and abs(found["size_ratio"] - 1) <= 0.145, found
+    assert found["spread_deg"] <= 0.5 and abs(found["size_ratio"] - 1) <= 0.01, found
+    assert found["spread_deg"] <= 5 * found["spread_se_deg"], found
     assert {"dual_parallel_spread_deg", "dual_size_ratio_error"} <= {
         t["target"] for t in ortho["targets"]}

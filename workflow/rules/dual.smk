@@ -47,9 +47,7 @@ rule dual_view:
     params:
         reference=get_flag("--reference", "reference"),
         method=config["dual_view"]["method"],
-        options=as_json(
-            {**config["dual_view"]["params"], "min_coverage": config["min_coverage"]}
-        ),
+        options=get_dual_view_params,
         intrinsics=as_json(config["dual_view"]["intrinsics"]),
     shell:
         "shadowcam dual-view --dual-coords {input.dual_coords} --shadow-time {input.shadow_time}"

@@ -1,4 +1,5 @@
-"""Exact image positions of straight scene edges: the edges of the back plane's coloured squares.
+"""Exact image positions of straight scene edges: the edges of the coloured squares of the
+scene's planes (``BackPlane`` objects with a ``squares`` texture: the back plane, panels).
 
 The ``squares`` texture (``scene.Texture``) puts squares with edges along straight lines of
 the back plane's coordinates. Their images are found here exactly, through the camera's
@@ -11,7 +12,7 @@ of edge points measures straightness in the primal view and in the dual view.
 Offers
 ------
 EdgePoints : world points on square edges with their camera and dual coordinates.
-square_edge_points : trace the edges of the back plane's squares into the camera and dual views.
+square_edge_points : trace the edges of the planes' squares into the camera and dual views.
 """
 
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ from shadowcam.synthetic.lab.optics import intersect_through_optics, trace_throu
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_back_plane, occluded
 from shadowcam.synthetic.lab.scene import (
     SQUARE_FILL,
+    BackPlane,
     DistantLight,
     camera_rays,
     wire_shadow_time,
@@ -73,9 +75,8 @@ def _line_position(count, margin):
     return np.where(odd, (count - 1) / 2 + margin, count / 2 - margin)
 
 
-def _plane_coords_of_rays(scene, x, y):
-    """Back-plane coordinates (N, 2) where the bent camera rays through (x, y) meet its plane."""
-    plane = scene.back_plane
+def _plane_coords_of_rays(scene, plane, x, y):
+    """Coordinates (N, 2) on `plane` where the bent camera rays through (x, y) meet it."""
     origins, dirs = camera_rays(scene.camera, x, y)
     bent = trace_through_optics(scene.optics, origins, dirs)
     t = np.full(len(x), np.inf)
@@ -86,18 +87,19 @@ def _plane_coords_of_rays(scene, x, y):
     return plane.plane_coords(points)
 
 
-def _crossings(scene, axis, step, iterations):
-    """Edge crossings along pixel-centre rows (axis 0: lines of constant plane x) or
-    columns (axis 1: constant plane y). Returns camera (x, y) and the line number."""
+def _crossings(scene, plane, axis, step, iterations):
+    """Edge crossings of `plane`'s squares along pixel-centre rows (axis 0: lines of
+    constant plane x) or columns (axis 1: constant plane y). Returns camera (x, y) and the
+    line number."""
     cam = scene.camera
-    scale = scene.back_plane.material.texture.scale
+    scale = plane.material.texture.scale
     margin = (1.0 - SQUARE_FILL) / 2.0
     n_lines, length = (cam.height, cam.width) if axis == 0 else (cam.width, cam.height)
     along = np.arange(0.0, length + step / 2, step)
     fixed = np.arange(n_lines) + 0.5
     f_grid, a_grid = np.meshgrid(fixed, along, indexing="ij")
     xy = (a_grid, f_grid) if axis == 0 else (f_grid, a_grid)
-    coord = _plane_coords_of_rays(scene, xy[0].ravel(), xy[1].ravel())[:, axis] / scale
+    coord = _plane_coords_of_rays(scene, plane, xy[0].ravel(), xy[1].ravel())[:, axis] / scale
     coord = coord.reshape(f_grid.shape)
     with np.errstate(invalid="ignore"):
         count = _line_count(coord, margin)
@@ -112,7 +114,7 @@ def _crossings(scene, axis, step, iterations):
     for _ in range(int(iterations)):
         mid = 0.5 * (lo + hi)
         pts = (mid, fix) if axis == 0 else (fix, mid)
-        value = _plane_coords_of_rays(scene, *pts)[:, axis] / scale - target
+        value = _plane_coords_of_rays(scene, plane, *pts)[:, axis] / scale - target
         same = np.sign(value) == sign_lo
         lo, hi = np.where(same, mid, lo), np.where(same, hi, mid)
     mid = 0.5 * (lo + hi)
@@ -121,13 +123,13 @@ def _crossings(scene, axis, step, iterations):
 
 
 def square_edge_points(scene, *, step=0.25, iterations=48):
-    """Trace the edges of the back plane's coloured squares into the camera and dual views.
+    """Trace the edges of the coloured squares of the scene's planes into the camera and dual views.
 
     Parameters
     ----------
     scene : scenes.Scene
-        Its back plane must carry a ``squares`` texture (e.g. preset ``tabletop_squares``);
-        its optics (if any) bend the camera rays.
+        At least one ``BackPlane`` must carry a ``squares`` texture (e.g. presets
+        ``tabletop_squares``, ``panels``); its optics (if any) bend the camera rays.
     step : float
         Bracketing grid step along rows / columns (camera pixels); an edge line must not be
         crossed twice within one step.
@@ -139,35 +141,37 @@ def square_edge_points(scene, *, step=0.25, iterations=48):
     EdgePoints
         One point per pixel-centre row crossing a square's vertical edge and per
         pixel-centre column crossing a horizontal edge, where the bent camera ray meets the
-        back plane first.
+        square's plane first; labels are distinct per plane.
     """
-    plane = scene.back_plane
-    if plane is None or plane.material.texture is None or \
-            plane.material.texture.kind != "squares":
+    planes = [(i, o) for i, o in enumerate(scene.objects) if isinstance(o, BackPlane)
+              and o.material.texture is not None and o.material.texture.kind == "squares"]
+    if not planes:
         raise ValueError("scene: its back plane must carry a 'squares' texture")
     if not (np.isfinite(step) and 0 < step <= 1):
         raise ValueError(f"step: must be in (0, 1] camera pixels, got {step!r}")
     if int(iterations) < 1:
         raise ValueError(f"iterations: must be >= 1, got {iterations!r}")
-    scale = plane.material.texture.scale
     margin = (1.0 - SQUARE_FILL) / 2.0
     parts = []
-    for axis in (0, 1):
-        x, y, line = _crossings(scene, axis, step, iterations)
-        origins, dirs = camera_rays(scene.camera, x, y)
-        hits, bent = intersect_through_optics(scene.objects, scene.optics, origins, dirs)
-        on_plane = hits.object_id == scene.objects.index(plane)
-        across = plane.plane_coords(np.nan_to_num(hits.point))[:, 1 - axis] / scale
-        cell = np.floor(across)
-        frac = across - cell
-        on_square = (frac >= margin) & (frac < 1.0 - margin)
-        keep = on_plane & on_square
-        key = np.stack([np.full(keep.sum(), axis), line[keep], cell[keep]], axis=1)
-        parts.append((x[keep], y[keep], hits.point[keep], hits.normal[keep], key,
-                      bent.interactions[keep] > 0))
+    for index, plane in planes:
+        scale = plane.material.texture.scale
+        for axis in (0, 1):
+            x, y, line = _crossings(scene, plane, axis, step, iterations)
+            origins, dirs = camera_rays(scene.camera, x, y)
+            hits, bent = intersect_through_optics(scene.objects, scene.optics, origins, dirs)
+            on_plane = hits.object_id == index
+            across = plane.plane_coords(np.nan_to_num(hits.point))[:, 1 - axis] / scale
+            cell = np.floor(across)
+            frac = across - cell
+            on_square = (frac >= margin) & (frac < 1.0 - margin)
+            keep = on_plane & on_square
+            key = np.stack([np.full(keep.sum(), index), np.full(keep.sum(), axis), line[keep],
+                            cell[keep]], axis=1)
+            parts.append((x[keep], y[keep], hits.point[keep], hits.normal[keep], key,
+                          bent.interactions[keep] > 0))
     x, y, world, normal, key, through = (np.concatenate(p) for p in zip(*parts))
     key = key.astype(np.int64)
-    _, label = np.unique(key[:, :2], axis=0, return_inverse=True)
+    _, label = np.unique(key[:, :3], axis=0, return_inverse=True)
     _, segment = np.unique(key, axis=0, return_inverse=True)
     light = scene.light
     if isinstance(light, DistantLight):

@@ -507,11 +507,19 @@ def _emitted_per_pixel(camera, x, y):
 
 def _tube_area(optics, camera, target, x, y, step):
     """(N,) cross-section of the bent ray tube at `target` per square pixel at pixel-edge
-    (x, y): ``|dO/dx x dO/dy|`` of the target's offset O from the ray (central differences)."""
+    (x, y): ``|dO/dx x dO/dy|`` of the target's offset O from the ray. Central differences
+    within the ray's branch; where one side's ray meets a different number of element
+    surfaces (the step crosses a mirror's or a glass's rim) the one-sided difference on the
+    ray's own branch, so the density of the branch is not taken across its jump."""
+    centre, _, bent = _bent_offset(optics, camera, target, x, y)
+
     def d_offset(dx, dy):
-        plus = _bent_offset(optics, camera, target, x + dx, y + dy)[0]
-        minus = _bent_offset(optics, camera, target, x - dx, y - dy)[0]
-        return (plus - minus) / (2 * step)
+        plus, _, bent_p = _bent_offset(optics, camera, target, x + dx, y + dy)
+        minus, _, bent_m = _bent_offset(optics, camera, target, x - dx, y - dy)
+        same_p = (bent_p.valid & (bent_p.interactions == bent.interactions))[:, None]
+        same_m = (bent_m.valid & (bent_m.interactions == bent.interactions))[:, None]
+        return np.where(same_p & same_m, (plus - minus) / (2 * step),
+                        np.where(same_p, (plus - centre) / step, (centre - minus) / step))
 
     return np.linalg.norm(np.cross(d_offset(step, 0.0), d_offset(0.0, step)), axis=1)
 
@@ -529,7 +537,7 @@ def camera_light_through_optics(objects, optics, camera, points, *, tolerance=0.
     ``camera_pixels_of_points`` from the nearest pixel centres of its own branch. The
     ray tube carries the emitted measure of a pixel (``_emitted_per_pixel``) onto the
     tube's cross-section at P (``_tube_area``, per square pixel, central differences of
-    `step` pixel), so the irradiance on a surface normal to the ray is ``strength * gain``
+    `step` pixel within the ray's branch, one-sided at an element's rim), so the irradiance on a surface normal to the ray is ``strength * gain``
     with ``gain = emitted per pixel / cross-section`` (the Jacobian of the optics' area change;
     without optics ``1 / d^2`` for a pinhole and 1 for an orthographic camera).
 

@@ -8,7 +8,7 @@ Offers
 Scene : a renderable scene.
 calibration_scene : the scene holding only its calibration (back) plane.
 CAMERA_KINDS : primal camera kinds of the presets (perspective, orthographic).
-SCENES, make_scene : presets by name (tabletop, tabletop_squares) and the factory.
+SCENES, make_scene : presets by name (tabletop, tabletop_squares, panels) and the factory.
 scene_from_description, DESCRIPTION_KEYS : a scene from a capture description (the scene
     keys of a manifest's ``synthetic:`` block: light, camera, sweeps, optics, ...).
 """
@@ -124,8 +124,20 @@ def _tabletop_squares(**options):
     return _tabletop(**options, back_texture="squares")
 
 
+def _panels(**options):
+    """A frontal squares back plane and a smaller frontal squares panel 0.1 nearer the
+    camera and the light, over the ground: long straight parallel edges on two depth
+    layers, nothing in front of them."""
+    objects, light, camera, mask = _tabletop(**options, back_texture="squares")
+    back = next(o for o in objects if isinstance(o, BackPlane))
+    back = replace(back, yaw_deg=0.0)
+    near = BackPlane(back.center + 0.1 * back.normal + np.array([0.01, -0.2, 0.0]), 0.13, 0.13,
+                     0.0, back.material)
+    return [o for o in objects if isinstance(o, GroundPlane)] + [back, near], light, camera, mask
+
+
 #: preset scene name -> builder(seed, height, width, frames, light_kind, camera_kind)
-SCENES = {"tabletop": _tabletop, "tabletop_squares": _tabletop_squares}
+SCENES = {"tabletop": _tabletop, "tabletop_squares": _tabletop_squares, "panels": _panels}
 
 
 def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="point",
@@ -138,7 +150,9 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
         Preset name, a key of ``SCENES`` (``"tabletop"``: three spheres and a yawed box on a
         brick-textured ground in front of a disc-textured back plane, light beside the camera;
         ``"tabletop_squares"``: the same with coloured squares on the back plane, whose
-        edges are straight world lines).
+        edges are straight world lines; ``"panels"``: a frontal squares back plane, the
+        ground and a frontal squares panel 0.1 in front of it: long parallel edges on two
+        depth layers).
     seed : int
         Varies texture layout, colours and object placement slightly.
     height, width : int
