@@ -111,8 +111,9 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
     plane: the plane's value ``a`` at the pixel and its variance under the
     stated variances; the local dispersion (chi-square per degree of freedom
     about the quadratic, corrected for the range kernel's down-weighting of
-    large residuals; inf where they exceed the kernel's scale), the quadratic's value at the pixel and its variance
-    (NaN where the quadratic is undetermined).
+    large residuals; inf where they exceed the kernel's scale), the quadratic's
+    value at the pixel and its variance (NaN where the quadratic is
+    undetermined).
     """
     h, w = t64.shape
     plane_out = np.full((h, w), np.nan)
@@ -240,8 +241,10 @@ def dispersion(local_phi):
     Returns
     -------
     phi : float
-        The median over the determined pixels; 1 (the stated variances as
-        given) where there is none.
+        The median over the pixels with a finite dispersion (an infinite one,
+        residuals beyond the range kernel's scale, is outside the kernel's
+        noise model and takes no part); 1 (the stated variances as given)
+        where there is none.
     """
     local_phi = np.asarray(local_phi, dtype=np.float64)
     finite = local_phi[np.isfinite(local_phi)]

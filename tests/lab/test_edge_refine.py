@@ -107,3 +107,12 @@ def test_silhouette_step_does_not_mix_the_sides():
         shift = (stepped - step - flat)[4:-4, side]
         assert abs(np.mean(shift)) < 0.02
         assert np.max(np.abs(shift)) < 0.15
+
+
+def test_dispersion_is_the_median_of_the_finite_fits():
+    from shadowcam.lab.edge_refine import dispersion
+
+    assert dispersion(np.array([[0.5, np.nan], [2.0, 1.0]])) == 1.0
+    assert dispersion(np.array([[0.25, np.inf], [0.5, np.nan]])) == 0.375
+    assert dispersion(np.full((2, 2), np.nan)) == 1.0
+    assert dispersion(np.array([[np.inf, np.inf], [np.nan, np.nan]])) == 1.0
