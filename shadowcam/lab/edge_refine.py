@@ -3,22 +3,40 @@
 On a smooth surface the shadow time is a smooth function of the pixel
 position: the shadow edge is a curve that sweeps the image. A pixel's own
 temporal estimate is quantised (a shadow crossing it within one frame leaves
-a nearly on/off profile) and noisy; fitting a local plane ``t = a + b*drow +
-c*dcol`` to its neighbours' estimates averages both away, because the
+a nearly on/off profile) and noisy; a local plane ``t = a + b*drow + c*dcol``
+fitted to its neighbours' estimates averages both away, because the
 quantisation error is periodic along the edge's motion and the noise is
 independent. Neighbours across a depth discontinuity have times that do not
 fit the plane; they are down-weighted by a range kernel on the residual, and
 the fit is repeated (iteratively reweighted least squares), so discontinuities
 stay sharp.
 
+A plane is itself a model, biased where the window spans a curved time
+surface. The refined time is therefore the inverse-variance combination of
+two independent estimates of the pixel's time: its own (variance: its stated
+variance) and the plane through its neighbours, the pixel left out (variance:
+the fit's variance at the centre plus the plane's squared bias there). Both
+come from the same neighbours fitted by a local quadratic, which follows the
+curvature. Its residuals are the per-pixel errors: the median over the map
+of their chi-square per degree of freedom, ``phi``, rescales every stated
+variance, the pixel's own included. The plane's bias at the pixel shows as
+the gap between the plane and the quadratic there; its square, less the part
+the per-pixel errors explain (``phi`` times the difference of the two fits'
+variances, as for nested least squares), estimates the squared bias
+``tau**2`` without bias; averaged over the window (the bias follows the
+curvature on that scale), then clipped at 0. A clean centroid on a curved surface is kept; on
+a plane, or where the pixel's own estimate is noisy, the plane takes over.
+
 Offers
 ------
-refine_times : local robust plane fit of a time map.
+refine_times : local robust plane fit of a time map, combined with the pixel's own time.
+dispersion : common scale of the stated variances from the local quadratic fits.
 shifted : an image shifted by a neighbour offset, filled outside.
 """
 
 import numba as nb
 import numpy as np
+from scipy import ndimage
 
 from shadowcam._shared.validation import check_array, check_positive
 
@@ -33,79 +51,208 @@ def shifted(array, dr, dc, fill):
     return out
 
 
+@nb.njit(cache=True)
+def _solve(normal, rhs, n):
+    """Solve the leading ``n x n`` block of `normal` for `rhs` (Gauss-Jordan, partial pivoting).
+
+    Returns ``(x, ok)``; ``ok`` is False when a pivot is negligible against the
+    matrix's scale (too few or collinear neighbours).
+    """
+    a = np.empty((n, n + 1))
+    for i in range(n):
+        for j in range(n):
+            a[i, j] = normal[i, j]
+        a[i, n] = rhs[i]
+    scale = 0.0
+    for i in range(n):
+        scale = max(scale, abs(a[i, i]))
+    for col in range(n):
+        pivot = col
+        for i in range(col + 1, n):
+            if abs(a[i, col]) > abs(a[pivot, col]):
+                pivot = i
+        if not abs(a[pivot, col]) > 1e-9 * scale:
+            return np.zeros(n), False
+        for j in range(n + 1):
+            a[col, j], a[pivot, j] = a[pivot, j], a[col, j]
+        for i in range(n):
+            if i != col:
+                f = a[i, col] / a[col, col]
+                for j in range(col, n + 1):
+                    a[i, j] -= f * a[col, j]
+    x = np.empty(n)
+    for i in range(n):
+        x[i] = a[i, n] / a[i, i]
+    return x, True
+
+
+@nb.njit(cache=True)
+def _basis(dr, dc, out):
+    """Quadratic basis ``1, dr, dc, dr^2, dr dc, dc^2`` (the plane is its first three)."""
+    out[0] = 1.0
+    out[1] = dr
+    out[2] = dc
+    out[3] = dr * dr
+    out[4] = dr * dc
+    out[5] = dc * dc
+
+
 @nb.njit(cache=True, parallel=True)
 def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
-    """Per pixel: IRLS local plane fit of the neighbours' times (see :func:`refine_times`).
+    """Per pixel: the neighbours' IRLS plane and its variances (see :func:`refine_times`).
 
-    Each pass fits ``t = a + b*dr + c*dc`` to the ``(2 * radius + 1)**2``
-    neighbours weighted by their inverse variance and a Gaussian range kernel
-    on their residual from the pixel's previous plane (first pass: the flat
-    plane through its own time). Returns the plane values ``a`` (NaN where the
-    pixel has no time) and the last pass's weight sums, ``(H, W)`` float64.
+    The pixel itself is left out. Each pass fits ``t = a + b*dr + c*dc`` to the
+    ``(2 * radius + 1)**2 - 1`` neighbours weighted by their inverse variance
+    and a Gaussian range kernel on their residual from the previous plane
+    (first pass: the flat plane through the pixel's own time). With the last
+    pass's weights, a local quadratic is fitted too.
+
+    Returns, each ``(H, W)`` float64, NaN where the pixel has no time or no
+    plane: the plane's value ``a`` at the pixel and its variance under the
+    stated variances; the local dispersion (chi-square per degree of freedom
+    about the quadratic, corrected for the range kernel's down-weighting of
+    large residuals; inf where they exceed the kernel's scale), the quadratic's
+    value at the pixel and its variance (NaN where the quadratic is
+    undetermined).
     """
     h, w = t64.shape
-    centre_out = np.full((h, w), np.nan)
-    weight_out = np.zeros((h, w))
+    plane_out = np.full((h, w), np.nan)
+    var_out = np.full((h, w), np.nan)
+    phi_out = np.full((h, w), np.nan)
+    quad_out = np.full((h, w), np.nan)
+    quad_var_out = np.full((h, w), np.nan)
     for row in nb.prange(h):
+        basis = np.empty(6)
+        normal = np.empty((6, 6))
+        rhs = np.empty(6)
         for col in range(w):
-            centre = t64[row, col]
-            if not np.isfinite(centre):
+            own = t64[row, col]
+            if not np.isfinite(own):
                 continue
-            slope_r = 0.0
-            slope_c = 0.0
-            s = 0.0
-            for _ in range(iterations):
-                s = m_r = m_c = m_rr = m_rc = m_cc = m_t = m_tr = m_tc = 0.0
+            coef = np.zeros(3)  # plane relative to the pixel's own time
+            ok = False
+            s_w = s_k = s_tt = 0.0
+            for it in range(iterations + 1):
+                normal[:] = 0.0
+                rhs[:] = 0.0
+                s_w = s_k = s_tt = 0.0
                 for dr in range(-radius, radius + 1):
                     rr = row + dr
                     for dc in range(-radius, radius + 1):
                         cc = col + dc
-                        if rr < 0 or rr >= h or cc < 0 or cc >= w:
+                        if (dr == 0 and dc == 0) or rr < 0 or rr >= h or cc < 0 or cc >= w:
                             continue
-                        t_n = t64[rr, cc]
-                        if not np.isfinite(t_n):
+                        t_n = t64[rr, cc] - own
+                        if not np.isfinite(t_n) or not inv_var[rr, cc] > 0:
                             continue
-                        predicted = centre + slope_r * dr + slope_c * dc
-                        residual = (t_n - predicted) / range_sigma
-                        wgt = inv_var[rr, cc] * np.exp(-0.5 * residual**2)
-                        if not np.isfinite(wgt):
+                        residual = (t_n - coef[0] - coef[1] * dr - coef[2] * dc) / range_sigma
+                        kernel = np.exp(-0.5 * residual**2)
+                        wgt = inv_var[rr, cc] * kernel
+                        if not wgt > 0 or not np.isfinite(wgt):
                             continue
-                        if not wgt > 0:
-                            t_n = 0.0
-                        s += wgt
-                        m_r += wgt * dr
-                        m_c += wgt * dc
-                        m_rr += wgt * dr * dr
-                        m_rc += wgt * dr * dc
-                        m_cc += wgt * dc * dc
-                        m_t += wgt * t_n
-                        m_tr += wgt * t_n * dr
-                        m_tc += wgt * t_n * dc
-                # solve [[s, r, c], [r, rr, rc], [c, rc, cc]] x = [t, tr, tc] by Cramer's rule
-                det = (s * (m_rr * m_cc - m_rc**2) - m_r * (m_r * m_cc - m_rc * m_c)
-                       + m_c * (m_r * m_rc - m_rr * m_c))
-                scale = max(s, 1e-300) ** 3 * max(radius, 1) ** 4
-                a = np.nan
-                if det != 0.0:
-                    a = (m_t * (m_rr * m_cc - m_rc**2) - m_r * (m_tr * m_cc - m_rc * m_tc)
-                         + m_c * (m_tr * m_rc - m_rr * m_tc)) / det
-                if abs(det) > 1e-6 * scale and np.isfinite(a):
-                    slope_r = (s * (m_tr * m_cc - m_tc * m_rc) - m_t * (m_r * m_cc - m_rc * m_c)
-                               + m_c * (m_r * m_tc - m_tr * m_c)) / det
-                    slope_c = (s * (m_rr * m_tc - m_rc * m_tr) - m_r * (m_r * m_tc - m_tr * m_c)
-                               + m_t * (m_r * m_rc - m_rr * m_c)) / det
-                    centre = a
-                else:  # too few or collinear neighbours: the weighted mean
-                    centre = m_t / s if s != 0.0 else np.nan
-                    slope_r = 0.0
-                    slope_c = 0.0
-            centre_out[row, col] = centre
-            weight_out[row, col] = s
-    return centre_out, weight_out
+                        _basis(dr, dc, basis)
+                        for i in range(6):
+                            rhs[i] += wgt * basis[i] * t_n
+                            for j in range(6):
+                                normal[i, j] += wgt * basis[i] * basis[j]
+                        s_w += wgt
+                        s_k += kernel
+                        s_tt += wgt * t_n * t_n
+                if s_w == 0.0:
+                    ok = False
+                    break
+                coef3, ok = _solve(normal, rhs, 3)
+                if not ok:  # too few or collinear neighbours: the weighted mean
+                    coef[0] = rhs[0] / s_w
+                    coef[1] = 0.0
+                    coef[2] = 0.0
+                elif it < iterations:
+                    coef[:] = coef3
+            if s_w == 0.0:
+                continue
+            e0 = np.zeros(6)
+            e0[0] = 1.0
+            if ok:
+                inverse, _ = _solve(normal, e0, 3)
+                variance = inverse[0]
+                a = coef3[0]
+            else:
+                variance = 1.0 / s_w
+                a = coef[0]
+            phi = np.nan
+            a_quad = np.nan
+            var_quad = np.nan
+            df_quad = s_k - 6.0
+            if ok and df_quad > 1.0:
+                coef6, ok6 = _solve(normal, rhs, 6)
+                inverse6, _ = _solve(normal, e0, 6)
+                if ok6:
+                    q_quad = s_tt
+                    for i in range(6):
+                        q_quad -= coef6[i] * rhs[i]
+                    # the range kernel keeps Gaussian residuals of variance s2 as if their
+                    # variance were s2 h2 / (s2 + h2) (h = range_sigma): undo that shrinkage
+                    shrunk = max(q_quad, 0.0) / df_quad * (s_k / s_w)
+                    h2 = range_sigma**2
+                    phi = shrunk * h2 / (h2 - shrunk) / (s_k / s_w) if shrunk < h2 else np.inf
+                    a_quad = own + coef6[0]
+                    var_quad = inverse6[0]
+            plane_out[row, col] = own + a
+            var_out[row, col] = variance
+            phi_out[row, col] = phi
+            quad_out[row, col] = a_quad
+            quad_var_out[row, col] = var_quad
+    return plane_out, var_out, phi_out, quad_out, quad_var_out
+
+
+def _squared_bias(gap, gap_var, radius):
+    """The plane's squared bias at each pixel, ``(H, W)``, from its gap to the quadratic.
+
+    ``gap**2 - gap_var`` is unbiased for the squared bias (nested fits:
+    ``var(plane - quadratic) = var(quadratic) - var(plane)``) but as noisy as
+    the gap; its mean over the fit's window (the bias varies with the
+    surface's curvature on that scale) is clipped at 0.
+    """
+    with np.errstate(invalid="ignore"):
+        estimate = gap**2 - gap_var
+    finite = np.isfinite(estimate)
+    size = 2 * radius + 1
+    total = ndimage.uniform_filter(np.where(finite, estimate, 0.0), size, mode="constant")
+    count = ndimage.uniform_filter(finite.astype(np.float64), size, mode="constant")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(count > 0, total / count, 0.0)
+    return np.maximum(np.where(finite, mean, 0.0), 0.0)
+
+
+def dispersion(local_phi):
+    """Common scale of the stated variances: the median of the local dispersions.
+
+    The per-pixel error (noise, and the staircase of a dip sampled at whole
+    frames) is a property of the capture; the local dispersion about the
+    quadratic also holds geometry (outlines, higher-order curvature) on a
+    minority of pixels, which the median ignores.
+
+    Parameters
+    ----------
+    local_phi : (H, W) float ndarray
+        Chi-square per degree of freedom about the local quadratic; NaN where
+        undetermined.
+
+    Returns
+    -------
+    phi : float
+        The median over the pixels with a finite dispersion (an infinite one,
+        residuals beyond the range kernel's scale, is outside the kernel's
+        noise model and takes no part); 1 (the stated variances as given)
+        where there is none.
+    """
+    local_phi = np.asarray(local_phi, dtype=np.float64)
+    finite = local_phi[np.isfinite(local_phi)]
+    return float(np.median(finite)) if finite.size else 1.0
 
 
 def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
-    """Edge-aware local plane fit of a shadow-time map.
+    """Edge-aware local plane fit of a shadow-time map, combined with each pixel's own time.
 
     Parameters
     ----------
@@ -113,7 +260,9 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         Per-pixel shadow times in frames; NaN where there is none (those
         pixels stay NaN and do not contribute).
     time_std : (H, W) float ndarray
-        Per-pixel standard deviation of `time`, frames (sets the weights).
+        Per-pixel standard deviation of `time`, frames, up to a common factor
+        (:func:`dispersion` rescales it); sets the weights. A pixel with zero standard deviation keeps its own time and
+        does not take part in its neighbours' planes.
     radius : int, optional
         Half size of the square neighbourhood, pixels.
     range_sigma : float, optional
@@ -126,9 +275,11 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
     Returns
     -------
     refined : (H, W) ndarray
-        Refined times, same dtype as `time`.
+        Inverse-variance combination of the pixel's own time (variance
+        ``phi * std**2``) and its neighbours' plane at the pixel (variance
+        ``phi * var(a) + tau**2``), same dtype as `time`.
     refined_std : (H, W) ndarray
-        Standard deviation of the refined times under the weights' noise model.
+        Standard deviation of the refined times under that noise model.
     """
     time = np.asarray(time)
     check_array(time, "time", ndim=2)
@@ -142,9 +293,21 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         inv_var = np.where(valid & (time_std > 0), 1.0 / time_std**2, 0.0)
     inv_var = np.nan_to_num(inv_var, nan=0.0, posinf=0.0)
 
-    centre, weight_sum = _robust_plane_fit(t64, inv_var, int(radius), float(range_sigma),
-                                           max(int(iterations), 1))
+    plane, plane_var, local_phi, quad, quad_var = _robust_plane_fit(
+        t64, inv_var, int(radius), float(range_sigma), max(int(iterations), 1))
+    phi = dispersion(local_phi)
+    tau2 = _squared_bias(plane - quad, phi * (quad_var - plane_var), int(radius))
+    own_var = np.where(inv_var > 0, phi / np.where(inv_var > 0, inv_var, 1.0), 0.0)
+    plane_var = phi * plane_var + tau2
     with np.errstate(invalid="ignore", divide="ignore"):
-        refined_std = np.sqrt(1.0 / weight_sum)
-    refined = np.where(valid & np.isfinite(centre), centre, time)
+        # own_var == 0: an exact own time; plane_var == 0: an exact plane (both 0: the own time)
+        w_own = np.where(own_var > 0, 1.0 / own_var, np.inf)
+        w_plane = np.where(plane_var > 0, 1.0 / plane_var, np.where(own_var > 0, np.inf, 0.0))
+        combined = np.where(np.isinf(w_own), t64,
+                            np.where(np.isinf(w_plane), plane,
+                                     (w_own * t64 + w_plane * plane) / (w_own + w_plane)))
+        combined_std = np.sqrt(1.0 / (w_own + w_plane))
+    has_plane = np.isfinite(plane)
+    refined = np.where(valid & has_plane, combined, time)
+    refined_std = np.where(has_plane, combined_std, np.sqrt(own_var))
     return refined.astype(time.dtype), np.where(valid, refined_std, np.nan)

@@ -253,11 +253,15 @@ def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
 
 
 def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15):
-    """Dip centroid refined by an edge-aware local plane fit of neighbours' times.
+    """Dip centroid combined with an edge-aware local plane fit of neighbours' times.
 
-    See :func:`shadowcam.lab.edge_refine.refine_times`; `floor_std` is the
-    per-pixel error, in frames, that remains without noise (the on/off
-    staircase of a shadow that crosses a pixel within one frame).
+    See :func:`shadowcam.lab.edge_refine.refine_times`: each pixel's centroid
+    and its neighbours' plane are weighed by their variances, so a clean
+    centroid on a curved surface is kept and a noisy one is replaced by the
+    plane. `floor_std` is the prior per-pixel error, in frames, without noise
+    (the on/off staircase of a shadow that crosses a pixel within one frame);
+    it sets that part's share against the centroid's noise, while the common
+    scale of both is measured from the map (:func:`~shadowcam.lab.edge_refine.dispersion`).
     """
     time, entry, exit_, std = time_dip_centroid(summary)
     refined, refined_std = refine_times(

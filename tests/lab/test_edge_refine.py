@@ -52,3 +52,67 @@ def test_rejects_bad_parameters():
         refine_times(np.zeros((4, 4)), 1.0, range_sigma=0)
     with pytest.raises(ValueError, match="time"):
         refine_times(np.zeros(4), 1.0)
+
+
+def _sphere_cap_times(radius=60.0, size=48):
+    """Shadow times over a sphere seen head-on: curved, smooth, not a quadric in (row, col)."""
+    rows, cols = np.mgrid[0:size, 0:size].astype(float)
+    centre = size / 2
+    height = np.sqrt(radius**2 - (rows - centre) ** 2 - (cols - centre) ** 2)
+    return 10.0 + 0.8 * cols + 0.6 * height
+
+
+def test_clean_centroid_on_a_curved_surface_is_kept():
+    # noise-free own times (an open-shutter centroid) stated with the workflow's prior std:
+    # the dispersion about the local quadratic is ~0, so the own time carries the weight
+    times = _sphere_cap_times()
+    refined, _ = refine_times(times, np.full(times.shape, 0.15))
+    np.testing.assert_allclose(refined, times, atol=0.01)
+
+
+def test_curved_surface_with_noise_is_still_smoothed():
+    # noise well above the plane's misfit: the plane keeps most of the weight
+    rng = np.random.default_rng(3)
+    truth = _sphere_cap_times()
+    noisy = truth + rng.normal(0, 0.3, truth.shape)
+    refined, _ = refine_times(noisy, np.full(truth.shape, 0.3))
+    inner = (slice(4, -4), slice(4, -4))
+    assert np.sqrt(np.mean((refined - truth)[inner] ** 2)) < 0.3 / 3
+
+
+def test_noisy_plane_is_averaged():
+    # std 0.4 frame -> 0.06 measured (the 48 neighbours' plane carries nearly all the weight)
+    rng = np.random.default_rng(1)
+    rows, cols = np.mgrid[0:48, 0:48]
+    truth = 3 + 0.4 * cols - 0.25 * rows
+    noisy = truth + rng.normal(0, 0.4, truth.shape)
+    refined, refined_std = refine_times(noisy, np.full(truth.shape, 0.4))
+    inner = (slice(4, -4), slice(4, -4))
+    assert np.std((refined - truth)[inner]) < 0.4 / 5
+    # the stated std follows the achieved error within a factor 1.5
+    ratio = np.std((refined - truth)[inner]) / np.median(refined_std[inner])
+    assert 1 / 1.5 < ratio < 1.5
+
+
+def test_silhouette_step_does_not_mix_the_sides():
+    # the same noisy plane with and without a 3-frame step at column 24: any weight taken
+    # across the step would shift the pixels next to it by 3 frames times that weight
+    rng = np.random.default_rng(2)
+    rows, cols = np.mgrid[0:40, 0:48]
+    plane = 0.5 * cols + 0.1 * rows + rng.normal(0, 0.1, cols.shape)
+    step = np.where(cols < 24, 0.0, 3.0)
+    flat, _ = refine_times(plane, np.full(plane.shape, 0.1))
+    stepped, _ = refine_times(plane + step, np.full(plane.shape, 0.1))
+    for side in (slice(21, 24), slice(24, 27)):  # the three columns next to the step, each side
+        shift = (stepped - step - flat)[4:-4, side]
+        assert abs(np.mean(shift)) < 0.02
+        assert np.max(np.abs(shift)) < 0.15
+
+
+def test_dispersion_is_the_median_of_the_finite_fits():
+    from shadowcam.lab.edge_refine import dispersion
+
+    assert dispersion(np.array([[0.5, np.nan], [2.0, 1.0]])) == 1.0
+    assert dispersion(np.array([[0.25, np.inf], [0.5, np.nan]])) == 0.375
+    assert dispersion(np.full((2, 2), np.nan)) == 1.0
+    assert dispersion(np.array([[np.inf, np.inf], [np.nan, np.nan]])) == 1.0
