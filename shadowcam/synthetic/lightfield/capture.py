@@ -21,6 +21,7 @@ capture_from_plan : the set-up a ``kind: lightfield`` manifest's ``synthetic`` b
 write_capture : DNG brackets of every frame and the description, written atomically into a directory.
 """
 
+import dataclasses
 import datetime
 import json
 from dataclasses import dataclass, field
@@ -232,6 +233,9 @@ def write_capture(directory, capture, *, compression="none"):
     return description
 
 
+#: manifest ``lightfield.camera`` key -> :class:`SensorModel` field
+_CAMERA_KEYS = {"gain_dn_per_e": "gain", "read_noise_dn": "read_noise"}
+
 #: scenes of a rendered light field (manifest ``synthetic.scene``)
 SCENES = {"reflector": ReflectorSource}
 
@@ -245,12 +249,18 @@ def capture_from_plan(plan, synthetic):
         Plan of the manifest (screens nearest first, bracket times).
     synthetic : mapping
         The manifest's ``synthetic`` block (``scene``, ``seed``, ``frames``, ``noise``).
+        The sensor's gain and read noise are the manifest's ``lightfield.camera`` keys where
+        given (else the :class:`LightFieldCapture` default sensor's).
     """
     if synthetic["scene"] not in SCENES:
         raise ValueError(f"manifest {plan.manifest_path}: key 'synthetic.scene' must be one of {list(SCENES)} "
                          f"for kind lightfield; got {synthetic['scene']!r}")
     screens = plan.lightfield["screens"]
+    camera = plan.lightfield["camera"]
+    sensor = LightFieldCapture.__dataclass_fields__["sensor"].default_factory()
+    sensor = dataclasses.replace(sensor, **{name: camera[key] for key, name in _CAMERA_KEYS.items()
+                                            if key in camera["given"]})
     return LightFieldCapture(source=SCENES[synthetic["scene"]](), positions_mm=tuple(s["position_mm"] for s in screens),
-                             shape=tuple(plan.frame_shape), n_frames=int(synthetic["frames"]),
+                             shape=tuple(plan.frame_shape), n_frames=int(synthetic["frames"]), sensor=sensor,
                              exposure_times=tuple(screens[0]["exposure_times_s"]), seed=int(synthetic["seed"]),
                              noise=bool(synthetic.get("noise", True)), screen_names=tuple(s["id"] for s in screens))
