@@ -71,7 +71,8 @@ def throughput(size, frame_counts):
                 print(f"{size}x{size} {n_frames:4d} frames  {step:6s} {pixel_frames / wall / 1e6:6.2f} M pixel-frames/s"
                       f"  ({wall:.2f} s per sweep)  peak {peak:6.1f} MB")
             ray_set, wall, peak = _timed(stages.rays_from_sweeps, sweeps, description)
-            print(f"{size}x{size} {n_frames:4d} frames  rays   {size * size / wall / 1e6:6.2f} M pixels/s  peak {peak:6.1f} MB")
+            print(f"{size}x{size} {n_frames:4d} frames  rays   {wall:.2f} s ({size * size / wall / 1e3:.1f} k rays/s)"
+                  f"  peak {peak:6.1f} MB")
             _, wall, peak = _timed(stages.render_positions, ray_set, description, [350.0, 675.0])
             print(f"{size}x{size} {n_frames:4d} frames  render {wall:.2f} s (2 planes)  peak {peak:6.1f} MB")
             _, wall, peak = _timed(stages.far_field, ray_set)

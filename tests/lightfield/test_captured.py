@@ -1,6 +1,8 @@
 """A captured (not rendered) kind: lightfield manifest: its description and HDR merge follow the
 manifest's files and facts, and match the renderer's own description of the same frames."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -57,7 +59,8 @@ def test_rendered_light_field_is_exposed_with_the_manifests_camera_noise(tmp_pat
     from shadowcam.io.manifest import load_manifest
     from shadowcam.synthetic.lightfield.capture import capture_from_plan
 
-    manifest = yaml.safe_load(open("data_manifest/synthetic_lightfield.yaml"))
+    repo = Path(__file__).resolve().parents[2]
+    manifest = yaml.safe_load((repo / "data_manifest" / "synthetic_lightfield.yaml").read_text())
     manifest["lightfield"]["camera"] = {"gain_dn_per_e": 0.25, "read_noise_dn": 7.5}
     path = tmp_path / "lf.yaml"
     path.write_text(yaml.safe_dump(manifest))
