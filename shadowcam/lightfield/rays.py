@@ -168,9 +168,12 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
     matched = np.full(shape + (4,), np.nan)
     matched[near["ok"]] = interpolate(near["mask"][near["ok"]])
     # the far point itself: C1 cubic on the same triangulation (the mask -> screen map curves
-    # within a far pixel near the caustics; a piecewise-linear point bends the ray there)
-    far_point = CloughTocher2DInterpolator(interpolate.tri, far["xy"][far_ok])
-    matched[near["ok"], :2] = far_point(near["mask"][near["ok"]])
+    # within a far pixel near the caustics; a piecewise-linear point bends the ray there).
+    # Where the cubic is undefined (its gradients at a degenerate, noise-folded triangle), the
+    # linear point stays.
+    cubic = CloughTocher2DInterpolator(interpolate.tri, far["xy"][far_ok])(near["mask"][near["ok"]])
+    linear = matched[near["ok"], :2]
+    matched[near["ok"], :2] = np.where(np.all(np.isfinite(cubic), -1, keepdims=True), cubic, linear)
     no_match = near["ok"] & ~np.all(np.isfinite(matched[..., :3]), axis=-1)
     flag[no_match] = NO_MATCH_FAR
     saturated = (flag == OK) & ~np.isfinite(near["irradiance"])
@@ -203,7 +206,8 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
         slope = slope[ri, ci]
     direction = np.concatenate([slope, np.ones(shape + (1,))], -1)
     irradiance = np.where(np.isfinite(near["irradiance"]), near["irradiance"], np.nan)
-    flux = irradiance * near["area"] * 1e-6
+    # a dark pixel's HDR estimate scatters around 0 with the read noise; a tube carries no negative flux
+    flux = np.maximum(irradiance, 0.0) * near["area"] * 1e-6
     flux = np.where(carries, flux, 0.0)
     std = np.hypot(near["mask_std"], matched[..., 2])
     confidence = np.where(good, np.exp(-0.5 * (std / mask_std_scale) ** 2), 0.0)

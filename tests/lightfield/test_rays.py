@@ -43,3 +43,11 @@ def test_far_point_follows_the_curvature_of_the_far_map():
     # measured: max 1.1e-5, median 6e-8 (piecewise-linear: 1.1e-4, 3.2e-5); directions up to 0.17
     assert error.max() < 3e-5 and error.max() < 0.2 * linear_error.max()
     assert np.median(error) < 1e-6 < np.median(linear_error)
+
+
+def test_a_dark_pixels_negative_hdr_estimate_carries_no_flux():
+    near, far = _curved_screen(100.0), _curved_screen(200.0)
+    near["irradiance"] = np.where(np.arange(32)[None, :] < 4, -0.01, 1.0) * np.ones((32, 1))  # read noise below 0
+    ray_set = rays.rays_dataset(near, far)
+    assert np.all(ray_set["flux"].values[:, :4] == 0) and np.all(ray_set["flux"].values[:, 4:] > 0)
+    assert np.all(ray_set["irradiance"].values[:, :4] < 0)  # the measurement itself is kept

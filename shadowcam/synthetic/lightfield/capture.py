@@ -8,7 +8,8 @@ A camera pixel's value is the screen irradiance averaged with a bilinear footpri
 A wire of width ``1.5 * step`` sweeps the mask plane along x (``axis="x"``: a vertical
 wire) or along y, ``n_frames`` frames, its centre at ``mask_start + step * t``; it
 removes the flux of the rays through it (the flux is binned by mask coordinate, eight
-bins per frame step), over the exposure if the wire moves during it (``shutter``). Each frame is exposed at every bracket time with
+bins per frame step), averaged over the exposure if the wire moves during it
+(``shutter``). Each frame is exposed at every bracket time with
 :func:`shadowcam.synthetic.sensor.simulate_raw` (noise seeded by ``[seed, screen, axis,
 frame, bracket]``); the longest bracket saturates the caustic rings.
 
@@ -193,7 +194,8 @@ def sweep_frames(capture, screen, axis, *, responsivity=None, truth=None):
     for t in range(capture.n_frames):
         brackets = []
         for e, exposure in enumerate(capture.exposure_times):
-            cover = wire_cover(bins.shape[-1], _BINS_PER_STEP * t, blur=_BINS_PER_STEP * capture.shutter * exposure / longest)
+            blur = _BINS_PER_STEP * capture.shutter * exposure / longest
+            cover = wire_cover(bins.shape[-1], _BINS_PER_STEP * t, blur=blur)
             lit = np.maximum(total - bins @ cover, 0.0)
             rgb = np.repeat(lit[..., None], 3, axis=-1)
             brackets.append(simulate_raw(rgb, sensor=capture.sensor, scale=q * exposure, noise=capture.noise,
@@ -226,7 +228,8 @@ def wire_cover(n_bins, start, *, blur):
         # integral over the exposure of the wire's extent below mask coordinate x (bins)
         if blur <= 0:
             return np.clip(x - start, 0.0, _WIRE_BINS)
-        # mean over u of clip(x - start - u, 0, W): antiderivative of clip(y, 0, W) is G
+        # mean over u of clip(x - start - u, 0, W), W the wire's width: g is the antiderivative
+        # of clip(y, 0, W)
         def g(y):
             return np.where(y <= 0, 0.0, np.where(y >= _WIRE_BINS, _WIRE_BINS * (y - _WIRE_BINS / 2), 0.5 * y**2))
         y = x - start
@@ -302,9 +305,8 @@ def capture_from_plan(plan, synthetic):
                          f"for kind lightfield; got {synthetic['scene']!r}")
     screens = plan.lightfield["screens"]
     camera = plan.lightfield["camera"]
-    sensor = LightFieldCapture.__dataclass_fields__["sensor"].default_factory()
-    sensor = dataclasses.replace(sensor, **{name: camera[key] for key, name in _CAMERA_KEYS.items()
-                                            if key in camera["given"]})
+    sensor = dataclasses.replace(LightFieldCapture().sensor, **{name: camera[key] for key, name in _CAMERA_KEYS.items()
+                                                                if key in camera["given"]})
     return LightFieldCapture(source=SCENES[synthetic["scene"]](), positions_mm=tuple(s["position_mm"] for s in screens),
                              shape=tuple(plan.frame_shape), n_frames=int(synthetic["frames"]), sensor=sensor,
                              exposure_times=tuple(screens[0]["exposure_times_s"]), seed=int(synthetic["seed"]),
