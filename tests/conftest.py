@@ -403,11 +403,11 @@ def make_timelapse():
 
 
 def _make_lightfield_manifest(folder, *, name="captured_lf", shape=(32, 32), n_frames=12, quadrature=300,
-                              noise=False, exposure="manifest"):
+                              noise=False, exposure="manifest", sensor=None):
     """Render a light field's DNG brackets into ``folder/data`` and write a captured manifest of them.
 
-    Screens ``near`` and ``far``; ``exposure="metadata"`` reads the bracket times from the
-    files. Returns ``(manifest path, the renderer's description)``.
+    Screens ``near`` and ``far``, the renderer's gain and read noise as ``lightfield.camera``;
+    ``exposure="metadata"`` reads the bracket times from the files. Returns ``(manifest path, the renderer's description)``.
     """
     import hashlib
 
@@ -415,12 +415,14 @@ def _make_lightfield_manifest(folder, *, name="captured_lf", shape=(32, 32), n_f
 
     folder = Path(folder)
     root = folder / "data"
+    options = {} if sensor is None else {"sensor": sensor}
     rendered = write_capture(root, LightFieldCapture(shape=shape, n_frames=n_frames, quadrature=quadrature,
-                                                     noise=noise, screen_names=("near", "far")))
+                                                     noise=noise, screen_names=("near", "far"), **options))
     block = {"screens": [{"id": s["name"], "position_m": s["position_mm"] / 1e3, "homography": s["homography"]}
                          for s in rendered["screens"]],
              "mask": {"position_m": rendered["mask"]["position_mm"] / 1e3,
-                      "start_m": rendered["mask"]["start_mm"] / 1e3, "step_m": rendered["mask"]["step_mm"] / 1e3}}
+                      "start_m": rendered["mask"]["start_mm"] / 1e3, "step_m": rendered["mask"]["step_mm"] / 1e3},
+             "camera": {"gain_dn_per_e": rendered["sensor"]["gain"], "read_noise_dn": rendered["sensor"]["read_noise"]}}
     if exposure == "metadata":
         block["exposure"] = {"source": "metadata", "brackets": len(rendered["exposure_times"])}
     else:

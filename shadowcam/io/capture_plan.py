@@ -376,7 +376,9 @@ def lightfield_facts(manifest):
         None), ``markers`` (or None), ``sweeps`` (suffix -> sweep name), ``exposure_times_s``),
         ``brackets`` (exposures per frame), ``exposure_source`` (``manifest`` or
         ``metadata``; times None for the latter) and ``mask`` (``position_mm``,
-        ``start_mm``, ``step_mm``; None for a rendered capture).
+        ``start_mm``, ``step_mm``; None for a rendered capture) and ``camera``
+        (``gain_dn_per_e``, ``read_noise_dn``, each 1.0 unless given; ``given`` lists the
+        keys the manifest sets).
 
     Raises
     ------
@@ -442,6 +444,7 @@ def lightfield_facts(manifest):
                                         "give every frame the same brackets, or fix the glob")
             sweeps[name] = SweepPlan(name=name, files=tuple(entry["paths"]), n_frames=n_files // brackets,
                                      times_s=tuple(float(t) for t in entry["times_s"][::brackets]))
+    camera = dict(block.get("camera") or {})
     mask = block.get("mask")
     if not rendered and mask is None:
         raise _lightfield_error(path, "'lightfield.mask'", "is missing",
@@ -451,6 +454,8 @@ def lightfield_facts(manifest):
         "brackets": brackets,
         "exposure_source": "metadata" if screens[0]["exposure_times_s"][0] is None else "manifest",
         "mask": None if mask is None else {k.replace("_m", "_mm"): 1e3 * float(v) for k, v in mask.items()},
+        "camera": {"gain_dn_per_e": float(camera.get("gain_dn_per_e", 1.0)),
+                   "read_noise_dn": float(camera.get("read_noise_dn", 1.0)), "given": sorted(camera)},
     }
     return sweeps, facts
 

@@ -5,8 +5,10 @@ x) and a vertical one (a horizontal wire moving along y). Their shadow times at 
 camera pixel, turned into mask positions ``x_mask = start + step * time``, name the
 mask point the pixel's light passed through (paper VI, Fig. 17). A ray is the line
 through the near screen's point and the far screen's point with the same mask
-coordinates: its origin is on the near screen, its direction goes to the far one. Its
-flux is the near screen's irradiance times the pixel's screen area.
+coordinates: its origin is on the near screen, its direction goes to the far one (the
+far point interpolated over the far screen's mask coordinates, Clough-Tocher C1 cubic on
+their Delaunay triangulation). Its flux is the near screen's irradiance times the pixel's
+screen area.
 
 The shadow times come from the lab wing's streaming dip tracker
 (:func:`shadowcam.lab.shadow_time.track_sweep`, memory independent of the number of
@@ -23,7 +25,7 @@ write_rays : the rays dataset as a netCDF file (h5netcdf), atomically.
 
 import numpy as np
 import xarray as xr
-from scipy.interpolate import LinearNDInterpolator
+from scipy.interpolate import CloughTocher2DInterpolator, LinearNDInterpolator
 from scipy.ndimage import distance_transform_edt
 
 from shadowcam._shared.atomic import atomic_path
@@ -165,6 +167,13 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
                                                                   magnification[far_ok]])
     matched = np.full(shape + (4,), np.nan)
     matched[near["ok"]] = interpolate(near["mask"][near["ok"]])
+    # the far point itself: C1 cubic on the same triangulation (the mask -> screen map curves
+    # within a far pixel near the caustics; a piecewise-linear point bends the ray there).
+    # Where the cubic is undefined (its gradients at a degenerate, noise-folded triangle), the
+    # linear point stays.
+    cubic = CloughTocher2DInterpolator(interpolate.tri, far["xy"][far_ok])(near["mask"][near["ok"]])
+    linear = matched[near["ok"], :2]
+    matched[near["ok"], :2] = np.where(np.all(np.isfinite(cubic), -1, keepdims=True), cubic, linear)
     no_match = near["ok"] & ~np.all(np.isfinite(matched[..., :3]), axis=-1)
     flag[no_match] = NO_MATCH_FAR
     saturated = (flag == OK) & ~np.isfinite(near["irradiance"])
@@ -197,7 +206,8 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
         slope = slope[ri, ci]
     direction = np.concatenate([slope, np.ones(shape + (1,))], -1)
     irradiance = np.where(np.isfinite(near["irradiance"]), near["irradiance"], np.nan)
-    flux = irradiance * near["area"] * 1e-6
+    # a dark pixel's HDR estimate scatters around 0 with the read noise; a tube carries no negative flux
+    flux = np.maximum(irradiance, 0.0) * near["area"] * 1e-6
     flux = np.where(carries, flux, 0.0)
     std = np.hypot(near["mask_std"], matched[..., 2])
     confidence = np.where(good, np.exp(-0.5 * (std / mask_std_scale) ** 2), 0.0)

@@ -58,10 +58,11 @@ def read_description(folder):
 def describe_capture(plan):
     """The ``capture.json`` description of a captured light field.
 
-    A captured camera's gain and read noise are not in the manifest: the merge takes
-    1 DN per electron and 1 DN of read noise, and its output is DN per second
-    (``responsivity`` 1), proportional to the screen irradiance. Black and white levels
-    are the first file's (the lowest white level of its CFA sites).
+    The camera's gain and read noise (the HDR merge's inverse-variance weights) are the
+    manifest's ``lightfield.camera.gain_dn_per_e`` and ``read_noise_dn`` (1 DN per electron
+    and 1 DN where absent); the merge's output is electrons per second (``responsivity``
+    1), proportional to the screen irradiance. Black and white levels are the first
+    file's (the lowest white level of its CFA sites).
 
     Parameters
     ----------
@@ -98,7 +99,8 @@ def describe_capture(plan):
         "mask": {**mask, "n_frames": plan.sweeps[facts["screens"][0]["sweeps"]["h"]].n_frames},
         "exposure_times": [float(t) for t in times],
         "sensor": {"black_level": float(np.mean(levels["black_sites"])), "white_level": float(np.min(levels["white_sites"])),
-                   "gain": 1.0, "read_noise": 1.0, "responsivity": 1.0},
+                   "gain": facts["camera"]["gain_dn_per_e"], "read_noise": facts["camera"]["read_noise_dn"],
+                   "responsivity": 1.0},
         "files": {name: list(sweep.files) for name, sweep in plan.sweeps.items()},
     }
 

@@ -53,8 +53,8 @@ def test_lightfield_manifest_runs_end_to_end_with_exports_and_report(tmp_path, w
     between, beyond = scores["renders"]["350"], scores["renders"]["675"]
     assert between["ratio"] <= 0.5 and beyond["ratio"] <= 0.5  # at pitch_factor 2 (config)
     assert between["bandpass_render"] >= 0.9 and beyond["bandpass_render"] >= 0.9
-    # open: the far field is ~13 % off (target 5 %); hold it to the measured figure
-    assert scores["far_field"]["median_error"] <= 0.15
+    # open: the far field is 7.8 % off at the capture's resolution (target 5 %); hold it to the measured figure
+    assert scores["far_field"]["median_error"] <= 0.09
     assert scores["coverage"] >= 0.5
     table_csv = (out / "accuracy.csv").read_text()
     assert "far-field intensity median |error|" in table_csv and "<= 5" in table_csv

@@ -8,7 +8,8 @@ A camera pixel's value is the screen irradiance averaged with a bilinear footpri
 A wire of width ``1.5 * step`` sweeps the mask plane along x (``axis="x"``: a vertical
 wire) or along y, ``n_frames`` frames, its centre at ``mask_start + step * t``; it
 removes the flux of the rays through it (the flux is binned by mask coordinate, eight
-bins per frame step). Each frame is exposed at every bracket time with
+bins per frame step), averaged over the exposure if the wire moves during it
+(``shutter``). Each frame is exposed at every bracket time with
 :func:`shadowcam.synthetic.sensor.simulate_raw` (noise seeded by ``[seed, screen, axis,
 frame, bracket]``); the longest bracket saturates the caustic rings.
 
@@ -16,11 +17,13 @@ Offers
 ------
 LightFieldCapture : the set-up (source, screens, camera, sweeps, exposures, sensor).
 sweep_frames : the brackets of every frame of one sweep (a generator: memory independent of frames).
+wire_cover : fraction of an exposure the moving wire covers each mask bin (a still or a moving wire).
 capture_description : the ``kind: lightfield`` description (screens, sweeps, exposures, sensor).
 capture_from_plan : the set-up a ``kind: lightfield`` manifest's ``synthetic`` block describes.
 write_capture : DNG brackets of every frame and the description, written atomically into a directory.
 """
 
+import dataclasses
 import datetime
 import json
 from dataclasses import dataclass, field
@@ -63,6 +66,11 @@ class LightFieldCapture:
         Rays per side of the flux quadrature.
     seed : int
     noise : bool
+    shutter : float
+        Fraction of the frame interval the longest bracket integrates over while the wire
+        moves on at constant speed (each bracket over its share ``shutter * t_e / max(t)``,
+        centred on the frame time); 0 (default) = the wire stands still during each
+        frame's brackets (a stepped wire).
     screen_names : tuple of str, optional
         Name of each screen (default ``screen<i>``): its folder and description entry.
     """
@@ -79,7 +87,12 @@ class LightFieldCapture:
     quadrature: int = 1200
     seed: int = 0
     noise: bool = True
+    shutter: float = 0.0
     screen_names: tuple = None
+
+    def __post_init__(self):
+        if not 0.0 <= self.shutter <= 1.0:
+            raise ValueError(f"shutter must be in [0, 1] (fraction of the frame interval); got {self.shutter!r}")
 
     def screen_name(self, screen):
         """Name of screen index `screen`."""
@@ -176,17 +189,53 @@ def sweep_frames(capture, screen, axis, *, responsivity=None, truth=None):
         centres = capture._bin_origin + (np.arange(bins.shape[-1]) + 0.5) * capture.step / _BINS_PER_STEP
         with np.errstate(invalid="ignore", divide="ignore"):
             truth.update(irradiance=total, mask_centre=(bins @ centres) / total)
-    cumulative = np.concatenate([np.zeros(bins.shape[:2] + (1,)), np.cumsum(bins, axis=-1)], -1)
     axis_index = 0 if axis == "x" else 1
+    longest = max(capture.exposure_times)
     for t in range(capture.n_frames):
-        start = _BINS_PER_STEP * t
-        blocked = cumulative[..., start + _WIRE_BINS] - cumulative[..., start]
-        lit = np.maximum(total - blocked, 0.0)
-        rgb = np.repeat(lit[..., None], 3, axis=-1)
-        yield np.stack([
-            simulate_raw(rgb, sensor=capture.sensor, scale=q * exposure, noise=capture.noise,
-                         seed=[capture.seed, screen, axis_index, t, e] if capture.noise else None)
-            for e, exposure in enumerate(capture.exposure_times)])
+        brackets = []
+        for e, exposure in enumerate(capture.exposure_times):
+            blur = _BINS_PER_STEP * capture.shutter * exposure / longest
+            cover = wire_cover(bins.shape[-1], _BINS_PER_STEP * t, blur=blur)
+            lit = np.maximum(total - bins @ cover, 0.0)
+            rgb = np.repeat(lit[..., None], 3, axis=-1)
+            brackets.append(simulate_raw(rgb, sensor=capture.sensor, scale=q * exposure, noise=capture.noise,
+                                         seed=[capture.seed, screen, axis_index, t, e] if capture.noise else None))
+        yield np.stack(brackets)
+
+
+def wire_cover(n_bins, start, *, blur):
+    """Fraction of an exposure during which the wire covers each mask bin.
+
+    The wire covers bins ``[start + u, start + u + 12)`` (bin units, continuous) while its
+    offset ``u`` runs uniformly over ``[-blur / 2, blur / 2]`` during the exposure.
+
+    Parameters
+    ----------
+    n_bins : int
+    start : float
+        Wire's leading bin edge at the exposure's centre.
+    blur : float, keyword-only
+        Wire motion during the exposure, bins (>= 0; 0 = a still wire).
+
+    Returns
+    -------
+    (n_bins,) float64 ndarray
+        In [0, 1]; sums to 12 (the wire's width in bins) where the wire is inside the bins.
+    """
+    edges = np.arange(n_bins + 1, dtype=np.float64)
+
+    def covered_below(x):
+        # integral over the exposure of the wire's extent below mask coordinate x (bins)
+        if blur <= 0:
+            return np.clip(x - start, 0.0, _WIRE_BINS)
+        # mean over u of clip(x - start - u, 0, W), W the wire's width: g is the antiderivative
+        # of clip(y, 0, W)
+        def g(y):
+            return np.where(y <= 0, 0.0, np.where(y >= _WIRE_BINS, _WIRE_BINS * (y - _WIRE_BINS / 2), 0.5 * y**2))
+        y = x - start
+        return (g(y + blur / 2) - g(y - blur / 2)) / blur
+
+    return np.diff(covered_below(edges))
 
 
 def capture_description(capture, *, responsivity):
@@ -232,6 +281,9 @@ def write_capture(directory, capture, *, compression="none"):
     return description
 
 
+#: manifest ``lightfield.camera`` key -> :class:`SensorModel` field
+_CAMERA_KEYS = {"gain_dn_per_e": "gain", "read_noise_dn": "read_noise"}
+
 #: scenes of a rendered light field (manifest ``synthetic.scene``)
 SCENES = {"reflector": ReflectorSource}
 
@@ -244,13 +296,19 @@ def capture_from_plan(plan, synthetic):
     plan : shadowcam.io.capture_plan.CapturePlan
         Plan of the manifest (screens nearest first, bracket times).
     synthetic : mapping
-        The manifest's ``synthetic`` block (``scene``, ``seed``, ``frames``, ``noise``).
+        The manifest's ``synthetic`` block (``scene``, ``seed``, ``frames``, ``noise``, ``shutter``).
+        The sensor's gain and read noise are the manifest's ``lightfield.camera`` keys where
+        given (else the :class:`LightFieldCapture` default sensor's).
     """
     if synthetic["scene"] not in SCENES:
         raise ValueError(f"manifest {plan.manifest_path}: key 'synthetic.scene' must be one of {list(SCENES)} "
                          f"for kind lightfield; got {synthetic['scene']!r}")
     screens = plan.lightfield["screens"]
+    camera = plan.lightfield["camera"]
+    sensor = dataclasses.replace(LightFieldCapture().sensor, **{name: camera[key] for key, name in _CAMERA_KEYS.items()
+                                                                if key in camera["given"]})
     return LightFieldCapture(source=SCENES[synthetic["scene"]](), positions_mm=tuple(s["position_mm"] for s in screens),
-                             shape=tuple(plan.frame_shape), n_frames=int(synthetic["frames"]),
+                             shape=tuple(plan.frame_shape), n_frames=int(synthetic["frames"]), sensor=sensor,
                              exposure_times=tuple(screens[0]["exposure_times_s"]), seed=int(synthetic["seed"]),
-                             noise=bool(synthetic.get("noise", True)), screen_names=tuple(s["id"] for s in screens))
+                             noise=bool(synthetic.get("noise", True)), shutter=float(synthetic.get("shutter", 0.0)),
+                             screen_names=tuple(s["id"] for s in screens))
