@@ -13,11 +13,12 @@ restarts the pixel's record. Memory is ``K`` float16 values per pixel.
 :func:`fit_descents` fits the circular-segment law (:mod:`shadowcam.outdoor.penumbra`) to
 every descent, then refits, with the duration of their confident neighbours
 (:func:`shadowcam.outdoor.penumbra.coherent_durations`), the pixels whose own fit is noisy
-(uncertain centre, too few samples in the ramp) but saw the ramp end. Each pixel gets a state
-(:data:`RAMP_STATES`): ramps shorter than the sampling resolves (``short``) keep the level
-crossing; ramps still under way at the last frame (``cut``: the shadow level is not observed,
-and the penumbra's duration varies with the skyline's slope too much to borrow it) and fits
-whose centre stays uncertain beyond ``max_sigma`` intervals (``ambiguous``) get no centre.
+(uncertain centre) or whose ramp looks cut by the sequence's end: with the neighbours'
+duration the ramp either ended by the last frame (the fit stands) or is shorter than the
+sampling resolves (the crossing stands). Each pixel gets a state (:data:`RAMP_STATES`): ramps
+shorter than the sampling resolves (``short``) keep the level crossing; ramps still under way
+at the last frame (``cut``: the shadow level is not observed) and fits whose centre stays
+uncertain beyond ``max_sigma`` intervals (``ambiguous``) get no centre.
 
 Every step but the neighbours' duration is per pixel; that one reads ``radius`` pixels
 each side, within the halo of a column strip (:mod:`shadowcam.outdoor.strips`).
@@ -166,18 +167,22 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
     good[rows, cols] = confident
     neighbours = coherent_durations(duration, good, radius=radius)
     nbr = neighbours[rows, cols]
-    # the neighbours' duration steadies a noisy ramp whose own fit saw it end; a ramp the
-    # pixel's own data shows still under way has no observed shadow level, whatever its duration
-    redo = np.isfinite(nbr) & ~confident & ~cut & ~short
+    # the neighbours' duration (the same sun behind the same skyline) steadies a noisy ramp, and
+    # decides a ramp the sequence's end cut: if the neighbours' ramp would have ended by then the
+    # fit with their duration stands, or, shorter than the sampling resolves, the crossing does
+    redo = np.isfinite(nbr) & ~confident & ~short
     if redo.any():
         r, c = rows[redo], cols[redo]
         refit = _fit(buffer, r, c, time_s, crossing[r, c], interval, duration=nbr[redo])
-        ok = (refit["resolved"] & (refit["sigma_s"] <= limit)
-              & (refit["centre_s"] + 0.5 * nbr[redo] <= end + 0.5 * interval))
-        centre[r, c] = refit["centre_s"]
+        ended = refit["centre_s"] + 0.5 * nbr[redo] <= end + 0.5 * interval
+        ok = refit["resolved"] & (refit["sigma_s"] <= limit) & ended
+        too_short = ~refit["resolved"] & (crossing[r, c] + 0.5 * nbr[redo] <= end + 0.5 * interval)
+        centre[r, c] = np.where(ok, refit["centre_s"], centre[r, c])
         duration[r, c] = nbr[redo]
-        sigma[r, c] = refit["sigma_s"]
-        state[r, c] = np.where(ok, STATE_CODE["neighbours_duration"], STATE_CODE["ambiguous"])
+        sigma[r, c] = np.where(ok, refit["sigma_s"], sigma[r, c])
+        was_cut = state[r, c] == STATE_CODE["cut"]
+        state[r, c] = np.select([ok, too_short, was_cut], [STATE_CODE["neighbours_duration"], STATE_CODE["short"],
+                                                           STATE_CODE["cut"]], STATE_CODE["ambiguous"])
     keep = (state == STATE_CODE["fitted"]) | (state == STATE_CODE["neighbours_duration"])
     out["ramp_centre_s"] = np.where(keep, centre, np.nan).astype(np.float32)
     out["ramp_duration_s"] = np.where(state > 0, duration, np.nan).astype(np.float32)
