@@ -16,9 +16,10 @@ every descent, then refits, with the duration of their confident neighbours
 (uncertain centre) or whose ramp looks cut by the sequence's end: with the neighbours'
 duration the ramp either ended by the last frame (the fit stands) or is shorter than the
 sampling resolves (the crossing stands). Each pixel gets a state (:data:`RAMP_STATES`): ramps
-shorter than the sampling resolves (``short``) keep the level crossing; ramps still under way
-at the last frame (``cut``: the shadow level is not observed) and fits whose centre stays
-uncertain beyond ``max_sigma`` intervals (``ambiguous``) get no centre.
+shorter than the sampling resolves (``short``) keep the level crossing, and so do ramps whose
+fit stays uncertain (a cloud's shade over the ramp) but agrees with the crossing within two
+standard errors; ramps still under way at the last frame (``cut``: the shadow level is not
+observed) and uncertain fits that contradict the crossing (``ambiguous``) get no time.
 
 Every step but the neighbours' duration is per pixel; that one reads ``radius`` pixels
 each side, within the halo of a column strip (:mod:`shadowcam.outdoor.strips`).
@@ -183,6 +184,11 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
         was_cut = state[r, c] == STATE_CODE["cut"]
         state[r, c] = np.select([ok, too_short, was_cut], [STATE_CODE["neighbours_duration"], STATE_CODE["short"],
                                                            STATE_CODE["cut"]], STATE_CODE["ambiguous"])
+    # an uncertain fit that does not contradict the level crossing (within two standard
+    # errors) leaves it standing; one that does gives no time
+    with np.errstate(invalid="ignore"):
+        agrees = (state == STATE_CODE["ambiguous"]) & (np.abs(centre - crossing) <= 2.0 * sigma)
+    state[agrees] = STATE_CODE["short"]
     keep = (state == STATE_CODE["fitted"]) | (state == STATE_CODE["neighbours_duration"])
     out["ramp_centre_s"] = np.where(keep, centre, np.nan).astype(np.float32)
     out["ramp_duration_s"] = np.where(state > 0, duration, np.nan).astype(np.float32)

@@ -106,7 +106,8 @@ def test_a_noisy_pixel_takes_its_neighbours_duration():
     series = series + rng.normal(0, 1, series.shape) * noise
     buffer, crossing, times = _stream(series, frames=128)
     out = fit_descents(buffer, crossing, times, max_sigma=1.0)
-    assert out["ramp_state"][3, 3] in (STATE_CODE["neighbours_duration"], STATE_CODE["ambiguous"])
+    # refitted with the neighbours' duration, or left to the crossing / no time when still uncertain
+    assert out["ramp_state"][3, 3] in (STATE_CODE["neighbours_duration"], STATE_CODE["ambiguous"], STATE_CODE["short"])
     if out["ramp_state"][3, 3] == STATE_CODE["neighbours_duration"]:
         assert out["ramp_duration_s"][3, 3] / INTERVAL == pytest.approx(40, rel=0.1)
     others = np.ones((7, 7), bool)
