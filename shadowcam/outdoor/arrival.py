@@ -14,6 +14,14 @@ Two estimators, combined:
   represent (a second transition in a column, a sunlit tongue that sweeps
   sideways) and is not fooled by a shadow that passes (a cloud).
 
+* **penumbra fit** (:mod:`shadowcam.outdoor.descent`): the centre of the final descent's
+  ramp, the circular-segment law of a disc sun behind a straight edge fitted to the
+  pixel's coverage over the whole ramp. Where the ramp spans several frames (the real
+  sun behind a far ridge at a photographer's cadence) it replaces both crossings, which
+  assume an edge sharper than one interval; a ramp shorter than the sampling resolves
+  keeps them. A ramp still under way at the last frame, or whose centre is uncertain, gets
+  no time but a reason (:func:`apply_ramps`).
+
 Earlier dark episodes of a pixel are resolved by :func:`resolve_episodes`: one
 whose start agrees with the ridge edge's crossing of the pixel is the ridge
 shadow's arrival, relit later by the geometry (a sunlit tongue through a
@@ -30,6 +38,7 @@ arrival_from_edges : arrival time of every pixel from the per-frame edge rows.
 EVENT_KINDS : event kind code -> name (CF flag meanings).
 resolve_episodes : which dark episode of each pixel is the ridge shadow's arrival.
 combine_arrivals : the final arrival map and its reasons.
+apply_ramps : the penumbra fit's centres and reasons where the final descent was fitted.
 arrivals : arrival map, reasons and events from tracked edges and pixel episodes (arrays).
 event_table : the dark episodes of pixels with more than one, as a table.
 arrival_dataset : the arrival-time map over (row, col) with reasons.
@@ -41,6 +50,7 @@ import xarray as xr
 
 from shadowcam._shared.validation import check_positive, check_same_shape
 from shadowcam.io.frame_times import median_interval, time_to_frame
+from shadowcam.outdoor.descent import STATE_CODE
 
 #: reason code -> meaning (stored as CF flag_values / flag_meanings)
 ARRIVAL_REASONS = {
@@ -51,6 +61,9 @@ ARRIVAL_REASONS = {
     4: "sky",
     5: "relit_after_arrival",
     6: "ambiguous_history",
+    7: "penumbra_fit",
+    8: "ramp_cut",
+    9: "ambiguous_ramp",
 }
 REASON_CODE = {name: code for code, name in ARRIVAL_REASONS.items()}
 #: event kind code -> meaning: the ridge shadow's arrival (end = relit time, NaN if it lasts),
@@ -214,6 +227,43 @@ def combine_arrivals(edge_s, coverage_s, *, tolerance_s, sky, lit_at_start, reli
     arrival[sky | ~np.asarray(lit_at_start, dtype=bool)] = np.nan
     return arrival, reason
 
+def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
+    """Take the fitted penumbra centres where the final descent's ramp spans several frames.
+
+    Parameters
+    ----------
+    arrival_s : (H, W) ndarray
+        :func:`combine_arrivals` result.
+    reason : (H, W) uint8 ndarray
+        Its reasons; only pixels whose arrival is the final episode's (``edge_crossing``,
+        ``coverage_crossing``) are changed.
+    ramp_centre_s : (H, W) ndarray
+    ramp_state : (H, W) uint8 ndarray
+        :func:`shadowcam.outdoor.descent.fit_descents` results.
+
+    Returns
+    -------
+    arrival_s : (H, W) float64 ndarray
+        The ramp centre where the state is ``fitted`` or ``neighbours_duration``; NaN where
+        it is ``cut`` (reason ``ramp_cut``) or ``ambiguous`` (reason ``ambiguous_ramp``).
+    reason : (H, W) uint8 ndarray
+    """
+    arrival = np.array(arrival_s, dtype=np.float64)
+    reason = np.array(reason, dtype=np.uint8)
+    state = np.asarray(ramp_state, dtype=np.uint8)
+    check_same_shape({"arrival_s": arrival, "reason": reason, "ramp_centre_s": np.asarray(ramp_centre_s),
+                      "ramp_state": state})
+    final = (reason == REASON_CODE["edge_crossing"]) | (reason == REASON_CODE["coverage_crossing"])
+    fitted = final & ((state == STATE_CODE["fitted"]) | (state == STATE_CODE["neighbours_duration"]))
+    arrival[fitted] = np.asarray(ramp_centre_s, dtype=np.float64)[fitted]
+    reason[fitted] = REASON_CODE["penumbra_fit"]
+    for name, code in (("cut", "ramp_cut"), ("ambiguous", "ambiguous_ramp")):
+        where = final & (state == STATE_CODE[name])
+        arrival[where] = np.nan
+        reason[where] = REASON_CODE[code]
+    return arrival, reason
+
+
 def event_table(final_s, final_depth, event_start_s, event_end_s, event_depth, *, chosen, ambiguous, eligible):
     """The dark episodes of every pixel that had more than one, with their kind.
 
@@ -308,7 +358,8 @@ def arrival_dataset(arrival_s, arrival_frame, reason, *, edge_arrival_s, coverag
 
 
 #: the tracker's per-pixel results the arrival step reads (the episodes are optional)
-EPISODE_KEYS = ("coverage_arrival_s", "final_depth", "event_start_s", "event_end_s", "event_depth")
+EPISODE_KEYS = ("coverage_arrival_s", "final_depth", "event_start_s", "event_end_s", "event_depth",
+                "ramp_centre_s", "ramp_state")
 
 
 def arrivals(edge_row, time_s, pixels, *, sky, lit_at_start, tolerance_s):
@@ -321,7 +372,8 @@ def arrivals(edge_row, time_s, pixels, *, sky, lit_at_start, tolerance_s):
     time_s : (T,) ndarray
     pixels : mapping
         ``coverage_arrival_s (H, W)`` and, optionally, ``final_depth``, ``event_start_s``,
-        ``event_end_s``, ``event_depth`` (:func:`shadowcam.outdoor.tracking.track_frames`).
+        ``event_end_s``, ``event_depth`` and ``ramp_centre_s``, ``ramp_state``
+        (:func:`shadowcam.outdoor.tracking.track_frames`).
     sky, lit_at_start : (H, W) bool ndarray
     tolerance_s : float
         Agreement of the edge crossing with an episode's start.
@@ -346,6 +398,8 @@ def arrivals(edge_row, time_s, pixels, *, sky, lit_at_start, tolerance_s):
                              eligible=lit & ~sky)
     arrival, reason = combine_arrivals(edge_s, coverage_s, sky=sky, lit_at_start=lit, tolerance_s=tolerance_s,
                                        relit=relit, ambiguous=ambiguous)
+    if "ramp_state" in pixels:
+        arrival, reason = apply_ramps(arrival, reason, pixels["ramp_centre_s"], pixels["ramp_state"])
     return {"arrival_s": arrival, "reason": reason, "edge_s": edge_s, "coverage_s": coverage_s, "events": events}
 
 

@@ -17,6 +17,8 @@ pushbroom_dataset : the ridge pushbroom over (time, col, channel).
 import numpy as np
 import xarray as xr
 
+from shadowcam.outdoor.descent import RAMP_STATES
+
 _CHANNELS = np.array(["R", "G", "B"], dtype=object)
 
 
@@ -174,7 +176,9 @@ def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpo
         ``interpolated`` over ``(time, col)``; ``is_keyframe``, ``band_fraction``
         over ``time``; ``coverage_arrival_s``, ``n_events`` over ``(row, col)`` and
         ``event_start_s``, ``event_end_s``, ``event_depth`` over ``(row, col, event_slot)``
-        (the earlier dark episodes, when `tracked` has them).
+        (the earlier dark episodes, when `tracked` has them); ``ramp_centre_s``,
+        ``ramp_duration_s``, ``ramp_sigma_s``, ``ramp_state`` (CF flags) over ``(row, col)``
+        (the fitted final descent, when `tracked` has it).
     """
     tc = ("time", "col")
     rows = "pixel-edge coordinates: row r spans [r, r+1], centre r+0.5; lit above"
@@ -199,6 +203,17 @@ def edges_dataset(tracked, photometry, time_s, *, edge_row, is_keyframe, interpo
             "event_start_s": (slot, tracked["event_start_s"], {"units": "s", "long_name": "start of an earlier dark episode"}),
             "event_end_s": (slot, tracked["event_end_s"], {"units": "s", "long_name": "end (relighting) of an earlier dark episode"}),
             "event_depth": (slot, tracked["event_depth"], {"units": "1", "long_name": "1 - mean lit fraction during the episode"}),
+        })
+    if "ramp_state" in tracked:
+        cam = ("row", "col")
+        codes = sorted(RAMP_STATES)
+        data.update({
+            "ramp_centre_s": (cam, tracked["ramp_centre_s"], {"units": "s", "long_name": "centre of the fitted penumbra ramp (half the sun occluded)"}),
+            "ramp_duration_s": (cam, tracked["ramp_duration_s"], {"units": "s", "long_name": "duration of the penumbra ramp"}),
+            "ramp_sigma_s": (cam, tracked["ramp_sigma_s"], {"units": "s", "long_name": "standard error of the ramp centre (fit residual)"}),
+            "ramp_state": (cam, np.asarray(tracked["ramp_state"], np.uint8), {
+                "long_name": "how the final descent's ramp was fitted", "flag_values": np.array(codes, np.uint8),
+                "flag_meanings": " ".join(RAMP_STATES[c] for c in codes)}),
         })
     return xr.Dataset(data, coords=_frame_coords(time_s, photometry))
 

@@ -21,13 +21,14 @@ from shadowcam.io.frame_store import iter_store_frames
 from shadowcam.io.frame_times import find_gaps, median_interval
 from shadowcam.outdoor.datasets import edges_dataset, photometry_arrays
 from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
-from shadowcam.outdoor.strips import merge_strips, strip_bounds, strip_halo, strip_window, track_strip
+from shadowcam.outdoor.photometric import luminance
+from shadowcam.outdoor.strips import edge_width, merge_strips, strip_bounds, strip_halo, strip_window, track_strip
 from shadowcam.outdoor.tracking import track_frames
 
 log = logging.getLogger(__name__)
 
 TRACK_OPTIONS = frozenset({"half_window", "min_drop", "margin", "max_step", "lit_update",
-                           "update_distance"})
+                           "update_distance", "descent_frames", "max_sigma"})
 KEYFRAME_OPTIONS = frozenset({"min_confidence", "min_found_fraction"})
 
 
@@ -47,6 +48,12 @@ def _edges(tracked, arrays, time_s, options):
                             interpolated=interpolated)
     dataset.attrs.update(median_interval_s=median_interval(time_s), gaps=json.dumps(find_gaps(time_s)))
     return dataset
+
+
+def _edge_width(photometry, arrays):
+    """The first frame's measured edge width in rows (:func:`shadowcam.outdoor.strips.edge_width`)."""
+    return edge_width(luminance(photometry["reference"].values), lit_level=arrays["lit_level"],
+                      shadow_level=arrays["shadow_level"], lit_at_start=arrays["lit_at_start"], sky=arrays["sky"])
 
 
 def track_edges(frames, photometry, **options):
@@ -69,7 +76,9 @@ def track_edges(frames, photometry, **options):
     _check_options(options, TRACK_OPTIONS | KEYFRAME_OPTIONS, "options")
     arrays = photometry_arrays(photometry)
     time_s = frames["time_s"].values
-    tracked = track_frames(iter_store_frames(frames, what="edge tracking"), arrays, time_s,
+    width_rows = _edge_width(photometry, arrays)
+    log.info("edge tracking: measured edge width %.1f rows", width_rows)
+    tracked = track_frames(iter_store_frames(frames, what="edge tracking"), arrays, time_s, edge_width_rows=width_rows,
                            **{k: v for k, v in options.items() if k in TRACK_OPTIONS})
     return _edges(tracked, arrays, time_s, options)
 
@@ -105,7 +114,7 @@ def track_column_strip(frames, photometry, *, index, count, **options):
     """Run the tracking pass on strip `index` of `count` equal column strips.
 
     Reads only the strip's window (its columns plus a halo for the registration
-    shift and the frame-differencing widening) of every frame.
+    shift, the frame-differencing widening and the measured edge width) of every frame.
 
     Parameters
     ----------
@@ -129,8 +138,11 @@ def track_column_strip(frames, photometry, *, index, count, **options):
     arrays = photometry_arrays(photometry)
     width = frames.sizes["col"]
     cols = strip_bounds(width, count)[index]
-    halo = strip_halo(arrays["shift"], margin=options.get("margin", 2))
+    width_rows = _edge_width(photometry, arrays)
+    halo = strip_halo(arrays["shift"], margin=options.get("margin", 2), edge_width_rows=width_rows)
     a, b = strip_window(cols, halo, width)
-    log.info("strip %d/%d: columns %d:%d, reading %d:%d (halo %d)", index, count, *cols, a, b, halo)
+    log.info("strip %d/%d: columns %d:%d, reading %d:%d (halo %d, edge width %.1f rows)", index, count, *cols, a,
+             b, halo, width_rows)
     stream = iter_store_frames(frames.isel(col=slice(a, b)), what=f"edge tracking, strip {index}/{count}")
-    return track_strip(stream, arrays, frames["time_s"].values, cols=cols, halo=halo, **options)
+    return track_strip(stream, arrays, frames["time_s"].values, cols=cols, halo=halo, edge_width_rows=width_rows,
+                       **options)

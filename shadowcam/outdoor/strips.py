@@ -13,14 +13,19 @@ Its spatial dependencies across columns are:
 * ``band_fraction``, a whole-frame mean: reassembled exactly from per-strip
   integer counts (band pixels and valid pixels of the strip's own columns).
 
+* the penumbra fit's neighbours' duration (:func:`shadowcam.outdoor.descent.fit_descents`):
+  :data:`~shadowcam.outdoor.descent.NEIGHBOUR_RADIUS` pixels each side.
+
 Everything else is per pixel (luminance, coverage, lit-level update, coverage
-crossing) or per column (the edge search, its tracking prior and the area
+crossing, the fit of the final descent) or per column (the edge search, its tracking prior and the area
 estimator, which sums rows). A strip of columns ``[c0, c1)`` therefore streams
 every frame over the window ``[c0 - halo, c1 + halo)`` and keeps only its own
 columns. The band of a halo column next to the window's cut can be wrong; that
 changes the halo column's edge and lit level and, through the next frames'
 band, can creep inward by up to ``margin`` columns a frame where columns have
-several transitions. The default halo adds :data:`GUARD_COLUMNS` for that, and
+several transitions; a soft edge (the penumbra of the real sun behind a far ridge, many rows
+wide) spreads those band errors over its whole width, so the halo grows by the edge's
+measured width in rows (:func:`edge_width`). The default halo adds :data:`GUARD_COLUMNS`, and
 each strip also keeps the column on either side of its own, which the
 neighbouring strip owns: :func:`merge_strips` refuses to merge strips that do
 not agree there (then raise the halo). On the seeded synthetic scene and on
@@ -29,7 +34,8 @@ dev_ridge the strips equal the single job bit for bit already with a guard of 0.
 Offers
 ------
 strip_bounds : column ranges of n equal strips.
-strip_halo : halo columns needed for a photometry's shifts and the tracking options.
+edge_width : the first frame's shadow-edge width in rows (penumbra), measured.
+strip_halo : halo columns needed for a photometry's shifts, edge width and the tracking options.
 strip_window : the columns a strip reads (its own plus the halo, clipped to the frame).
 track_strip : run the tracking pass on one strip.
 merge_strips : join strips into the single job's result.
@@ -42,6 +48,7 @@ import math
 import numpy as np
 
 from shadowcam._shared.atomic import atomic_path
+from shadowcam.outdoor.descent import NEIGHBOUR_RADIUS
 from shadowcam.outdoor.tracking import PIXEL_KEYS, EdgeTracker
 
 #: extra halo columns against the band errors creeping in from the window's cut
@@ -61,7 +68,47 @@ def strip_bounds(width, n_strips):
     return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:])]
 
 
-def strip_halo(shift, *, margin=2, guard=GUARD_COLUMNS):
+def edge_width(reference_luma, *, lit_level, shadow_level, lit_at_start, sky):
+    """Width in rows of the shadow edge in the first frame, measured from its partly lit pixels.
+
+    The pixels shadowed in the first frame have a measured shadow level (the sequence's
+    minimum) and a lit level (the shadow level over the shadow ratio), so their lit fraction
+    in the first frame is known; those strictly between 0.1 and 0.9 lie in the penumbra's
+    shadow-side half (the lit side is taken for lit and has no level below it yet).
+
+    Parameters
+    ----------
+    reference_luma : (H, W) ndarray
+        Luminance of the first frame.
+    lit_level, shadow_level : (H, W) ndarray
+        The first pass's levels (:func:`shadowcam.outdoor.normalise.normalise_frames`).
+    lit_at_start, sky : (H, W) bool ndarray
+
+    Returns
+    -------
+    float
+        Twice the median count of such pixels per column, over the columns that have a
+        lit / shadowed boundary; 0 where none has one.
+    """
+    ref = np.asarray(reference_luma, dtype=np.float64)
+    lit_level = np.asarray(lit_level, dtype=np.float64)
+    shadow_level = np.asarray(shadow_level, dtype=np.float64)
+    lit = np.asarray(lit_at_start, dtype=bool)
+    sky = np.asarray(sky, dtype=bool)
+    if ref.ndim != 2 or not (ref.shape == lit_level.shape == shadow_level.shape == lit.shape == sky.shape):
+        raise ValueError(f"reference_luma {ref.shape}, lit_level {lit_level.shape}, shadow_level {shadow_level.shape}, "
+                         f"lit_at_start {lit.shape} and sky {sky.shape} must be the same (H, W) shape")
+    shadowed = ~lit & ~sky & (lit_level > shadow_level)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cover = (ref - shadow_level) / (lit_level - shadow_level)
+    partial = shadowed & (cover > 0.1) & (cover < 0.9)
+    boundary = shadowed.any(axis=0) & (lit & ~sky).any(axis=0)
+    if not boundary.any():
+        return 0.0
+    return 2.0 * float(np.median(partial.sum(axis=0)[boundary]))
+
+
+def strip_halo(shift, *, margin=2, guard=GUARD_COLUMNS, edge_width_rows=0.0):
     """Return the halo (columns each side of a strip) for the tracking pass.
 
     Parameters
@@ -72,19 +119,22 @@ def strip_halo(shift, *, margin=2, guard=GUARD_COLUMNS):
         Frame-differencing widening (the tracking option of the same name).
     guard : int, optional
         Extra columns (see the module notes).
+    edge_width_rows : float, optional
+        Measured width of the shadow edge (:func:`edge_width`).
 
     Returns
     -------
     int
-        ``ceil(max |shift_col|) + 2 + margin + guard``.
+        ``ceil(max |shift_col|) + 2 + margin + NEIGHBOUR_RADIUS + guard + ceil(edge_width_rows)``.
     """
     shift = np.asarray(shift, dtype=np.float64)
     if shift.ndim != 2 or shift.shape[1] != 2 or not np.all(np.isfinite(shift)):
         raise ValueError(f"shift must be a finite (T, 2) array; got shape {shift.shape}")
-    if margin < 0 or guard < 0:
-        raise ValueError(f"margin and guard must be >= 0; got {margin}, {guard}")
+    if margin < 0 or guard < 0 or not edge_width_rows >= 0:
+        raise ValueError(f"margin, guard and edge_width_rows must be >= 0; got {margin}, {guard}, {edge_width_rows}")
     largest = float(np.abs(shift[:, 1]).max()) if shift.size else 0.0
-    return int(math.ceil(largest)) + 2 + int(margin) + int(guard)
+    return (int(math.ceil(largest)) + 2 + int(margin) + NEIGHBOUR_RADIUS + int(guard)
+            + int(math.ceil(edge_width_rows)))
 
 
 def strip_window(cols, halo, width):

@@ -9,13 +9,14 @@ gives the band where the edge moved (:mod:`shadowcam.outdoor.frame_difference`);
 edge of every column is located with sub-pixel precision
 (:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions in the band, then near
 the column's most recent edge (tracking), and the dark episodes of every pixel are
-accumulated (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`). The lit level of each
+accumulated (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`), with each pixel's final
+descent, whose penumbra ramp is fitted at the end (:mod:`shadowcam.outdoor.descent`). The lit level of each
 pixel follows slow shading changes (the sun moves) while the pixel is fully lit and well
-above the edge. Memory is a few ``(H, W)`` arrays, ``E`` episode slots per pixel and the
-``(T, W)`` edges.
+above the edge. Memory is a few ``(H, W)`` arrays, ``E`` episode slots and ``descent_frames``
+float16 values per pixel and the ``(T, W)`` edges.
 
 Every step but the frame differencing's widening (``margin`` columns), the episodes'
-neighbour count (one pixel each side) and the
+neighbour count (one pixel each side), the ramps' neighbours' duration (three pixels) and the
 registration shift (:func:`shadowcam.outdoor.translation.translate`, ``"cubic_Keys1981"``,
 whose bits do not depend on where the frame is cut) works column by column,
 so column strips of the frames can be tracked as separate jobs and merged
@@ -30,6 +31,7 @@ track_frames : run it over an iterable of frames.
 
 import numpy as np
 
+from shadowcam.outdoor.descent import DescentBuffer, fit_descents
 from shadowcam.outdoor.edge_tracking import column_edges
 from shadowcam.outdoor.episodes import ShadowEpisodes
 from shadowcam.outdoor.frame_difference import difference_band
@@ -38,8 +40,11 @@ from shadowcam.outdoor.shade import remove_shade, shade_above_edge
 from shadowcam.outdoor.translation import translate
 
 
+#: rows between the edge and the rows a passing shade is measured on (plus the edge's width)
+SHADE_GAP = 4
 #: per-pixel (row, col, ...) results of the pass
-PIXEL_KEYS = ("coverage_arrival_s", "final_depth", "event_start_s", "event_end_s", "event_depth", "n_events")
+PIXEL_KEYS = ("coverage_arrival_s", "final_depth", "event_start_s", "event_end_s", "event_depth", "n_events",
+              "ramp_centre_s", "ramp_duration_s", "ramp_sigma_s", "ramp_state")
 
 
 class EdgeTracker:
@@ -67,10 +72,24 @@ class EdgeTracker:
         Columns ``[c0, c1)`` of the frames over which :attr:`band_count` (pixels in
         the band, per frame) and :attr:`valid_count` (valid pixels) are counted
         (default all): the exact partial sums of ``band_fraction`` for a column strip.
+    edge_width_rows : float, optional
+        Measured width of the shadow edge (:func:`shadowcam.outdoor.strips.edge_width`):
+        the lit level is updated only `update_distance` rows beyond it, and a passing
+        shade is measured that many rows further above the edge, so that neither takes
+        the penumbra's own dimming (the real sun behind a far ridge: tens of rows) for a
+        change of the lit level or for a cloud.
+    descent_frames : int, optional
+        Frames of each pixel's final descent kept for the penumbra fit
+        (:class:`shadowcam.outdoor.descent.DescentBuffer`; at least the penumbra's
+        duration in frames plus a few frames of lit and shadowed level).
+    max_sigma : float, optional
+        Largest standard error of a fitted ramp centre, in median intervals
+        (:func:`shadowcam.outdoor.descent.fit_descents`).
     """
 
     def __init__(self, photometry, time_s, *, half_window=3, min_drop=0.2, margin=2, max_step=3.0,
-                 lit_update=0.3, update_distance=4.0, count_cols=None):
+                 lit_update=0.3, update_distance=4.0, count_cols=None, edge_width_rows=0.0, descent_frames=128,
+                 max_sigma=1.0):
         self.shift = np.asarray(photometry["shift"], dtype=np.float64)
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
@@ -90,7 +109,11 @@ class EdgeTracker:
         height, width = self.valid.shape
         self.options = dict(half_window=half_window, max_step=max_step)
         self.band_options = dict(min_drop=min_drop, margin=margin)
-        self.lit_update, self.update_distance = float(lit_update), float(update_distance)
+        if not edge_width_rows >= 0:
+            raise ValueError(f"edge_width_rows must be >= 0; got {edge_width_rows}")
+        soft = float(np.ceil(edge_width_rows))
+        self.lit_update, self.update_distance = float(lit_update), float(update_distance) + soft
+        self._shade_gap = SHADE_GAP + int(soft)
         self.edge_row = np.full((n_frames, width), np.nan, dtype=np.float32)
         self.confidence = np.zeros((n_frames, width), dtype=np.float32)
         self.n_transitions = np.zeros((n_frames, width), dtype=np.int16)
@@ -102,6 +125,8 @@ class EdgeTracker:
         self.band_count = np.zeros(n_frames, dtype=np.int64)
         self.valid_count = int(self.valid[self._counted].sum())
         self.episodes = ShadowEpisodes((height, width), eligible=self.lit_at_start & self.valid)
+        self.descent = DescentBuffer((height, width), frames=descent_frames)
+        self.max_sigma = float(max_sigma)
         self._previous = None
         self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
         self._k = 0
@@ -116,8 +141,8 @@ class EdgeTracker:
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
         if k:  # a passing cloud's shade at the edge (measured above the last edge found)
-            shade = shade_above_edge(cover, self._last_edge, valid=self.lit_at_start & self.valid)
-            cover = remove_shade(cover, shade, self._last_edge)
+            shade = shade_above_edge(cover, self._last_edge, valid=self.lit_at_start & self.valid, gap=self._shade_gap)
+            cover = remove_shade(cover, shade, self._last_edge, gap=self._shade_gap)
         band = None
         if self._previous is not None:
             band = difference_band(self._previous, cover, valid=self.valid, **self.band_options)
@@ -128,6 +153,7 @@ class EdgeTracker:
         found = np.isfinite(self.edge_row[k])
         self._last_edge[found] = self.edge_row[k][found]
         self.episodes.update(cover, self.time_s[k])
+        self.descent.update(cover, dark=self.episodes.dark & np.isfinite(self.episodes.start))
         if self.lit_update > 0:
             with np.errstate(invalid="ignore"):
                 far = ~(self._centre > self.edge_row[k][None, :] - self.update_distance)
@@ -141,13 +167,15 @@ class EdgeTracker:
         """Return the pass's results (see :func:`track_frames`)."""
         if self._k != self.time_s.size:
             raise ValueError(f"got {self._k} frames but {self.time_s.size} frame times")
+        episodes = {"coverage_arrival_s" if key == "final_start_s" else key: value
+                    for key, value in self.episodes.result().items()}
         return {
             "edge_row": self.edge_row,
             "confidence": self.confidence,
             "n_transitions": self.n_transitions,
             "band_fraction": self.band_fraction,
-            **{"coverage_arrival_s" if key == "final_start_s" else key: value
-               for key, value in self.episodes.result().items()},
+            **episodes,
+            **fit_descents(self.descent, episodes["coverage_arrival_s"], self.time_s, max_sigma=self.max_sigma),
         }
 
 
@@ -171,7 +199,9 @@ def track_frames(frames, photometry, time_s, **options):
         ``n_transitions (T, W)``, ``band_fraction (T,)`` (share of valid pixels in
         the frame-differencing band), ``coverage_arrival_s (H, W)`` (start of the final dark
         episode) and the earlier episodes: ``event_start_s``, ``event_end_s``, ``event_depth``
-        ``(H, W, E)``, ``n_events (H, W)`` (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`).
+        ``(H, W, E)``, ``n_events (H, W)`` (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`) and the
+        fitted final descent: ``ramp_centre_s``, ``ramp_duration_s``, ``ramp_sigma_s``, ``ramp_state``
+        ``(H, W)`` (:func:`shadowcam.outdoor.descent.fit_descents`).
     """
     tracker = EdgeTracker(photometry, time_s, **options)
     for frame in frames:

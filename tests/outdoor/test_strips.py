@@ -71,7 +71,8 @@ def test_a_halo_too_narrow_for_the_shake_is_refused(shaken):
 def test_strip_layout_is_validated(shaken):
     scene, photometry, _ = shaken
     assert strip_bounds(70, 3) == [(0, 23), (23, 47), (47, 70)]
-    assert strip_halo(np.array([[0.0, 0.2], [3.0, -1.4]]), margin=2, guard=0) == 6  # ceil(1.4) + 2 + 2
+    # ceil(1.4) + 2 + 2 + the ramp fit's neighbours (3)
+    assert strip_halo(np.array([[0.0, 0.2], [3.0, -1.4]]), margin=2, guard=0) == 9
     assert strip_window((0, 23), 6, 70) == (0, 29) and strip_window((47, 70), 6, 70) == (41, 70)
     with pytest.raises(ValueError, match="n_strips"):
         strip_bounds(70, 0)

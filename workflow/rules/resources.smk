@@ -24,12 +24,13 @@ IMAGE_BYTES_PER_PIXEL = 2000
 #: MB per megapixel of frame and fixed MB of the outdoor steps, with margin
 #: (`make bench-outdoor-size`: benchmarks/bench<N>/<rule>.tsv max_rss at 24 MP; tracking
 #: and per-pixel steps: tracemalloc peaks per pixel, docs/benchmarks.md "Outdoor arrival",
-#: plus 30%)
+#: plus 30%; tracking also keeps each pixel's final descent, track_edges.descent_frames
+#: float16 values (128: 256 bytes per pixel), and fits it in batches of 4096 pixels)
 OUTDOOR_MEM_MB = {
     "normalise": (400, 85),
-    "track": (400, 130),
-    "track_strip": (400, 130),
-    "per_pixel": (400, 95),
+    "track": (500, 460),
+    "track_strip": (500, 460),
+    "per_pixel": (400, 110),
 }
 #: seconds per frame and megapixel of the outdoor steps on one core
 #: (`make bench-outdoor-size`: benchmarks/bench<N>/<rule>.tsv s at 24 MP)

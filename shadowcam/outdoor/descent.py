@@ -1,0 +1,197 @@
+"""Each pixel's final descent into shadow, kept while streaming and fitted with the penumbra law.
+
+With the real sun (a 0.53 deg disc) the shadow of a ridge kilometres away arrives over a
+penumbra that lasts many frames at a photographer's cadence; the arrival (half the disc
+occluded) is the centre of that ramp, which a level crossing between two frames finds only
+when the ramp is shorter than an interval and the levels are right. :class:`DescentBuffer`
+keeps, per pixel, the coverage of the last ``K`` frames, and stops writing once the
+pixel's current dark episode has lasted ``K // 2`` frames: what it holds at the end is the
+final descent (``K // 2`` frames before the final episode's level crossing and as many
+after, or up to the last frame). An episode that ends (the pixel relights: a cloud passed)
+restarts the pixel's record. Memory is ``K`` float16 values per pixel.
+
+:func:`fit_descents` fits the circular-segment law (:mod:`shadowcam.outdoor.penumbra`) to
+every descent, then refits, with the duration of their confident neighbours
+(:func:`shadowcam.outdoor.penumbra.coherent_durations`), the pixels whose own fit is noisy
+(uncertain centre) or whose ramp looks cut by the sequence's end: with the neighbours'
+duration the ramp either ended by the last frame (the fit stands) or is shorter than the
+sampling resolves (the crossing stands). Each pixel gets a state (:data:`RAMP_STATES`): ramps
+shorter than the sampling resolves (``short``) keep the level crossing, and so do ramps whose
+fit stays uncertain (a cloud's shade over the ramp) but agrees with the crossing within two
+standard errors; ramps still under way at the last frame (``cut``: the shadow level is not
+observed) and uncertain fits that contradict the crossing (``ambiguous``) get no time.
+
+Every step but the neighbours' duration is per pixel; that one reads ``radius`` pixels
+each side, within the halo of a column strip (:mod:`shadowcam.outdoor.strips`).
+
+Offers
+------
+RAMP_STATES : ramp state code -> name.
+DescentBuffer : the streaming record; :meth:`update` per frame, :meth:`series`.
+fit_descents : per-pixel centre, duration, uncertainty and state of the final descent.
+"""
+
+import numpy as np
+
+from shadowcam._shared.validation import check_positive
+from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps
+
+#: ramp state code -> meaning
+RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: "cut", 5: "ambiguous"}
+STATE_CODE = {name: code for code, name in RAMP_STATES.items()}
+#: pixels each side whose fitted durations steady a noisy ramp (:func:`fit_descents`)
+NEIGHBOUR_RADIUS = 3
+#: pixels fitted at once (bounds the (N, K, 4, 4) normal equations)
+_CHUNK = 4096
+
+
+class DescentBuffer:
+    """The last ``frames`` coverage values of every pixel, frozen into its final descent.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)``.
+    frames : int, keyword-only
+        ``K``: frames kept per pixel (even; ``K // 2`` each side of the crossing).
+    """
+
+    def __init__(self, shape, *, frames=128):
+        shape = tuple(int(n) for n in shape)
+        if int(frames) < 4:
+            raise ValueError(f"frames must be >= 4; got {frames}")
+        self.size = int(frames)
+        self.values = np.full((self.size, *shape), np.nan, dtype=np.float16)
+        self.count = np.zeros(shape, dtype=np.int32)  # consecutive frames held (<= K)
+        self.last = np.full(shape, -1, dtype=np.int32)  # frame index of the newest value held
+        self.frozen = np.zeros(shape, dtype=bool)
+        self._dark_frames = np.zeros(shape, dtype=np.int32)
+        self._k = 0
+
+    def update(self, cover, *, dark):
+        """Add the next frame's coverage ``(H, W)``; `dark` ``(H, W)`` marks the pixels in a dark episode."""
+        cover = np.asarray(cover)
+        dark = np.asarray(dark, dtype=bool)
+        if cover.shape != self.count.shape or dark.shape != self.count.shape:
+            raise ValueError(f"cover {cover.shape} and dark {dark.shape} must have shape {self.count.shape}")
+        k = self._k
+        self._dark_frames = np.where(dark, self._dark_frames + 1, 0)
+        restart = self.frozen & ~dark  # the episode ended: it was not the final one
+        self.count[restart] = 0
+        self.frozen &= dark
+        write = ~self.frozen
+        np.copyto(self.values[k % self.size], cover, where=write, casting="unsafe")
+        self.count[write] = np.minimum(self.count[write] + 1, self.size)
+        self.last[write] = k
+        self.frozen |= dark & (self._dark_frames >= self.size // 2)
+        self._k += 1
+
+    def series(self, rows, cols):
+        """The held values of pixels ``(rows, cols)`` in time order.
+
+        Returns
+        -------
+        values : (N, K) float64 ndarray
+            NaN where nothing is held.
+        frame : (N, K) int64 ndarray
+            Frame index of each value (negative where nothing is held).
+        """
+        j = np.arange(self.size)
+        last = self.last[rows, cols].astype(np.int64)[:, None]
+        frame = last - (self.size - 1) + j[None, :]
+        held = j[None, :] >= self.size - self.count[rows, cols][:, None]
+        values = self.values[np.mod(frame, self.size), rows[:, None], cols[:, None]].astype(np.float64)
+        values[~held] = np.nan
+        return values, np.where(held, frame, -1)
+
+
+def _fit(buffer, rows, cols, time_s, centre, interval, duration=None):
+    out = []
+    for a in range(0, rows.size, _CHUNK):
+        s = slice(a, a + _CHUNK)
+        values, frame = buffer.series(rows[s], cols[s])
+        t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
+        out.append(fit_ramps(values, t, centre_s=centre[s], interval_s=interval,
+                             duration_s=None if duration is None else duration[s]))
+    return {key: np.concatenate([o[key] for o in out]) for key in out[0]} if out else None
+
+
+def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS):
+    """Fit the penumbra law to every pixel's final descent.
+
+    Parameters
+    ----------
+    buffer : DescentBuffer
+        After the last frame.
+    crossing_s : (H, W) ndarray
+        Level crossing of the final dark episode (the fit's start; NaN: no final episode,
+        no fit).
+    time_s : (T,) ndarray
+        Frame times (s).
+    max_sigma : float, keyword-only
+        Largest standard error of the centre, in median intervals, for a centre to be given.
+    radius : int, keyword-only
+        Neighbourhood of the duration's coherence (pixels each side).
+
+    Returns
+    -------
+    dict of (H, W) ndarray
+        ``ramp_centre_s`` (NaN unless state fitted / neighbours_duration), ``ramp_duration_s``,
+        ``ramp_sigma_s`` (float32) and ``ramp_state`` (uint8, :data:`RAMP_STATES`).
+    """
+    crossing = np.asarray(crossing_s, dtype=np.float64)
+    time_s = np.asarray(time_s, dtype=np.float64)
+    if crossing.shape != buffer.count.shape:
+        raise ValueError(f"crossing_s {crossing.shape} must have the buffer's shape {buffer.count.shape}")
+    check_positive(max_sigma, "max_sigma")
+    shape = crossing.shape
+    centre = np.full(shape, np.nan)
+    duration = np.full(shape, np.nan)
+    sigma = np.full(shape, np.inf)
+    state = np.zeros(shape, dtype=np.uint8)
+    rows, cols = np.nonzero(np.isfinite(crossing) & (buffer.count > 0))
+    interval = float(np.median(np.diff(time_s))) if time_s.size > 1 else 1.0
+    out = {"ramp_centre_s": centre.astype(np.float32), "ramp_duration_s": duration.astype(np.float32),
+           "ramp_sigma_s": np.full(shape, np.nan, np.float32), "ramp_state": state}
+    if rows.size == 0:
+        return out
+    fit = _fit(buffer, rows, cols, time_s, crossing[rows, cols], interval)
+    end = time_s[-1]
+    limit = max_sigma * interval
+    cut = fit["centre_s"] + 0.5 * fit["duration_s"] > end + 0.5 * interval
+    short = ~fit["resolved"]
+    confident = fit["resolved"] & ~cut & (fit["sigma_s"] <= limit)
+    centre[rows, cols], duration[rows, cols], sigma[rows, cols] = fit["centre_s"], fit["duration_s"], fit["sigma_s"]
+    state[rows, cols] = np.select([short, cut, confident], [STATE_CODE["short"], STATE_CODE["cut"],
+                                                          STATE_CODE["fitted"]], STATE_CODE["ambiguous"])
+    good = np.zeros(shape, dtype=bool)
+    good[rows, cols] = confident
+    neighbours = coherent_durations(duration, good, radius=radius)
+    nbr = neighbours[rows, cols]
+    # the neighbours' duration (the same sun behind the same skyline) steadies a noisy ramp, and
+    # decides a ramp the sequence's end cut: if the neighbours' ramp would have ended by then the
+    # fit with their duration stands, or, shorter than the sampling resolves, the crossing does
+    redo = np.isfinite(nbr) & ~confident & ~short
+    if redo.any():
+        r, c = rows[redo], cols[redo]
+        refit = _fit(buffer, r, c, time_s, crossing[r, c], interval, duration=nbr[redo])
+        ended = refit["centre_s"] + 0.5 * nbr[redo] <= end + 0.5 * interval
+        ok = refit["resolved"] & (refit["sigma_s"] <= limit) & ended
+        too_short = ~refit["resolved"] & (crossing[r, c] + 0.5 * nbr[redo] <= end + 0.5 * interval)
+        centre[r, c] = np.where(ok, refit["centre_s"], centre[r, c])
+        duration[r, c] = nbr[redo]
+        sigma[r, c] = np.where(ok, refit["sigma_s"], sigma[r, c])
+        was_cut = state[r, c] == STATE_CODE["cut"]
+        state[r, c] = np.select([ok, too_short, was_cut], [STATE_CODE["neighbours_duration"], STATE_CODE["short"],
+                                                           STATE_CODE["cut"]], STATE_CODE["ambiguous"])
+    # an uncertain fit that does not contradict the level crossing (within two standard
+    # errors) leaves it standing; one that does gives no time
+    with np.errstate(invalid="ignore"):
+        agrees = (state == STATE_CODE["ambiguous"]) & (np.abs(centre - crossing) <= 2.0 * sigma)
+    state[agrees] = STATE_CODE["short"]
+    keep = (state == STATE_CODE["fitted"]) | (state == STATE_CODE["neighbours_duration"])
+    out["ramp_centre_s"] = np.where(keep, centre, np.nan).astype(np.float32)
+    out["ramp_duration_s"] = np.where(state > 0, duration, np.nan).astype(np.float32)
+    out["ramp_sigma_s"] = np.where(state > 0, sigma, np.nan).astype(np.float32)
+    out["ramp_state"] = state
+    return out

@@ -1,0 +1,261 @@
+"""The penumbra ramp of a disc sun behind a straight edge, fitted per pixel.
+
+The sun is a uniform disc of angular diameter ~0.53 deg. As it sets behind a ridge, the
+ridge's skyline seen from a ground point is, over the disc, a straight edge moving at the
+sun's angular speed across that skyline, which is nearly constant over the few minutes a
+disc takes to pass. The direct-sun light at the point is the visible fraction of the disc,
+the circular-segment area law
+
+    v(u) = (arccos u - u sqrt(1 - u^2)) / pi,   u = 2 (t - t_c) / D  clipped to [-1, 1],
+
+with ``t_c`` the time the edge crosses the disc centre (half the disc occluded: the
+arrival) and ``D`` the penumbra's duration (disc diameter over the edge's angular speed).
+The duration is the same for neighbouring points (the same sun behind the same skyline;
+it varies only with the skyline's slope), which is what :func:`coherent_durations` uses.
+The pixel's normalised luminance (coverage) is ``S + (L - S) v``: the lit and shadow
+levels are fitted with the ramp, so level errors of the first pass do not move ``t_c``.
+
+:func:`fit_ramps` fits ``(t_c, D, L, S)`` (or ``(t_c, L, S)`` with ``D`` given) by
+Levenberg-Marquardt from a grid start, pixel by pixel in vectorised batches, with the
+centre's standard error from the fit residual. A ramp with fewer than ``min_samples``
+samples inside it is shorter than the sampling resolves: the fit's centre is then not
+determined by the law and the caller keeps the level crossing between the two frames
+around it (the midpoint crossing).
+
+Offers
+------
+visible_fraction : the circular-segment law v(u).
+ramp_model : coverage of a pixel over time for given centre, duration and levels.
+fit_ramps : per-pixel fit of the law to luminance series, with the centre's uncertainty.
+coherent_durations : the median fitted duration of each pixel's confident neighbours.
+"""
+
+import numpy as np
+
+from shadowcam._shared.validation import check_positive
+
+#: fit parameters, in order
+PARAMETERS = ("centre_s", "duration_s", "lit", "shadow")
+
+
+def visible_fraction(u):
+    """Visible fraction of a uniform disc whose occluding straight edge is at `u` radii.
+
+    Parameters
+    ----------
+    u : ndarray
+        Signed distance of the edge from the disc's centre in radii (-1: the edge touches
+        the disc, nothing occluded; 0: half; 1: all). Values outside [-1, 1] are clipped.
+
+    Returns
+    -------
+    ndarray
+        ``(arccos u - u sqrt(1 - u^2)) / pi``, same shape as `u`, in [0, 1].
+    """
+    u = np.clip(np.asarray(u, dtype=np.float64), -1.0, 1.0)
+    return (np.arccos(u) - u * np.sqrt(1.0 - u * u)) / np.pi
+
+
+def ramp_model(time_s, *, centre_s, duration_s, lit, shadow):
+    """Coverage of a pixel as the disc passes: ``shadow + (lit - shadow) v(2 (t - centre) / duration)``.
+
+    Parameters
+    ----------
+    time_s : ndarray
+        Times (s), broadcast against the parameters.
+    centre_s, duration_s, lit, shadow : float or ndarray
+        Ramp centre (s), duration (s, > 0), lit and shadow levels.
+
+    Returns
+    -------
+    ndarray
+        Broadcast shape of the inputs.
+    """
+    duration_s = np.asarray(duration_s, dtype=np.float64)
+    if np.any(~(duration_s > 0)):
+        raise ValueError("duration_s must be > 0")
+    u = 2.0 * (np.asarray(time_s, dtype=np.float64) - centre_s) / duration_s
+    return shadow + (np.asarray(lit) - shadow) * visible_fraction(u)
+
+
+def _levels(v, y, w):
+    """Least-squares lit and shadow levels of ``y = S (1 - v) + L v`` (weights `w` = finite samples)."""
+    a = v * w
+    b = (1.0 - v) * w
+    aa, bb, ab = (a * v).sum(-1), (b * (1.0 - v)).sum(-1), (a * (1.0 - v)).sum(-1)
+    ay, by = (a * y).sum(-1), (b * y).sum(-1)
+    det = aa * bb - ab * ab
+    ok = det > 1e-9 * np.maximum(aa * bb, 1e-30)
+    safe = np.where(ok, det, 1.0)
+    lit = np.where(ok, (ay * bb - by * ab) / safe, np.nan)
+    shadow = np.where(ok, (by * aa - ay * ab) / safe, np.nan)
+    return lit, shadow
+
+
+def _residual_and_jacobian(t, y, w, p, free):
+    tc, q, lit, shadow = (p[:, i:i + 1] for i in range(4))
+    duration = np.exp(q)
+    u = 2.0 * (t - tc) / duration
+    inside = np.abs(u) < 1.0
+    uc = np.clip(u, -1.0, 1.0)
+    v = (np.arccos(uc) - uc * np.sqrt(1.0 - uc * uc)) / np.pi
+    dv_du = np.where(inside, -(2.0 / np.pi) * np.sqrt(1.0 - uc * uc), 0.0)
+    r = (y - (shadow + (lit - shadow) * v)) * w
+    amp = (lit - shadow) * dv_du
+    columns = [amp * (-2.0 / duration), amp * (-u), v, 1.0 - v]
+    jac = np.stack(columns, axis=-1) * w[..., None] * free[:, None, :]
+    return r, jac, inside
+
+
+def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samples=3, iterations=30):
+    """Fit the disc-sun ramp to each pixel's series.
+
+    The law ``S + (L - S) v(2 (t - t_c) / D)`` is fitted by Levenberg-Marquardt from a grid
+    start (durations from half an interval to twice the series' length in intervals,
+    centres around the guess). The centre's standard error is that of the least-squares covariance scaled by
+    the residual, widened by ``(1 + rho) / (1 - rho)`` (``rho`` the residuals' lag-1
+    autocorrelation): residuals correlated in time, where the law does not describe the
+    ramp exactly (a shade over it, a direct light that drifts, an edge speed that changes),
+    carry fewer independent samples.
+
+    Parameters
+    ----------
+    series : (N, K) ndarray
+        Coverage (or luminance) of N pixels at K times each; NaN where unknown. Only the
+        final descent should be given (lit before, shadowed after).
+    time_s : (N, K) or (K,) ndarray
+        Times of the samples (s).
+    centre_s : (N,) ndarray
+        Start guess of the centre (e.g. the level crossing).
+    interval_s : float, keyword-only
+        Median capture interval (s): sets the grid of start durations.
+    duration_s : (N,) ndarray, optional, keyword-only
+        Known durations (s): only the centre and the levels are fitted (NaN: fitted too).
+    min_samples : int, keyword-only
+        Samples inside the fitted ramp needed for its centre to be resolved.
+    iterations : int, keyword-only
+        Levenberg-Marquardt iterations.
+
+    Returns
+    -------
+    dict of (N,) ndarray
+        ``centre_s``, ``duration_s``, ``lit``, ``shadow``; ``sigma_s`` (standard error of
+        the centre; inf where undetermined), ``rms`` (residual rms),
+        ``n_inside`` (samples strictly inside the ramp), ``resolved`` (``n_inside >=
+        min_samples`` and a finite centre).
+    """
+    y = np.asarray(series, dtype=np.float64)
+    if y.ndim != 2:
+        raise ValueError(f"series must be (N, K); got shape {y.shape}")
+    t = np.broadcast_to(np.asarray(time_s, dtype=np.float64), y.shape)
+    n = y.shape[0]
+    c0 = np.asarray(centre_s, dtype=np.float64).reshape(-1)
+    if c0.shape != (n,):
+        raise ValueError(f"centre_s must be ({n},); got shape {np.shape(centre_s)}")
+    check_positive(interval_s, "interval_s", finite=True)
+    if int(min_samples) < 1:
+        raise ValueError(f"min_samples must be >= 1; got {min_samples}")
+    fixed = np.full(n, np.nan) if duration_s is None else np.asarray(duration_s, dtype=np.float64).reshape(-1)
+    if fixed.shape != (n,):
+        raise ValueError(f"duration_s must be ({n},); got shape {np.shape(duration_s)}")
+    w = np.isfinite(y) & np.isfinite(t)
+    y = np.where(w, y, 0.0)
+    t = np.where(w, t, 0.0)
+    wf = w.astype(np.float64)
+    # the grid depends on the series' length only (pixels fitted together or apart agree)
+    span = float(interval_s) * max(y.shape[1] - 1, 1)
+    start = np.where(np.isfinite(c0), c0, 0.0)
+    # grid start: durations from half an interval to twice the span, centres around the guess
+    best = np.full(n, np.inf)
+    p = np.zeros((n, 4))
+    for duration in interval_s * np.geomspace(0.5, max(2.0 * span / interval_s, 1.0), 14):
+        dur = np.where(np.isfinite(fixed), fixed, duration)
+        for shift in (-0.4, -0.2, 0.0, 0.2, 0.4):
+            tc = start + shift * dur
+            v = visible_fraction(2.0 * (t - tc[:, None]) / dur[:, None])
+            lit, shadow = _levels(v, y, wf)
+            sse = (((y - (shadow[:, None] + (lit - shadow)[:, None] * v)) * wf) ** 2).sum(-1)
+            better = np.isfinite(sse) & (sse < best)
+            best[better] = sse[better]
+            p[better] = np.stack([tc, np.log(dur), lit, shadow], axis=-1)[better]
+    free = np.ones((n, 4))
+    free[np.isfinite(fixed), 1] = 0.0
+    lam = np.full(n, 1e-3)
+    r, jac, inside = _residual_and_jacobian(t, y, wf, p, free)
+    sse = (r * r).sum(-1)
+    eye = np.eye(4)
+    for _ in range(int(iterations)):
+        jtj = np.einsum("nki,nkj->nij", jac, jac)
+        jtr = np.einsum("nki,nk->ni", jac, r)
+        diag = np.einsum("nii->ni", jtj)
+        scale = np.maximum(diag, 1e-12 * (diag.max(-1, keepdims=True) + 1e-30))
+        step = np.linalg.solve(jtj + lam[:, None, None] * scale[:, :, None] * eye + 1e-12 * eye,
+                               jtr[..., None])[..., 0] * free
+        trial = p + step
+        trial[:, 1] = np.clip(trial[:, 1], np.log(0.05 * interval_s), np.log(4.0 * span + interval_s))
+        r2, jac2, inside2 = _residual_and_jacobian(t, y, wf, trial, free)
+        sse2 = (r2 * r2).sum(-1)
+        good = np.isfinite(sse2) & (sse2 <= sse)
+        p[good], r[good], jac[good], inside[good], sse[good] = trial[good], r2[good], jac2[good], inside2[good], sse2[good]
+        lam = np.where(good, np.maximum(lam / 3.0, 1e-9), np.minimum(lam * 10.0, 1e9))
+    count = wf.sum(-1)
+    n_params = free.sum(-1)
+    jtj = np.einsum("nki,nkj->nij", jac, jac) + (1.0 - free)[:, :, None] * eye  # fixed: unit diagonal
+    pair = w[:, 1:] & w[:, :-1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rho = np.clip((r[:, 1:] * r[:, :-1] * pair).sum(-1) / np.maximum(sse, 1e-300), 0.0, 0.95)
+        cond_ok = np.linalg.cond(jtj) < 1e12
+        cov = np.linalg.pinv(jtj)
+        sigma = np.sqrt(np.maximum(sse / np.maximum(count - n_params, 1), 0.0) * cov[:, 0, 0]
+                        * (1.0 + rho) / (1.0 - rho))
+    n_inside = (inside & w).sum(-1)
+    sigma = np.where(cond_ok & (n_inside >= 2) & np.isfinite(sigma), sigma, np.inf)
+    duration = np.exp(p[:, 1])
+    centre = np.where(np.isfinite(c0), p[:, 0], np.nan)
+    resolved = (n_inside >= int(min_samples)) & np.isfinite(centre) & (count > n_params)
+    return {"centre_s": centre, "duration_s": duration, "lit": p[:, 2], "shadow": p[:, 3], "sigma_s": sigma,
+            "rms": np.sqrt(sse / np.maximum(count, 1)), "n_inside": n_inside, "resolved": resolved}
+
+
+def coherent_durations(duration_s, confident, *, radius=3):
+    """Median duration of each pixel's confident neighbours (the pixel included).
+
+    Parameters
+    ----------
+    duration_s : (H, W) ndarray
+        Fitted penumbra durations (s).
+    confident : (H, W) bool ndarray
+        Pixels whose fit is trusted (resolved, small uncertainty, not cut by the sequence end).
+    radius : int, keyword-only
+        Half size of the square neighbourhood (pixels).
+
+    Returns
+    -------
+    (H, W) float64 ndarray
+        NaN where the neighbourhood has no confident pixel.
+    """
+    duration = np.asarray(duration_s, dtype=np.float64)
+    confident = np.asarray(confident, dtype=bool)
+    if duration.ndim != 2 or confident.shape != duration.shape:
+        raise ValueError(f"duration_s {duration.shape} and confident {confident.shape} must be the same (H, W) shape")
+    if int(radius) < 0:
+        raise ValueError(f"radius must be >= 0; got {radius}")
+    r = int(radius)
+    values = np.where(confident & np.isfinite(duration) & (duration > 0), np.log(np.where(duration > 0, duration, 1.0)),
+                      np.nan).astype(np.float32)
+    padded = np.pad(values, r, constant_values=np.nan)
+    out = np.full(duration.shape, np.nan)
+    any_rows = np.nonzero(np.isfinite(values).any(axis=1))[0]
+    if any_rows.size == 0:
+        return out
+    lo, hi = max(0, any_rows[0] - r), min(duration.shape[0], any_rows[-1] + r + 1)
+    # row band by row band keeps the (rows, W, (2r+1)^2) window view small
+    for a in range(lo, hi, 256):
+        b = min(hi, a + 256)
+        view = np.lib.stride_tricks.sliding_window_view(padded[a:b + 2 * r], (2 * r + 1, 2 * r + 1))
+        flat = view.reshape(b - a, duration.shape[1], -1)
+        has = np.isfinite(flat).any(-1)
+        with np.errstate(all="ignore"):
+            med = np.nanmedian(np.where(has[..., None], flat, 0.0), axis=-1)
+        out[a:b] = np.where(has, np.exp(med), np.nan)
+    return out

@@ -1,0 +1,146 @@
+"""Each pixel's final descent: kept while streaming, fitted, with states and arrival reasons."""
+
+import numpy as np
+import pytest
+
+from shadowcam.outdoor.arrival import REASON_CODE, apply_ramps
+from shadowcam.outdoor.descent import STATE_CODE, DescentBuffer, fit_descents
+from shadowcam.outdoor.penumbra import ramp_model
+from shadowcam.outdoor.strips import edge_width, strip_halo
+
+INTERVAL = 5.0
+
+
+def _stream(series, *, frames=64):
+    """Feed (T, H, W) coverage through a buffer, dark below 0.5 from the first crossing on; return
+    the buffer and the crossing times (linear between frames)."""
+    series = np.asarray(series, dtype=np.float64)
+    times = np.arange(series.shape[0]) * INTERVAL
+    buffer = DescentBuffer(series.shape[1:], frames=frames)
+    crossing = np.full(series.shape[1:], np.nan)
+    dark = np.zeros(series.shape[1:], bool)
+    for k, cover in enumerate(series):
+        now = cover < 0.5
+        start = now & ~dark
+        if k and start.any():
+            prev = series[k - 1]
+            frac = (prev - 0.5) / np.where(prev != cover, prev - cover, 1.0)
+            crossing[start] = times[k - 1] + np.clip(frac, 0, 1)[start] * INTERVAL
+        crossing[~now] = np.nan
+        dark = now
+        buffer.update(cover, dark=dark)
+    return buffer, crossing, times
+
+
+def test_the_buffer_freezes_on_the_final_descent_and_restarts_after_a_passing_shadow():
+    t = np.arange(200)
+    cover = np.ones((200, 1, 2))
+    cover[20:25, 0, 1] = 0.2  # a passing cloud, then the final shadow at frame 150
+    cover[150:, 0, :] = 0.1
+    buffer = DescentBuffer((1, 2), frames=16)
+    for k in range(200):
+        buffer.update(cover[k], dark=cover[k] < 0.5)
+    values, frame = buffer.series(np.array([0, 0]), np.array([0, 1]))
+    # both hold the 8 frames before the crossing and the 8 from it on (frozen after)
+    for j in range(2):
+        np.testing.assert_array_equal(frame[j], t[142:158])
+        np.testing.assert_allclose(values[j], cover[142:158, 0, j], atol=1e-3)  # float16
+
+
+@pytest.mark.parametrize("duration", [10, 60])
+def test_fitted_descents_give_the_ramp_centre_and_short_ones_keep_the_crossing(duration):
+    rng = np.random.default_rng(2)
+    centre = rng.uniform(60, 70, (3, 8)) * INTERVAL
+    times = np.arange(160) * INTERVAL
+    series = ramp_model(times[:, None, None], centre_s=centre, duration_s=duration * INTERVAL, lit=1.0, shadow=0.05)
+    series = series + rng.normal(0, 0.02, series.shape)
+    buffer, crossing, times = _stream(series, frames=128)
+    out = fit_descents(buffer, crossing, times, max_sigma=1.0)
+    fitted = (out["ramp_state"] == STATE_CODE["fitted"]) | (out["ramp_state"] == STATE_CODE["neighbours_duration"])
+    assert fitted.all()
+    error = np.abs(out["ramp_centre_s"] - centre) / INTERVAL
+    assert np.median(error) <= (0.1 if duration == 10 else 0.3)
+    assert error.max() <= 1.5
+
+
+def test_a_one_frame_ramp_is_short_and_keeps_the_level_crossing():
+    rng = np.random.default_rng(3)
+    centre = rng.uniform(30, 40, (2, 6)) * INTERVAL
+    times = np.arange(80) * INTERVAL
+    series = ramp_model(times[:, None, None], centre_s=centre, duration_s=INTERVAL, lit=1.0, shadow=0.05)
+    buffer, crossing, times = _stream(series + rng.normal(0, 0.01, series.shape))
+    out = fit_descents(buffer, crossing, times)
+    assert (out["ramp_state"] == STATE_CODE["short"]).mean() >= 0.9
+    assert np.isnan(out["ramp_centre_s"][out["ramp_state"] == STATE_CODE["short"]]).all()
+    # the arrival keeps the crossing (the midpoint crossing of the old estimators) with its reason
+    reason = np.full(crossing.shape, REASON_CODE["coverage_crossing"], np.uint8)
+    arrival, new_reason = apply_ramps(crossing, reason, out["ramp_centre_s"], out["ramp_state"])
+    short = out["ramp_state"] == STATE_CODE["short"]
+    np.testing.assert_array_equal(arrival[short], crossing[short])
+    assert (new_reason[short] == REASON_CODE["coverage_crossing"]).all()
+    # the crossing of a one-frame ramp is the centre within a small part of an interval
+    assert np.median(np.abs(crossing - centre)) / INTERVAL < 0.15
+
+
+def test_a_ramp_cut_by_the_sequence_end_gets_a_reason_and_no_time():
+    rng = np.random.default_rng(5)
+    times = np.arange(100) * INTERVAL
+    centre = np.full((2, 7), 90.0 * INTERVAL)  # a 60-frame ramp centred 10 frames before the end
+    series = ramp_model(times[:, None, None], centre_s=centre, duration_s=60 * INTERVAL, lit=1.0, shadow=0.05)
+    buffer, crossing, times = _stream(series + rng.normal(0, 0.02, series.shape), frames=128)
+    out = fit_descents(buffer, crossing, times)
+    assert (out["ramp_state"] == STATE_CODE["cut"]).all()
+    assert np.isnan(out["ramp_centre_s"]).all()
+    reason = np.full(centre.shape, REASON_CODE["coverage_crossing"], np.uint8)
+    arrival, reason = apply_ramps(crossing, reason, out["ramp_centre_s"], out["ramp_state"])
+    assert np.isnan(arrival).all() and (reason == REASON_CODE["ramp_cut"]).all()
+
+
+def test_a_noisy_pixel_takes_its_neighbours_duration():
+    rng = np.random.default_rng(7)
+    times = np.arange(160) * INTERVAL
+    centre = rng.uniform(60, 70, (7, 7)) * INTERVAL
+    series = ramp_model(times[:, None, None], centre_s=centre, duration_s=40 * INTERVAL, lit=1.0, shadow=0.05)
+    noise = np.full((7, 7), 0.01)
+    noise[3, 3] = 0.25  # one very noisy pixel
+    series = series + rng.normal(0, 1, series.shape) * noise
+    buffer, crossing, times = _stream(series, frames=128)
+    out = fit_descents(buffer, crossing, times, max_sigma=1.0)
+    # refitted with the neighbours' duration, or left to the crossing / no time when still uncertain
+    assert out["ramp_state"][3, 3] in (STATE_CODE["neighbours_duration"], STATE_CODE["ambiguous"], STATE_CODE["short"])
+    if out["ramp_state"][3, 3] == STATE_CODE["neighbours_duration"]:
+        assert out["ramp_duration_s"][3, 3] / INTERVAL == pytest.approx(40, rel=0.1)
+    others = np.ones((7, 7), bool)
+    others[3, 3] = False
+    assert (out["ramp_state"][others] == STATE_CODE["fitted"]).all()
+
+
+def test_apply_ramps_labels_fitted_and_ambiguous_pixels():
+    arrival = np.array([[10.0, 20.0, 30.0, 40.0]])
+    reason = np.array([[REASON_CODE["edge_crossing"], REASON_CODE["coverage_crossing"],
+                        REASON_CODE["relit_after_arrival"], REASON_CODE["coverage_crossing"]]], np.uint8)
+    centre = np.array([[12.0, 22.0, 32.0, np.nan]])
+    state = np.array([[STATE_CODE["fitted"], STATE_CODE["neighbours_duration"], STATE_CODE["fitted"],
+                       STATE_CODE["ambiguous"]]], np.uint8)
+    out, codes = apply_ramps(arrival, reason, centre, state)
+    np.testing.assert_array_equal(out[0, :3], [12.0, 22.0, 30.0])  # a relit pixel's arrival is not the final descent
+    assert np.isnan(out[0, 3])
+    assert codes[0].tolist() == [REASON_CODE["penumbra_fit"], REASON_CODE["penumbra_fit"],
+                                 REASON_CODE["relit_after_arrival"], REASON_CODE["ambiguous_ramp"]]
+
+
+def test_the_edge_width_is_measured_and_widens_the_strip_halo():
+    rows, cols = 100, 4
+    r = np.arange(rows)[:, None] + 0.5
+    lit_frac = np.clip((60.0 - r) / 20.0 + 0.5, 0, 1) * np.ones((1, cols))  # a 20-row penumbra centred at row 60
+    shadow, lit = 0.1, 1.0
+    ref = shadow + (lit - shadow) * lit_frac
+    lit_at_start = lit_frac >= 0.5
+    width = edge_width(ref, lit_level=np.full(ref.shape, lit), shadow_level=np.full(ref.shape, shadow),
+                       lit_at_start=lit_at_start, sky=np.zeros(ref.shape, bool))
+    # the shadow-side half: rows with lit fraction in (0.1, 0.9) below the Otsu split, doubled
+    assert width == pytest.approx(16.0, abs=2.0)
+    shift = np.zeros((3, 2))
+    assert strip_halo(shift, edge_width_rows=width) == strip_halo(shift) + int(np.ceil(width))
+    with pytest.raises(ValueError, match="edge_width_rows"):
+        strip_halo(shift, edge_width_rows=-1.0)

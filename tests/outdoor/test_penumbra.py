@@ -1,0 +1,101 @@
+"""The disc-sun ramp: the circular-segment law, its per-pixel fit and the neighbours' duration."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, ramp_model, visible_fraction
+
+INTERVAL = 5.0
+TIMES = np.arange(128) * INTERVAL
+
+
+def test_visible_fraction_is_the_area_of_the_disc_beyond_a_straight_edge():
+    assert visible_fraction(-1.0) == 1.0 and visible_fraction(1.0) == 0.0
+    assert visible_fraction(0.0) == pytest.approx(0.5, abs=1e-15)
+    u = np.linspace(-1.5, 1.5, 31)
+    np.testing.assert_allclose(visible_fraction(u) + visible_fraction(-u), 1.0, atol=1e-12)
+    # area of the unit disc with x < -u (the edge at x = u occludes x > u ... mirrored), on a fine grid
+    grid = (np.arange(2000) + 0.5) / 1000 - 1.0
+    x, y = np.meshgrid(grid, grid)
+    inside = x * x + y * y <= 1.0
+    for edge in (-0.7, -0.2, 0.3, 0.8):
+        assert visible_fraction(edge) == pytest.approx((inside & (x < -edge)).sum() / inside.sum(), abs=2e-3)
+
+
+def _ramps(duration_intervals, n, *, noise, seed=0):
+    rng = np.random.default_rng(seed)
+    centre = rng.uniform(40.0, 80.0, n) * INTERVAL
+    clean = ramp_model(TIMES[None, :], centre_s=centre[:, None], duration_s=duration_intervals * INTERVAL,
+                       lit=1.0, shadow=0.1)
+    return centre, clean + rng.normal(0.0, noise, clean.shape)
+
+
+@pytest.mark.parametrize(("duration", "median_tol"), [(10, 0.1), (60, 0.3)])
+def test_noisy_ramps_of_10_and_60_frames_are_centred_within_tolerance(duration, median_tol):
+    centre, series = _ramps(duration, 300, noise=0.02)
+    # the start guess is a level crossing several intervals off (as on a penumbra of the real sun)
+    guess = centre + np.random.default_rng(1).normal(0.0, 5.0, centre.size) * INTERVAL
+    fit = fit_ramps(series, TIMES, centre_s=guess, interval_s=INTERVAL)
+    assert fit["resolved"].all()
+    error = np.abs(fit["centre_s"] - centre) / INTERVAL
+    assert np.median(error) <= median_tol  # intervals, noise 0.02 of a lit-shadow contrast of 0.9
+    assert np.percentile(error, 95) <= 3 * median_tol
+    # the standard error is honest: within 3 sigma for ~all pixels
+    assert np.mean(np.abs(fit["centre_s"] - centre) <= 3 * fit["sigma_s"]) >= 0.97
+    np.testing.assert_allclose(np.median(fit["duration_s"]) / INTERVAL, duration, rtol=0.05)
+
+
+def test_a_ramp_of_one_frame_is_not_resolved_by_the_law():
+    centre, series = _ramps(1, 300, noise=0.02)
+    fit = fit_ramps(series, TIMES, centre_s=centre, interval_s=INTERVAL)
+    # at most one or two samples inside the ramp: the caller keeps the level crossing
+    assert fit["resolved"].mean() < 0.05
+    assert (fit["n_inside"] <= 2).mean() > 0.95
+
+
+@settings(max_examples=40, deadline=None)
+@given(duration=st.floats(4.0, 80.0), phase=st.floats(0.0, 1.0), lit=st.floats(0.3, 2.0),
+       contrast=st.floats(0.2, 0.9))
+def test_noise_free_ramps_are_recovered_exactly_whatever_their_length_and_phase(duration, phase, lit, contrast):
+    centre = (64.0 + phase) * INTERVAL
+    shadow = lit * (1.0 - contrast)
+    series = ramp_model(TIMES, centre_s=centre, duration_s=duration * INTERVAL, lit=lit, shadow=shadow)[None]
+    fit = fit_ramps(series, TIMES, centre_s=np.array([centre + 4 * INTERVAL]), interval_s=INTERVAL)
+    assert fit["resolved"][0]
+    assert abs(fit["centre_s"][0] - centre) / INTERVAL <= 1e-3
+    assert fit["duration_s"][0] / INTERVAL == pytest.approx(duration, rel=1e-3)
+    assert fit["lit"][0] == pytest.approx(lit, rel=1e-3) and fit["shadow"][0] == pytest.approx(shadow, rel=1e-3)
+
+
+def test_a_known_duration_fits_only_the_centre_and_the_levels():
+    centre, series = _ramps(40, 50, noise=0.02, seed=4)
+    fit = fit_ramps(series, TIMES, centre_s=centre, interval_s=INTERVAL, duration_s=np.full(50, 40 * INTERVAL))
+    np.testing.assert_allclose(fit["duration_s"], 40 * INTERVAL, rtol=1e-12)
+    assert np.median(np.abs(fit["centre_s"] - centre)) / INTERVAL <= 0.25
+
+
+def test_fit_inputs_are_validated():
+    with pytest.raises(ValueError, match="series"):
+        fit_ramps(np.zeros(5), TIMES[:5], centre_s=np.zeros(1), interval_s=1.0)
+    with pytest.raises(ValueError, match="centre_s"):
+        fit_ramps(np.zeros((2, 5)), TIMES[:5], centre_s=np.zeros(3), interval_s=1.0)
+    with pytest.raises(ValueError, match="interval_s"):
+        fit_ramps(np.zeros((2, 5)), TIMES[:5], centre_s=np.zeros(2), interval_s=0.0)
+    with pytest.raises(ValueError, match="duration_s"):
+        ramp_model(TIMES, centre_s=0.0, duration_s=0.0, lit=1.0, shadow=0.0)
+
+
+def test_neighbours_duration_is_the_median_of_the_confident_ones():
+    duration = np.full((5, 6), 10.0)
+    duration[2, 3] = 1000.0  # an outlier
+    confident = np.ones((5, 6), bool)
+    confident[:, 0] = False
+    duration[:, 0] = np.nan
+    out = coherent_durations(duration, confident, radius=1)
+    assert out[2, 3] == pytest.approx(10.0)  # the median ignores one outlier in nine
+    assert out[0, 0] == pytest.approx(10.0)  # from the confident neighbours
+    assert np.isnan(coherent_durations(duration, np.zeros_like(confident), radius=1)).all()
+    with pytest.raises(ValueError, match="radius"):
+        coherent_durations(duration, confident, radius=-1)
