@@ -20,9 +20,11 @@ them into an image, neither of them last-write-wins splatting:
   cover a dual pixel their colours are averaged. Fully vectorised (triangles are expanded to candidate
   pixels of their bounding boxes, in bounded-memory chunks).
   With ``density=True`` each triangle's colour is weighted by the camera-pixel
-  density ``1 / |det d(u, v)/d(col, row)|`` and the triangles covering a dual pixel
-  are summed, not averaged (pixel-transport reciprocity, docs/methods.md): the
-  dual view of a camera behind a mirror or glass, whose branches add up.
+  density ``1 / |det d(u, v)/d(col, row)|`` (its Jacobian smoothed over the mesh,
+  `mesh_smoothed_areas`) and the triangles covering a dual pixel are summed, not
+  averaged (pixel-transport reciprocity, docs/methods.md): the dual image is the
+  reciprocal image, for a pinhole as for a camera behind a mirror or glass, whose
+  branches add up. The front function `dual_view_from_coords` carries it by default.
 * ``idw``: inverse-distance weighting of the ``k`` nearest camera samples
   within ``radius`` dual pixels (``scipy.spatial.cKDTree``).
 
@@ -32,6 +34,7 @@ Offers
 ------
 DUAL_VIEW_METHODS : name -> resampler, ``mesh`` and ``idw``.
 continuous_steps : camera-side test that a neighbour step does not straddle a discontinuity.
+mesh_smoothed_areas : triangle areas averaged over their mesh neighbourhood.
 dual_view_mesh : forward mesh warp.
 dual_view_idw : k-nearest inverse-distance weighting.
 resample_dual_view : dispatch through `DUAL_VIEW_METHODS` with input checks.
@@ -129,8 +132,43 @@ def continuous_steps(u, v, *, valid, step, max_edge=2.0, smooth_tol=2.0 / 3.0):
         return np.isfinite(length) & ((length <= max_edge) | (agree_all & any_neighbour))
 
 
+def mesh_smoothed_areas(triangles, areas, *, n_vertices, passes):
+    """Average triangle areas over their mesh neighbourhood, never across a missing triangle.
+
+    Each pass averages the areas of the triangles meeting at each vertex, then gives each
+    triangle the mean of its three vertices' averages: a diffusion over the kept mesh, so a
+    surface's neighbours on the other side of a silhouette (no triangle joins them) never
+    mix in. ``passes`` passes reach about ``passes`` camera pixels.
+
+    Parameters
+    ----------
+    triangles : (n, 3) int ndarray
+        Vertex indices of the kept triangles.
+    areas : (n,) float ndarray
+        Their absolute areas (dual pixels per camera triangle).
+    n_vertices : int
+    passes : int
+        0 returns `areas` unchanged.
+
+    Returns
+    -------
+    (n,) float64 ndarray
+    """
+    if int(passes) != passes or passes < 0:
+        raise ValueError(f"passes must be an integer >= 0; got {passes!r}")
+    smoothed = np.asarray(areas, dtype=np.float64)
+    if len(triangles) == 0:
+        return smoothed
+    flat = np.asarray(triangles).ravel()
+    count = np.maximum(np.bincount(flat, minlength=n_vertices), 1)
+    for _ in range(int(passes)):
+        per_vertex = np.bincount(flat, weights=np.repeat(smoothed, 3), minlength=n_vertices) / count
+        smoothed = per_vertex[triangles].mean(axis=1)
+    return smoothed
+
+
 def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 / 3.0, density=False,
-                   three_corners=False, eps=1e-9):
+                   density_passes=2, three_corners=False, eps=1e-9):
     """Forward mesh warp of camera colours into the dual grid.
 
     Parameters
@@ -157,6 +195,10 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
         The image is then the reciprocal image ``T^T 1`` of a uniform camera pattern
         (docs/methods.md) in camera-colour x camera-pixels-per-dual-pixel units. False:
         the colours are averaged (the scene's radiance seen from the light).
+    density_passes : int
+        Smoothing passes of the triangles' Jacobians before the density is taken
+        (:func:`mesh_smoothed_areas`): a Jacobian differenced from noisy dual coordinates is
+        noisy, and its inverse more so; the smoothing stays on the surface.
     three_corners : bool
         Also draw the triangle of a quad's three timed pixels when its untimed one lies on
         the fixed diagonal (top-right or bottom-left), where neither fixed triangle exists;
@@ -201,7 +243,10 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     bw, bh = i1 - i0 + 1, j1 - j0 + 1
     keep &= (bw > 0) & (bh > 0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        weight = 1.0 / np.abs(det) if density else np.ones(len(det))
+        weight = np.ones(len(det))
+        if density:
+            weight[keep] = 1.0 / mesh_smoothed_areas(tri[keep], np.abs(det[keep]), n_vertices=rows * cols,
+                                                     passes=density_passes)
         # inward gradients of the barycentrics l1, l2, l0 (dual px^-1): an edge owns the
         # centres on it when its gradient points to +u (or +v when along u)
         grads = [(e2v / det, -e2u / det), (-e1v / det, e1u / det)]
@@ -450,9 +495,10 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     min_coverage : float
         Smallest fraction of the dual pixels that must receive a colour.
     density : bool, optional
-        Carry the camera-pixel density (``dual_view_mesh(density=True)``). Default: when
-        the coordinates' camera has optics on its primal path (attr ``optics`` of `coords`,
-        set by ``cameras.models.capture_dual_coords``) and `method` is ``mesh``.
+        Carry the camera-pixel density (``dual_view_mesh(density=True)``): the dual image
+        is then the reciprocal image (pixel-transport reciprocity). Default: when `method`
+        is ``mesh``; False gives the camera colours averaged (the scene's radiance under
+        the primal light, placed on the dual grid).
     **params
         Method options.
 
@@ -473,7 +519,7 @@ def dual_view_from_coords(coords, shadow_time, *, reference=None, method="mesh",
     check_in_interval(min_coverage, "min_coverage", 0.0, 1.0, closed="both")
     optics = str(coords.attrs.get("optics", "none"))
     if density is None:
-        density = optics != "none" and method == "mesh"
+        density = method == "mesh"
     elif density and method != "mesh":
         raise ValueError(f"density: the camera-pixel density is carried by the mesh warp only, not by "
                          f"method {method!r}; set dual_view.method: mesh or drop dual_view.params.density")

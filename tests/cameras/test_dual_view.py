@@ -189,10 +189,16 @@ def test_front_function_resamples_the_reference_colours_into_the_dual_grid():
                         attrs={"dual_height": 12, "dual_width": 16, "model": "uniform"})
     reference = xr.Dataset({"image": (("time", "row", "col", "channel"), np.stack([colours, colours]))})
     shadow_time = xr.Dataset(coords={"sweep": ["u", "v"], "channel": ["R", "G", "B"]})
-    dataset = dual_view_from_coords(coords, shadow_time, reference=reference)
+    dataset = dual_view_from_coords(coords, shadow_time, reference=reference, density=False)
     # identity coordinates: the dual view is the camera image
     np.testing.assert_allclose(dataset["dual_view"].values, colours, atol=1e-6)
     assert dataset["coverage"].values.all()
+    # with the density (the default): one camera pixel per dual pixel, the same image; the
+    # centres on the grid's last row and column belong to no triangle (top-left rule)
+    dense = dual_view_from_coords(coords, shadow_time, reference=reference)
+    cov = dense["coverage"].values
+    assert cov[:-1, :-1].all() and not cov[-1].any() and not cov[:, -1].any()
+    np.testing.assert_allclose(dense["dual_view"].values[cov], colours[cov], atol=1e-6)
     assert dataset.attrs["colour_source"] == "reference" and dataset.attrs["dual_coords_model"] == "uniform"
     with pytest.raises(ValueError, match="params"):
         dual_view_from_coords(coords, shadow_time, reference=reference, no_such_option=1)
@@ -422,9 +428,9 @@ def test_three_corners_leaves_only_the_triangles_of_the_untimed_pixel(density):
                                rtol=1e-6)
 
 
-def test_front_function_carries_the_density_for_a_camera_with_optics():
-    # coordinates of a camera with optics (attr `optics`, set by capture_dual_coords) get the
-    # density by default; explicit density=False gives the colours; no optics: the colours
+def test_front_function_carries_the_density_by_default():
+    # the mesh carries the density for every camera (pixel-transport reciprocity); explicit
+    # density=False gives the colours; the optics attribute does not change the choice
     from shadowcam.cameras.dual_view import dual_view_from_coords
     from shadowcam.cameras.models import capture_dual_coords
 
@@ -441,9 +447,10 @@ def test_front_function_carries_the_density_for_a_camera_with_optics():
     colour = dual_view_from_coords(mirror, shadow_time, reference=reference, density=False)
     cov = dense["coverage"].values
     np.testing.assert_allclose(dense["dual_view"].values[cov], 0.6 / 4, rtol=1e-6)  # 1/4 px per dual px
-    np.testing.assert_allclose(colour["dual_view"].values[cov], 0.6, rtol=1e-6)
-    np.testing.assert_array_equal(plain["dual_view"].values, colour["dual_view"].values)
-    assert "camera_pixel_density" in dense.attrs and "camera_pixel_density" not in plain.attrs
+    np.testing.assert_allclose(colour["dual_view"].values[colour["coverage"].values], 0.6, rtol=1e-6)
+    np.testing.assert_array_equal(plain["dual_view"].values, dense["dual_view"].values)
+    assert "camera_pixel_density" in dense.attrs and "camera_pixel_density" in plain.attrs
+    assert "camera_pixel_density" not in colour.attrs
     # the dual-coords front function marks a description with optics, and only that one
     st = xr.Dataset({"shadow_time": (("sweep", "row", "col"), np.stack([cols, rows]))},
                     coords={"sweep": ["u", "v"]}, attrs={"n_frames_u": 16, "n_frames_v": 12})
@@ -453,3 +460,38 @@ def test_front_function_carries_the_density_for_a_camera_with_optics():
     assert found.attrs["optics"] == "glass"
     assert "optics" not in capture_dual_coords(st, {**description, "optics": "none"},
                                                camera_model="perspective").attrs
+
+
+def test_mesh_smoothing_of_the_density_stays_on_the_surface():
+    from shadowcam.cameras.dual_view import mesh_smoothed_areas
+
+    # two strips of triangles that share no vertex: a silhouette between them
+    left = np.array([[0, 1, 2], [1, 3, 2], [2, 3, 4], [3, 5, 4]])
+    right = left + 6
+    triangles = np.concatenate([left, right])
+    areas = np.array([1.0, 1.2, 0.8, 1.0, 9.0, 9.0, 9.0, 9.0])
+    smoothed = mesh_smoothed_areas(triangles, areas, n_vertices=12, passes=3)
+    np.testing.assert_allclose(smoothed[4:], 9.0)  # the far surface's areas are untouched
+    assert smoothed[:4].max() - smoothed[:4].min() < areas[:4].max() - areas[:4].min()
+    assert np.all((smoothed[:4] > 0.8) & (smoothed[:4] < 1.2))
+    np.testing.assert_array_equal(mesh_smoothed_areas(triangles, areas, n_vertices=12, passes=0), areas)
+    with pytest.raises(ValueError, match="passes"):
+        mesh_smoothed_areas(triangles, areas, n_vertices=12, passes=-1)
+
+
+def test_smoothed_density_halves_the_noise_of_noisy_coordinates():
+    # an affine camera -> dual map with 0.15 dual px of coordinate noise: the density of a
+    # uniform colour is 1/4 camera px per dual px; the smoothed Jacobian's density is closer
+    rng = np.random.default_rng(3)
+    rows, cols = np.mgrid[0:40, 0:40].astype(np.float64)
+    u = 2.0 * cols + rng.normal(0, 0.15, cols.shape) + 2
+    v = 2.0 * rows + rng.normal(0, 0.15, rows.shape) + 2
+    colours = np.ones(rows.shape + (1,), np.float32)
+    errors = {}
+    for passes in (0, 2):
+        img, cov = resample_dual_view(colours, u, v, shape=(84, 84), method="mesh", density=True,
+                                      density_passes=passes)
+        inner = cov.copy()
+        inner[:8], inner[-8:], inner[:, :8], inner[:, -8:] = False, False, False, False
+        errors[passes] = np.sqrt(np.mean((img[inner, 0] / 0.25 - 1) ** 2))
+    assert errors[2] < 0.5 * errors[0], errors

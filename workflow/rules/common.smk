@@ -193,14 +193,11 @@ def get_dual_coords_params(wildcards):
 
 
 def get_dual_view_params(wildcards):
-    """JSON ``--params`` of ``shadowcam dual-view``: config section ``dual_view.params``;
-    the mesh carries the camera-pixel density when the camera has optics (unless set).
-    """
-    options = dict(config["dual_view"]["params"], min_coverage=config["min_coverage"])
-    optics = capture(wildcards.ds).camera.get("optics", "none")
-    if optics != "none" and config["dual_view"]["method"] == "mesh":
-        options.setdefault("density", True)
-    return as_json(options)
+    """JSON ``--params`` of ``shadowcam dual-view``: config section ``dual_view.params``
+    (the mesh carries the camera-pixel density unless ``density: false``)."""
+    return as_json(
+        dict(config["dual_view"]["params"], min_coverage=config["min_coverage"])
+    )
 
 
 def get_evaluate_params(wildcards):
