@@ -674,13 +674,17 @@ def interval_errors(shadow_time, ground_truth, *, sweeps=("u", "v")):
     ground_truth : xarray.Dataset
         ``lit`` and, per sweep, ``interval_entry_<sweep>``, ``interval_exit_<sweep>``
         (row, col): the half-depth crossings the tracker measures (the rendered capture
-        of an area light, ``synthetic.lab.render``).
+        of an area light, ``synthetic.lab.render``), and ``penumbra_first_<sweep>``,
+        ``penumbra_last_<sweep>`` when it has them (the dip's outer edges).
     sweeps : sequence of str, keyword-only
 
     Returns
     -------
     dict
-        Per sweep with truth: ``n_truth`` (lit pixels with a whole interval in the sweep),
+        Per sweep with truth: ``n_truth`` (lit pixels whose whole dip, from the penumbra's
+        first to its last frame, or the half-depth interval without them, lies within the
+        sweep's frames ``0 .. shadow_time.attrs["n_frames_<sweep>"] - 1``: only those have
+        a measurable entry and exit),
         ``coverage`` (their share with an estimated interval), and ``entry``, ``centre``,
         ``exit``: median, p95, RMSE, max of the absolute error in frames.
     """
@@ -697,7 +701,14 @@ def interval_errors(shadow_time, ground_truth, *, sweeps=("u", "v")):
         true_entry, true_exit = (ground_truth[k].transpose("row", "col").values.astype(np.float64) for k in keys)
         entry, exit_ = (shadow_time[k].sel(sweep=sweep).transpose("row", "col").values.astype(np.float64)
                         for k in ("interval_entry", "interval_exit"))
-        truth = lit & np.isfinite(true_entry) & np.isfinite(true_exit)
+        first, last = true_entry, true_exit
+        if f"penumbra_first_{sweep}" in ground_truth and f"penumbra_last_{sweep}" in ground_truth:
+            first, last = (ground_truth[f"penumbra_{k}_{sweep}"].transpose("row", "col").values.astype(np.float64)
+                           for k in ("first", "last"))
+        n_frames = shadow_time.attrs.get(f"n_frames_{sweep}", np.inf)
+        with np.errstate(invalid="ignore"):
+            inside = (first >= 0) & (last <= float(n_frames) - 1)
+        truth = lit & np.isfinite(true_entry) & np.isfinite(true_exit) & inside
         found = truth & np.isfinite(entry) & np.isfinite(exit_)
         out[sweep] = {
             "n_truth": int(truth.sum()),

@@ -46,6 +46,22 @@ def test_interval_errors_are_the_offsets_and_missing_pixels_lower_the_coverage()
     assert v["coverage"] == 1.0 and v["entry"]["max"] == v["centre"]["max"] == v["exit"]["max"] == 0.0
 
 
+def test_only_dips_whole_within_the_sweep_are_counted():
+    # a dip whose penumbra starts before frame 0 or ends after the last frame has no
+    # measurable entry or exit: it is not part of the truth
+    truth = _truth(np.random.default_rng(5))
+    for sweep in ("u", "v"):
+        truth[f"penumbra_first_{sweep}"] = truth[f"interval_entry_{sweep}"] - 3.0
+        truth[f"penumbra_last_{sweep}"] = truth[f"interval_exit_{sweep}"] + 3.0
+    entry = np.stack([truth["interval_entry_u"].values] * 2)
+    shadow_time = _shadow_time(entry, entry + 8.0).assign_attrs(n_frames_u=30, n_frames_v=1000)
+    first = truth["penumbra_first_u"].values
+    last = truth["penumbra_last_u"].values
+    report = interval_errors(shadow_time, truth)
+    assert report["u"]["n_truth"] == int(((first >= 0) & (last <= 29)).sum()) < ROWS * COLS
+    assert report["v"]["n_truth"] == int((first >= 0).sum())
+
+
 def test_interval_errors_need_the_interval_pass():
     truth = _truth(np.random.default_rng(1))
     with pytest.raises(ValueError, match="interval_entry"):
