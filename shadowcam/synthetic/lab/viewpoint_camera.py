@@ -79,21 +79,10 @@ class ViewpointCamera:
         return np.cross(d, line)
 
     def rays(self, x, y):
-        """Viewing rays through pixel-edge coordinates.
-
-        Parameters
-        ----------
-        x, y : (N,) ndarray
-            Pixel-edge coordinates (column, row).
-
-        Returns
-        -------
-        origins, directions : (N, 3) ndarray
-            The source point and unit directions into the scene (NaN where the planes are
-            parallel or the wire's edge would hide the source itself).
-        """
-        x = np.asarray(x, dtype=np.float64).ravel()
-        y = np.asarray(y, dtype=np.float64).ravel()
+        """(N, 3) origins (the source) and unit directions into the scene of the rays through
+        (N,) pixel-edge coordinates `x`, `y` (column, row); NaN where the two planes are
+        parallel or the wire's edge would cover the source itself."""
+        x, y = (np.asarray(c, dtype=np.float64).ravel() for c in (x, y))
         if x.shape != y.shape:
             raise ValueError(f"x, y: shapes differ ({x.shape} vs {y.shape})")
         direction = np.cross(self._planes(self.sweep_a, x - 0.5), self._planes(self.sweep_b, y - 0.5))
