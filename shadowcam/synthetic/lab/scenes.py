@@ -145,8 +145,9 @@ SCENES = {"tabletop": _tabletop, "tabletop_squares": _tabletop_squares, "panels"
 def _area_light(light, area_light):
     """The scene's area light with the shape, size and samples of `area_light` (a mapping)."""
     if not isinstance(light, AreaLight):
-        raise ValueError("area_light: describes an area light; set the light to 'area' or drop "
-                         "the key")
+        raise ValueError(f"area_light: describes an area light, but the scene's light is a "
+                         f"{type(light).__name__}; set the light to 'area' (a manifest's top-level "
+                         f"`light: area`) or drop the key")
     if not hasattr(area_light, "get"):
         raise ValueError(f"area_light: expected a mapping with shape, size, samples; got {area_light!r}")
     unknown = set(area_light) - set(AREA_LIGHT_KEYS)
