@@ -114,11 +114,13 @@ def test_viewpoint_camera_refuses_bad_arguments(wide_scene):
         viewpoint_camera(wide_scene.sweeps, ("u", "v"), [0.0, 1.0], 0.5, wide_scene.mask)
 
 
-def test_area_light_capture_carries_interval_truth_and_viewpoint_renders():
+@pytest.mark.parametrize("shape", ["disc", "sphere"])
+def test_area_light_capture_carries_interval_truth_and_viewpoint_renders(shape):
     from shadowcam.synthetic.lab.area_truth import area_light_times
     from shadowcam.synthetic.lab.render import prepare_capture
 
-    scene = make_scene("tabletop", height=16, width=16, frames=24, light_kind="area", wire_radius_frames=3)
+    scene = make_scene("tabletop", height=16, width=16, frames=24, light_kind="area", wire_radius_frames=3,
+                       area_light={"shape": shape, "samples": 3})
     gt = prepare_capture(scene, supersample=1, calibration=False).ground_truth
     points = gt["P"].values.reshape(-1, 3).astype(np.float64)
     entry, exit_ = area_light_times(points, scene.sweeps["v"], scene.mask, scene.light, fraction=0.5)
