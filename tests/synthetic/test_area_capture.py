@@ -32,7 +32,7 @@ def test_description_keys_set_the_wire_radius_and_the_area_light():
 @pytest.mark.parametrize("keys, message", [
     ({"wire_radius_frames": 0}, "wire_radius_frames"),
     ({"wire_radius_frames": float("nan")}, "wire_radius_frames"),
-    ({"area_light": {"shape": "tube"}}, "area_light.shape"),
+    ({"area_light": {"shape": "strip"}}, "area_light.shape"),
     ({"area_light": {"size": -1.0}}, "area_light.size"),
     ({"area_light": {"samples": 0}}, "area_light.samples"),
     ({"area_light": {"samples": 2.5}}, "area_light.samples"),
@@ -57,6 +57,26 @@ def test_sphere_samples_project_to_a_uniform_disc_along_any_direction(k, directi
     assert np.all(np.linalg.norm(positions, axis=1) <= 1.0 + 1e-12)
     assert np.abs(flat.mean(axis=0)).max() < 0.05
     assert np.mean(np.sum(flat**2, axis=1)) == pytest.approx(0.5, abs=0.6 / k**2)
+
+
+def test_a_tube_spans_the_u_sweep_and_is_a_point_to_the_v_sweep():
+    # a tube along e_u: the u sweep's dip spreads over the tube's projection (penumbra as long
+    # as the tube seen through the mask), the v sweep's stays a point light's
+    from shadowcam.synthetic.lab.area_truth import area_light_times
+
+    scene = make_scene("tabletop", height=16, width=16, frames=48, light_kind="area", wire_radius_frames=3,
+                       area_light={"shape": "tube", "size": 0.006, "samples": 3})
+    positions = light_samples(scene.light)[0]
+    along = (positions - scene.light.center) @ scene.mask.e_u
+    np.testing.assert_allclose(along.max() - along.min(), 0.006 * (1 - 1 / 9), rtol=1e-9)
+    np.testing.assert_allclose((positions - scene.light.center) @ scene.mask.e_v, 0.0, atol=1e-12)
+    points = _points()
+    spread = {}
+    for name in ("u", "v"):
+        first, _ = area_light_times(points, scene.sweeps[name], scene.mask, scene.light, fraction=0.0)
+        inner, _ = area_light_times(points, scene.sweeps[name], scene.mask, scene.light, fraction=1.0)
+        spread[name] = np.nanmedian(inner - first)
+    assert spread["u"] > 1.0 and spread["v"] < 1e-6
 
 
 @pytest.fixture(scope="module")

@@ -311,17 +311,19 @@ class DistantLight:
 
 
 #: shapes of an area light
-AREA_SHAPES = ("disc", "square", "sphere")
+AREA_SHAPES = ("disc", "square", "sphere", "tube")
 
 
 @dataclass(frozen=True, eq=False)
 class AreaLight:
-    """Small isotropic area light: a disc or square perpendicular to `normal`, or a sphere.
+    """Small isotropic area light: a disc or square perpendicular to `normal`, a sphere, or a
+    tube (a uniform line source) along the first axis of the plane perpendicular to `normal`
+    (``normal x up``: the mask plane's e_u when the mask faces the same way).
 
-    `size` is the disc's or sphere's diameter, the square's side. Sampled with a fixed
-    stratified pattern of point lights that share `intensity` (3,) (total radiant intensity,
-    W/sr): ``samples_per_side**2`` for a disc or square, ``samples_per_side**3`` for a
-    sphere (see :func:`light_samples`).
+    `size` is the disc's or sphere's diameter, the square's side, the tube's length. Sampled
+    with a fixed stratified pattern of point lights that share `intensity` (3,) (total radiant
+    intensity, W/sr): ``samples_per_side**2`` for a disc, square or tube,
+    ``samples_per_side**3`` for a sphere (see :func:`light_samples`).
     """
 
     position: np.ndarray
@@ -420,6 +422,8 @@ def light_samples(light):
             r = 0.5 * light.size * np.sqrt(a)
             phi = 2 * np.pi * b
             x, y = r * np.cos(phi), r * np.sin(phi)
+        elif light.shape == "tube":  # k*k strata along e1 (the mask's e_u for the presets)
+            x, y = ((np.arange(k * k) + 0.5) / (k * k) - 0.5) * light.size, np.zeros(k * k)
         else:
             x, y = (a - 0.5) * light.size, (b - 0.5) * light.size
         pos = light.position + x[:, None] * e1 + y[:, None] * e2

@@ -163,8 +163,9 @@ def _area_light(light, area_light):
 
 
 #: keys of a scene's ``area_light`` description -> meaning
-AREA_LIGHT_KEYS = {"shape": "disc, square or sphere (AREA_SHAPES)",
-                   "size": "diameter of the disc or sphere, side of the square (scene units)",
+AREA_LIGHT_KEYS = {"shape": "disc, square, sphere or tube (AREA_SHAPES)",
+                   "size": "diameter of the disc or sphere, side of the square, length of the tube "
+                           "(scene units)",
                    "samples": "samples per side (k**2 point lights; k**3 for a sphere)"}
 
 
@@ -211,8 +212,9 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
         wider than the source seen through it casts an umbra between two penumbrae.
         None = one mask step (a dip about two frames wide).
     area_light : dict, optional
-        With ``light_kind="area"``: ``shape`` ({"disc", "square", "sphere"}), ``size``
-        (diameter of the disc or sphere, side of the square) and ``samples`` (per side);
+        With ``light_kind="area"``: ``shape`` ({"disc", "square", "sphere", "tube"}; a tube
+        lies along the mask plane's e_u), ``size`` (diameter of the disc or sphere, side of
+        the square, length of the tube) and ``samples`` (per side);
         omitted keys keep the preset's disc of diameter 0.006 with 4 samples per side.
 
     Returns
