@@ -155,3 +155,27 @@ def test_area_light_capture_carries_interval_truth_and_viewpoint_renders(shape):
     point = make_scene("tabletop", height=16, width=16, frames=24, light_kind="point")
     assert not any(k.startswith("reciprocal_") for k in prepare_capture(point, supersample=1,
                                                                         calibration=False).ground_truth)
+
+
+def test_extreme_point_views_give_the_penumbras_outer_edges():
+    # the corner of the disc samples' bounding box, through the leading edges, is the view
+    # whose times are the first sample's blocking in both sweeps (area_truth at fraction 0);
+    # the opposite corner through the trailing edges the last sample's freeing
+    from shadowcam.synthetic.lab.area_truth import area_light_times
+    from shadowcam.synthetic.lab.render import _extreme_point_views
+
+    scene = make_scene("tabletop", height=16, width=16, frames=48, light_kind="area", wire_radius_frames=4)
+    views = _extreme_point_views(scene)
+    points = _points()
+    for name, pick in (("penumbra_first", 0), ("penumbra_last", 1)):
+        source, fraction, _ = views[name]
+        xy, _ = viewpoint_camera(scene.sweeps, ("u", "v"), source, fraction, scene.mask).project(points)
+        for column, sweep in enumerate(("u", "v")):
+            truth = area_light_times(points, scene.sweeps[sweep], scene.mask, scene.light, fraction=0.0)[pick]
+            np.testing.assert_allclose(xy[:, column] - 0.5, truth, atol=1e-9)
+    # sampled finely, the disc's corner lies off the disc, farther from the centre than any
+    # sample (with 4 x 4 samples, which lie on the diagonals, it is the sample at 225 deg)
+    fine = make_scene("tabletop", height=16, width=16, frames=48, light_kind="area", area_light={"samples": 12})
+    corner = _extreme_point_views(fine)["penumbra_first"][0]
+    radius = np.linalg.norm(light_samples(fine.light)[0] - fine.light.center, axis=1).max()
+    assert np.linalg.norm(corner - fine.light.center) == pytest.approx(np.sqrt(2) * radius * np.cos(np.radians(15)))

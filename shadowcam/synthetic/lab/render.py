@@ -629,7 +629,8 @@ def _edge_point_truth(scene):
 
 def _area_light_truth(scene, points, supersample):
     """GT variables of the dip interval under an area light (``interval_*``, ``penumbra_*``
-    per sweep; ``reciprocal_<viewpoint>`` per viewpoint of ``lab.viewpoints.VIEWPOINTS``).
+    per sweep; ``reciprocal_<viewpoint>`` per viewpoint of ``lab.viewpoints.VIEWPOINTS`` and
+    for the penumbra's outer edges, ``_extreme_point_views``).
 
     The tracker's entry and exit are the dip's half-depth crossings; through a wire wider
     than the source (an umbra) they are the times half the source's weight is blocked
@@ -662,17 +663,44 @@ def _area_light_truth(scene, points, supersample):
                 ("penumbra_last", outer[1], "last source point freed (the source's other extreme point)")):
             data[f"{key}_{name}"] = (rc, times.reshape(points.shape[:2]).astype(f32), "frame",
                                      f"sweep {name}: {what}")
-    for viewpoint, fraction in VIEWPOINTS.items():
-        dual = viewpoint_camera(scene.sweeps, names, light.center, fraction, scene.mask)
+    views = {name: (light.center, fraction, f"the light's centre with the wires' lines at fraction "
+                                             f"{fraction} across their width")
+             for name, fraction in VIEWPOINTS.items()}
+    views.update(_extreme_point_views(scene))
+    for viewpoint, (source, fraction, what) in views.items():
+        dual = viewpoint_camera(scene.sweeps, names, source, fraction, scene.mask)
         recip = render_reciprocal(scene.objects, scene.camera, light, scene.mask,
                                   supersample=supersample, dual=dual)
-        data[f"reciprocal_{viewpoint}"] = (
-            vu + ("channel",), recip["reciprocal"], "radiance",
-            f"reciprocal render of viewpoint {viewpoint}: from the light's centre with the "
-            f"wires' lines at fraction {fraction} across their width, the camera as a light")
+        data[f"reciprocal_{viewpoint}"] = (vu + ("channel",), recip["reciprocal"], "radiance",
+                                           f"reciprocal render of viewpoint {viewpoint}: from {what}, "
+                                           "the camera as a light")
         data[f"dual_cam_visible_{viewpoint}"] = (vu, recip["dual_cam_visible"], "1",
                                                  f"dual point of viewpoint {viewpoint} seen by the camera")
     return data
+
+
+def _extreme_point_views(scene):
+    """The views of the penumbra's outer edges: from the source's extreme points.
+
+    The wire of sweep u moves along e_u, so it first blocks the source point of least e_u
+    coordinate and last frees the one of greatest; likewise along e_v. With the light's
+    plane parallel to the mask plane a point's u time depends on its e_u coordinate alone,
+    so the corner (least u, least v) of the samples' bounding box, seen through the wires'
+    leading edges, has both sweeps' first times (``penumbra_first``; a corner of the
+    bounding square for a disc, off the disc itself), the opposite corner through the
+    trailing edges their last times (``penumbra_last``). None when the planes are not
+    parallel.
+    """
+    mask, light = scene.mask, scene.light
+    positions = light_samples(light)[0]
+    if abs(abs(mask.normal @ light.normal) - 1.0) > 1e-9 or scene.sweeps["u"].velocity @ mask.e_u <= 0 \
+            or scene.sweeps["v"].velocity @ mask.e_v <= 0:
+        return {}
+    u, v = (positions - light.center) @ mask.e_u, (positions - light.center) @ mask.e_v
+    return {"penumbra_first": (light.center + u.min() * mask.e_u + v.min() * mask.e_v, 0.0,
+                               "the samples' bounding-box corner the wires reach first, through their leading edges"),
+            "penumbra_last": (light.center + u.max() * mask.e_u + v.max() * mask.e_v, 1.0,
+                              "the samples' bounding-box corner the wires leave last, through their trailing edges")}
 
 
 def _light_attrs(light):
