@@ -7,7 +7,7 @@ import pytest
 
 DS = "synthetic_area"
 VIEWPOINTS = ("entry", "centre", "exit")
-pytestmark = pytest.mark.slow  # renders and runs the lab DAG (~75 s on 2 shared cores)
+pytestmark = pytest.mark.slow  # renders and runs the lab DAG: 63 s on 2 cores, 100 s at load 5-6
 
 
 def test_area_capture_viewpoints_match_their_reciprocal_renders(tmp_path, workflow_copy, snakemake):
