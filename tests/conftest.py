@@ -39,7 +39,7 @@ REPO = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 WORKFLOW_FILES = ("Snakefile", "workflow", "config", "profiles")
 SYNTHETIC_MANIFESTS = ("synthetic_tiny.yaml", "synthetic_lab.yaml", "synthetic_array.yaml",
-                       "synthetic_lights.yaml")
+                       "synthetic_lights.yaml", "synthetic_area.yaml")
 
 
 # --------------------------------------------------------------------------- paths

@@ -37,6 +37,9 @@ def add_parser(subparsers, name):
     parser.add_argument("--dual-view", default=None, help="results/<ds>/dual_view.nc")
     parser.add_argument("--pushbroom", default=None, help="results/<ds>/pushbroom.nc (single-sweep lab capture)")
     parser.add_argument("--reference", default=None, help="reference frame store the pushbroom was coloured with")
+    parser.add_argument("--viewpoint", nargs=4, action="append", default=[],
+                        metavar=("NAME", "SHADOW_TIME", "DUAL_COORDS", "DUAL_VIEW"),
+                        help="a viewpoint's products (results/<ds>/viewpoints/<name>/*.nc); repeatable")
     parser.add_argument("--params", default="{}", help='JSON: {"noise": "noise_free" | "raw12"}')
     parser.add_argument("--out-json", required=True, help="results/<ds>/accuracy.json")
     parser.add_argument("--out-csv", required=True, help="results/<ds>/accuracy.csv")
@@ -52,7 +55,9 @@ def run(args):
     from shadowcam.io.ground_truth import load_ground_truth
     from shadowcam.io.manifest import load_manifest
     from shadowcam.io.provenance import file_sha256
-    from shadowcam.lab.accuracy import accuracy_report, noise_condition, report_to_csv, report_to_json
+    from shadowcam.lab.accuracy import (
+        accuracy_report, add_interval_checks, noise_condition, report_to_csv, report_to_json,
+    )
 
     params = parse_params(args.params, allowed={"noise"})
     manifest = load_manifest(args.manifest)
@@ -68,6 +73,8 @@ def run(args):
         add_camera_checks(report, open_dataset(args.shadow_time), gt, camera_model=plan.camera_model,
                           description=plan.camera,
                           dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None)
+    add_interval_checks(report, open_dataset(args.shadow_time), gt,
+                        viewpoints={name: tuple(open_dataset(p) for p in paths) for name, *paths in args.viewpoint})
     report.update(noise_source=source, dataset=manifest["name"],
                   inputs={str(p): file_sha256(p) for p in (args.shadow_time, args.dual_coords, args.dual_view, args.pushbroom) if p},
                   ground_truth_sha256=gt.attrs.get("source_sha256", ""))

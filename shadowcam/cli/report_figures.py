@@ -36,6 +36,9 @@ def add_parser(subparsers, name):
     parser.add_argument("--dual-coords", help="dual_coords.nc (grid and model choice of the dual view), optional")
     parser.add_argument("--reference", help="reference frame store (reference.zarr), optional")
     parser.add_argument("--accuracy", help="accuracy.csv to show as a table, optional")
+    parser.add_argument("--viewpoint", nargs=4, action="append", default=[],
+                        metavar=("NAME", "SHADOW_TIME", "DUAL_COORDS", "DUAL_VIEW"),
+                        help="a viewpoint's products (results/<ds>/viewpoints/<name>/*.nc), drawn in viewpoints.png; repeatable")
     parser.add_argument("--outdir", required=True, help="output directory (created)")
     return parser
 
@@ -61,5 +64,7 @@ def run(args):
                                    dual_view=open_dataset(args.dual_view), truth=truth,
                                    dual_coords=open_dataset(args.dual_coords) if args.dual_coords else None,
                                    reference=reference, accuracy_csv=args.accuracy,
-                                   camera_kind=capture_plan(args.manifest).camera_model)
+                                   camera_kind=capture_plan(args.manifest).camera_model,
+                                   viewpoints={name: (open_dataset(view), open_dataset(coords))
+                                               for name, _, coords, view in args.viewpoint})
     LOG.info("wrote %s", ", ".join(written))

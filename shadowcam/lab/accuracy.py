@@ -19,6 +19,9 @@ Metrics (synthetic data with exact ground truth, docs/contracts.md form):
 * shadow pushbroom (one sweep) against the same assembly applied to the GT shadow
   times and the same colour source, after ONE least-squares gain: relative RMSE over
   the cells both have, and coverage = fraction of the GT cells the estimate has.
+* dip interval (a wide wire under an area light), per sweep: absolute error of the
+  entry, centre and exit against the exact half-depth crossings, and coverage; each
+  viewpoint's dual view against its own reciprocal render, as the main dual view.
 Targets (foundation issue) are checked and reported pass/fail.
 
 Offers
@@ -36,6 +39,8 @@ flatten_report : the report as ``(key, value)`` rows.
 TABLE_ROWS, TARGET_KEYS, GROUND_TRUTH_DEFINITION : what the accuracy table shows.
 accuracy_table : the report as one row per quantity (value, unit, target, pass).
 report_to_json, report_to_csv : serialise a report to text (JSON whole, CSV as the table).
+interval_errors : errors and coverage of the dip interval's entry, centre and exit.
+viewpoint_image_errors : a viewpoint's dual view against its reciprocal render.
 """
 
 import json
@@ -657,3 +662,114 @@ def noise_condition(manifest, noise=None):
     if "noise" in synthetic:
         return ("raw12" if synthetic["noise"] else "noise_free"), "manifest synthetic.noise"
     return "noise_free", "default"
+
+
+def interval_errors(shadow_time, ground_truth, *, sweeps=("u", "v")):
+    """Errors of the dip interval's entry, centre and exit against their exact times.
+
+    Parameters
+    ----------
+    shadow_time : xarray.Dataset
+        ``interval_entry``, ``interval_exit`` over ``(sweep, row, col)``.
+    ground_truth : xarray.Dataset
+        ``lit`` and, per sweep, ``interval_entry_<sweep>``, ``interval_exit_<sweep>``
+        (row, col): the half-depth crossings the tracker measures (the rendered capture
+        of an area light, ``synthetic.lab.render``), and ``penumbra_first_<sweep>``,
+        ``penumbra_last_<sweep>`` when it has them (the dip's outer edges).
+    sweeps : sequence of str, keyword-only
+
+    Returns
+    -------
+    dict
+        Per sweep with truth: ``n_truth`` (lit pixels whose whole dip, from the penumbra's
+        first to its last frame, or the half-depth interval without them, lies within the
+        sweep's frames ``0 .. shadow_time.attrs["n_frames_<sweep>"] - 1``: only those have
+        a measurable entry and exit),
+        ``coverage`` (their share with an estimated interval), and ``entry``, ``centre``,
+        ``exit``: median, p95, RMSE, max of the absolute error in frames.
+    """
+    missing = {"interval_entry", "interval_exit"} - set(shadow_time)
+    if missing:
+        raise ValueError(f"shadow_time: has no {sorted(missing)}; recompute it with the current shadow-time step")
+    lit = np.asarray(ground_truth["lit"].values, dtype=bool)
+    names = [str(s) for s in shadow_time["sweep"].values]
+    out = {}
+    for sweep in sweeps:
+        keys = (f"interval_entry_{sweep}", f"interval_exit_{sweep}")
+        if sweep not in names or any(k not in ground_truth for k in keys):
+            continue
+        true_entry, true_exit = (ground_truth[k].transpose("row", "col").values.astype(np.float64) for k in keys)
+        entry, exit_ = (shadow_time[k].sel(sweep=sweep).transpose("row", "col").values.astype(np.float64)
+                        for k in ("interval_entry", "interval_exit"))
+        first, last = true_entry, true_exit
+        if f"penumbra_first_{sweep}" in ground_truth and f"penumbra_last_{sweep}" in ground_truth:
+            first, last = (ground_truth[f"penumbra_{k}_{sweep}"].transpose("row", "col").values.astype(np.float64)
+                           for k in ("first", "last"))
+        n_frames = shadow_time.attrs.get(f"n_frames_{sweep}", np.inf)
+        with np.errstate(invalid="ignore"):
+            inside = (first >= 0) & (last <= float(n_frames) - 1)
+        truth = lit & np.isfinite(true_entry) & np.isfinite(true_exit) & inside
+        found = truth & np.isfinite(entry) & np.isfinite(exit_)
+        out[sweep] = {
+            "n_truth": int(truth.sum()),
+            "coverage": float(found.sum() / truth.sum()) if truth.any() else float("nan"),
+            "entry": _stats(np.abs(entry - true_entry)[found]),
+            "centre": _stats(np.abs(0.5 * (entry + exit_) - 0.5 * (true_entry + true_exit))[found]),
+            "exit": _stats(np.abs(exit_ - true_exit)[found]),
+        }
+    return out
+
+
+def viewpoint_image_errors(ground_truth, viewpoint, *, shadow_time, dual_coords, dual_view):
+    """A viewpoint's dual view against its reciprocal render after one gain fit.
+
+    The same comparison as the main dual view (:func:`dual_image_errors` on the grid of
+    `dual_coords`), with the ground truth's ``reciprocal_<viewpoint>`` and
+    ``dual_cam_visible_<viewpoint>`` as the reciprocal render.
+
+    Parameters
+    ----------
+    ground_truth : xarray.Dataset
+    viewpoint : str
+        A viewpoint name the ground truth renders (e.g. ``entry``).
+    shadow_time, dual_coords, dual_view : xarray.Dataset, keyword-only
+        The viewpoint's products (``results/<ds>/viewpoints/<viewpoint>/``).
+
+    Returns
+    -------
+    dict
+        Keys of :func:`dual_image_errors`, or ``skipped`` (why) when the ground truth has
+        no reciprocal render of the viewpoint or cannot express the dual grid.
+    """
+    keys = (f"reciprocal_{viewpoint}", f"dual_cam_visible_{viewpoint}")
+    if any(k not in ground_truth for k in keys):
+        return {"skipped": f"the ground truth has no reciprocal render of viewpoint {viewpoint!r}"}
+    truth = ground_truth.assign(reciprocal=ground_truth[keys[0]], dual_cam_visible=ground_truth[keys[1]])
+    report = accuracy_report(shadow_time, truth, dual_coords=dual_coords, dual_view=dual_view, sweeps=())
+    return report["dual_image"]
+
+
+def add_interval_checks(report, shadow_time, ground_truth, *, viewpoints=None):
+    """Add the dip interval (``report["interval"]``) and viewpoint (``report["viewpoints"]``)
+    sections to an accuracy report, when the ground truth has what they need.
+
+    Parameters
+    ----------
+    report : dict
+        From :func:`accuracy_report`; updated in place.
+    shadow_time, ground_truth : xarray.Dataset
+    viewpoints : dict of str to (xarray.Dataset, xarray.Dataset, xarray.Dataset), optional
+        Viewpoint name -> its ``(shadow_time, dual_coords, dual_view)``.
+
+    Returns
+    -------
+    dict
+        `report`.
+    """
+    if "interval_entry" in shadow_time and any(str(k).startswith("interval_entry_") for k in ground_truth):
+        report["interval"] = interval_errors(shadow_time, ground_truth)
+    if viewpoints:
+        report["viewpoints"] = {
+            name: viewpoint_image_errors(ground_truth, name, shadow_time=st, dual_coords=coords, dual_view=view)
+            for name, (st, coords, view) in viewpoints.items()}
+    return report

@@ -8,6 +8,8 @@ The directory receives:
 * ``dual_view.png`` - the dual view, next to the ground-truth reciprocal view when the
   capture has ground truth,
 * ``error_histogram.png`` - shadow-time errors against ground truth (ground truth only),
+* ``viewpoints.png`` - with viewpoints (paper Fig. 13): each viewpoint's dual view beside
+  its reciprocal render on the same grid, one row per viewpoint,
 * ``accuracy.html`` - the accuracy CSV as an HTML table with the ground truth's
   definition (when given).
 
@@ -17,6 +19,7 @@ table_html : an HTML page with rows as a table (pass column coloured).
 csv_to_html : an HTML page with a CSV file as a table.
 primal_image : the camera image shown as the primal view.
 dual_view_report_figure : the dual view beside its ground truth on the same grid, model and coverage.
+viewpoints_report_figure : each viewpoint's dual view beside its reciprocal render (Fig. 13).
 write_report_figures : write every figure of a dataset into a directory, atomically.
 """
 
@@ -141,8 +144,37 @@ def dual_view_report_figure(dual_view, *, dual_coords=None, truth=None, camera_k
                                     note=f"dual model: {note}" if note else None)
 
 
+def viewpoints_report_figure(viewpoints, *, truth=None):
+    """Each viewpoint's dual view beside its reciprocal render on the same grid (paper Fig. 13).
+
+    Parameters
+    ----------
+    viewpoints : dict of str to (xarray.Dataset, xarray.Dataset)
+        Viewpoint name -> its ``(dual_view, dual_coords)``, in reading order.
+    truth : xarray.Dataset, optional
+        Lab ground truth with ``reciprocal_<viewpoint>`` and ``dual_cam_visible_<viewpoint>``
+        (a capture under an area light); resampled onto each dual grid like the accuracy step.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    from shadowcam.lab.accuracy import reciprocal_on_dual_grid
+
+    rows = []
+    for name, (dual_view, dual_coords) in viewpoints.items():
+        dual = dual_view["dual_view"].transpose("v", "u", ...).values
+        reciprocal = None
+        keys = (f"reciprocal_{name}", f"dual_cam_visible_{name}")
+        if truth is not None and all(k in truth for k in keys):
+            own = truth.assign(reciprocal=truth[keys[0]], dual_cam_visible=truth[keys[1]])
+            reciprocal, _ = reciprocal_on_dual_grid(own, dual.shape[:2], dual_coords=dual_coords)
+        rows.append((f"viewpoint {name}", dual, reciprocal))
+    return figures.viewpoints_figure(rows)
+
+
 def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv,
-               camera_kind):
+               camera_kind, viewpoints=None):
     figures.save_png(figures.primal_figure(primal_image(shadow_time, reference)), outdir / "primal.png")
     times = shadow_time["shadow_time"]
     for sweep in times["sweep"].values:
@@ -162,6 +194,8 @@ def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, ac
     figures.save_png(dual_view_report_figure(dual_view, dual_coords=dual_coords, truth=truth,
                                              camera_kind=camera_kind),
                      outdir / "dual_view.png")
+    if viewpoints:
+        figures.save_png(viewpoints_report_figure(viewpoints, truth=truth), outdir / "viewpoints.png")
     if accuracy_csv:
         from shadowcam.lab.accuracy import GROUND_TRUTH_DEFINITION
 
@@ -171,7 +205,7 @@ def _write_all(outdir, shadow_time, dual_view, dual_coords, truth, reference, ac
 
 
 def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, truth=None, reference=None,
-                         accuracy_csv=None, camera_kind=None):
+                         accuracy_csv=None, camera_kind=None, viewpoints=None):
     """Write the report figures of one dataset into `outdir` (replaced whole, or left as it was).
 
     Parameters
@@ -191,6 +225,8 @@ def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, tr
         Accuracy table to show as ``accuracy.html``.
     camera_kind : str, optional
         The capture plan's camera model, named in the dual-view figure's title.
+    viewpoints : dict of str to (xarray.Dataset, xarray.Dataset), optional
+        Viewpoint name -> its ``(dual_view, dual_coords)``: drawn as ``viewpoints.png``.
 
     Returns
     -------
@@ -201,5 +237,5 @@ def write_report_figures(outdir, *, shadow_time, dual_view, dual_coords=None, tr
         raise FileNotFoundError(f"accuracy_csv {accuracy_csv}: no such file")
     with atomic_directory(outdir) as tmp:
         _write_all(tmp, shadow_time, dual_view, dual_coords, truth, reference, accuracy_csv,
-                   camera_kind)
+                   camera_kind, viewpoints)
     return sorted(p.name for p in Path(outdir).iterdir())

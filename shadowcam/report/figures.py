@@ -16,6 +16,7 @@ suppress_colour_fringes : median of the colour differences (demosaic false colou
 primal_figure : the camera (primal) image.
 time_map_figure : a shadow-time map with colour bar.
 dual_view_figure : the dual view, next to the ground-truth reciprocal view if given.
+viewpoints_figure : per viewpoint, the dual view beside its reciprocal render (paper Fig. 13).
 error_histogram_figure : histogram of shadow-time errors per sweep.
 study_factor_figure : the simulation study's error curves against one factor (paper Fig. 5).
 save_png : write a figure as PNG (exact pixel size).
@@ -197,6 +198,41 @@ def dual_view_figure(dual_view, *, reciprocal=None, title="dual view (shadow cam
         figure.text(0.01, 0.01, "\n".join(lines), fontsize="small", va="bottom", ha="left")
         bottom = min(0.4, 0.03 + 0.032 * len(lines) * 5.6 / figure.get_figheight())
     figure.tight_layout(rect=(0, bottom, 1, 0.97))
+    return figure
+
+
+def viewpoints_figure(rows, *, size=None):
+    """Paper Fig. 13's layout: one row per viewpoint, its dual view beside its ground truth.
+
+    Parameters
+    ----------
+    rows : sequence of (str, ndarray, ndarray or None)
+        In reading order: ``(title, dual_view, reciprocal)`` with the (v, u[, channel])
+        linear dual view (NaN = hole) and the reciprocal render on the same grid (None =
+        no ground truth). Each panel is scaled to its own white point.
+    size : (float, float), optional
+        Default 3.2 inches per panel.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    if not rows:
+        raise ValueError("rows: expected at least one viewpoint")
+    columns = 2 if any(r[2] is not None for r in rows) else 1
+    figure = _new_figure(size or (3.4 * columns, 3.3 * len(rows)))
+    for index, (title, dual, reciprocal) in enumerate(rows):
+        panels = [(f"{title}: dual view", dual)]
+        if reciprocal is not None:
+            if np.shape(reciprocal)[:2] != np.shape(dual)[:2]:
+                raise ValueError(f"rows[{index}]: reciprocal must be on the dual grid {np.shape(dual)[:2]}; "
+                                 f"got shape {np.shape(reciprocal)}")
+            panels.append((f"{title}: reciprocal render", reciprocal))
+        for column, (panel_title, image) in enumerate(panels, start=1):
+            _show_image(figure.add_subplot(len(rows), columns, index * columns + column),
+                        tone_map(image, percentile=WHITE_PERCENTILE), panel_title,
+                        xlabel="u (dual column, dual px)", ylabel="v (dual row, dual px)")
+    figure.tight_layout()
     return figure
 
 

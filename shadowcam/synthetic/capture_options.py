@@ -30,8 +30,12 @@ DEFAULTS = {
 }
 #: ``synthetic`` keys without a default that a capture's options hold only when given:
 #: ``camera`` (the shadow camera to render), ``shutter`` (exposure of a lab frame as a
-#: fraction of the frame interval; absent = an instant)
-OPTIONAL_KEYS = ("camera", "shutter")
+#: fraction of the frame interval; absent = an instant), ``wire_radius_frames`` (the wire's
+#: radius in mask steps; absent = one), ``area_light`` (shape, size, samples of an area
+#: light; absent = the preset's disc)
+OPTIONAL_KEYS = ("camera", "shutter", "wire_radius_frames", "area_light")
+#: optional keys that describe the lab scene (``scenes.DESCRIPTION_KEYS``)
+SCENE_KEYS = ("wire_radius_frames", "area_light")
 #: scenes rendered as outdoor time-lapses
 OUTDOOR_SCENES = ("ridge",)
 FORMATS = ("dng", "tiff")
@@ -156,11 +160,13 @@ def lab_scene_description(options):
     Returns
     -------
     dict
-        ``scene, seed, height, width, frames, light`` and, with a camera block, ``camera``,
+        ``scene, seed, height, width, frames, light``, the ``wire_radius_frames`` and
+        ``area_light`` the manifest gives and, with a camera block, ``camera``,
         ``sweeps`` and ``optics`` (None for ``none``).
     """
     description = {key: options[key] for key in ("scene", "seed", "height", "width", "frames",
                                                   "light")}
+    description.update({key: options[key] for key in SCENE_KEYS if options.get(key) is not None})
     block = options.get("camera")
     if not block:
         return description

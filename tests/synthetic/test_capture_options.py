@@ -57,3 +57,13 @@ def test_sun_diameter_defaults_to_the_point_sun_and_the_manifest_schema_bounds_i
     doc["synthetic"]["outdoor"]["sun_diameter_deg"] = 2.0
     with pytest.raises(ValueError, match="sun_diameter_deg"):
         load_manifest(_manifest(tmp_path, doc))
+
+
+def test_wire_radius_and_area_light_reach_the_scene_description(repo):
+    from shadowcam.synthetic.capture_options import capture_options, lab_scene_description
+
+    description = lab_scene_description(capture_options(repo / "data_manifest" / "synthetic_area.yaml"))
+    assert description["light"] == "area" and description["wire_radius_frames"] == 4
+    assert description["area_light"] == {"shape": "disc", "size": 0.006, "samples": 4}
+    plain = lab_scene_description(capture_options(repo / "data_manifest" / "synthetic_tiny.yaml"))
+    assert "wire_radius_frames" not in plain and "area_light" not in plain

@@ -8,6 +8,7 @@ rule accuracy:
         shadow_time="results/{ds}/shadow_time.nc",
         stages=get_accuracy_stages,
         reference=get_accuracy_reference,
+        viewpoints=get_viewpoint_products,
     output:
         json="results/{ds}/accuracy.json",
         # shown in the report as the figure "accuracy" (HTML); a CSV there only downloads
@@ -24,7 +25,8 @@ rule accuracy:
     params:
         manifest=get_capture_manifest,
         stages=get_accuracy_flags,
+        viewpoints=get_viewpoint_flags,
     shell:
         "shadowcam accuracy --manifest {params.manifest} --shadow-time {input.shadow_time}"
-        " {params.stages}"
+        " {params.stages} {params.viewpoints}"
         " --out-json {output.json} --out-csv {output.csv} > {log} 2>&1"

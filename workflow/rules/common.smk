@@ -147,6 +147,7 @@ FIGURE_ORDER = (
     "shadow_time_cal_u",
     "shadow_time_cal_v",
     "dual_view",
+    "viewpoints",
     "keyframes",
     "edge_over_time",
     "arrival_map",

@@ -10,6 +10,7 @@ rule report_figures:
         dual_coords="results/{ds}/dual_coords.nc",
         reference=get_reference,
         accuracy=get_accuracy,
+        viewpoints=get_viewpoint_products,
     output:
         report(
             directory("results/{ds}/figures"),
@@ -32,6 +33,8 @@ rule report_figures:
         manifest=get_capture_manifest,
         reference=get_flag("--reference", "reference"),
         accuracy=get_flag("--accuracy", "accuracy"),
+        viewpoints=get_viewpoint_flags,
     shell:
         "shadowcam report-figures --manifest {params.manifest} --shadow-time {input.shadow_time}"
-        " --dual-view {input.dual_view} --dual-coords {input.dual_coords} {params.reference} {params.accuracy} --outdir {output} > {log} 2>&1"
+        " --dual-view {input.dual_view} --dual-coords {input.dual_coords} {params.reference} {params.accuracy}"
+        " {params.viewpoints} --outdir {output} > {log} 2>&1"

@@ -82,3 +82,27 @@ def get_accuracy_flags(wildcards, input):
     ]
     flags += [f"--reference {path}" for path in _as_list(input.reference)]
     return " ".join(flags)
+
+
+VIEWPOINT_PRODUCTS = ("shadow_time", "dual_coords", "dual_view")
+
+
+def get_viewpoint_products(wildcards):
+    """Shadow time, dual coordinates and dual view of each configured viewpoint."""
+    if "dual_view" not in capture(wildcards.ds).stages:
+        return []
+    return [
+        f"results/{wildcards.ds}/viewpoints/{vp}/{stem}.nc"
+        for vp in config["dual_view"]["viewpoints"]
+        for stem in VIEWPOINT_PRODUCTS
+    ]
+
+
+def get_viewpoint_flags(wildcards, input):
+    """``--viewpoint NAME SHADOW_TIME DUAL_COORDS DUAL_VIEW`` per viewpoint of the accuracy step."""
+    paths = _as_list(input.viewpoints)
+    n = len(VIEWPOINT_PRODUCTS)
+    return " ".join(
+        f"--viewpoint {path.split('/')[-2]} " + " ".join(paths[i : i + n])
+        for i, path in zip(range(0, len(paths), n), paths[::n])
+    )

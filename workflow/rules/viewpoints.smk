@@ -1,6 +1,7 @@
 # Stage: dual views from points across each pixel's dip interval (config
 # dual_view.viewpoints): the shadow times at the viewpoint (viewpoint_shadow_time), then
-# the dual stages of dual.smk on them.
+# the dual stages of dual.smk on them. The accuracy step scores each viewpoint's products
+# (targets.smk: get_viewpoint_products) against its reciprocal render, when the ground truth has one.
 
 
 rule viewpoint_shadow_time:

@@ -48,7 +48,7 @@ from shadowcam.synthetic.lab.optics import (
 )
 from shadowcam.synthetic.lab.raycast import SURFACE_OFFSET, intersect_scene, occluded, wire_occlusion_interval
 from shadowcam.synthetic.lab.scene import (
-    DistantLight, OrthographicCamera, PinholeCamera, PointLight, camera_rays, dual_camera,
+    AreaLight, DistantLight, OrthographicCamera, PinholeCamera, PointLight, camera_rays, dual_camera,
     light_samples, project, wire_shadow_time,
 )
 from shadowcam.synthetic.lab.scenes import calibration_scene
@@ -627,6 +627,82 @@ def _edge_point_truth(scene):
     }
 
 
+def _area_light_truth(scene, points, supersample):
+    """GT variables of the dip interval under an area light (``interval_*``, ``penumbra_*``
+    per sweep; ``reciprocal_<viewpoint>`` per viewpoint of ``lab.viewpoints.VIEWPOINTS`` and
+    for the penumbra's outer edges, ``_extreme_point_views``).
+
+    The tracker's entry and exit are the dip's half-depth crossings; through a wire wider
+    than the source (an umbra) they are the times half the source's weight is blocked
+    (``area_truth.area_light_times`` at fraction 0.5): the wire's leading and trailing edges
+    passing the source's centre, for the centrally symmetric disc, square and sphere. So the
+    viewpoint at fraction f across the interval is the view from the light's centre at
+    fraction f across the wire (``viewpoint_camera``). Only the standard pair under the
+    scene's light, seen directly.
+    """
+    from shadowcam.lab.viewpoints import VIEWPOINTS
+    from shadowcam.synthetic.lab.area_truth import area_light_times
+    from shadowcam.synthetic.lab.viewpoint_camera import viewpoint_camera
+
+    light, names = scene.light, ("u", "v")
+    if (not isinstance(light, AreaLight) or scene.optics or scene.dual_sweeps is not None
+            or any(n not in scene.sweeps or scene.sweeps[n].light is not None for n in names)):
+        return {}
+    rc, vu, f32 = ("row", "col"), ("v", "u"), np.float32
+    flat = points.reshape(-1, 3)
+    data = {}
+    for name, sweep in scene.sweeps.items():
+        if sweep.light is not None:
+            continue
+        half = area_light_times(flat, sweep, scene.mask, light, fraction=0.5)
+        outer = area_light_times(flat, sweep, scene.mask, light, fraction=0.0)
+        for key, times, what in (
+                ("interval_entry", half[0], "half the source blocked, entering (leading edge at its centre)"),
+                ("interval_exit", half[1], "half the source blocked, leaving (trailing edge at its centre)"),
+                ("penumbra_first", outer[0], "first source point blocked (the source's extreme point)"),
+                ("penumbra_last", outer[1], "last source point freed (the source's other extreme point)")):
+            data[f"{key}_{name}"] = (rc, times.reshape(points.shape[:2]).astype(f32), "frame",
+                                     f"sweep {name}: {what}")
+    views = {name: (light.center, fraction, f"the light's centre with the wires' lines at fraction "
+                                             f"{fraction} across their width")
+             for name, fraction in VIEWPOINTS.items()}
+    views.update(_extreme_point_views(scene))
+    for viewpoint, (source, fraction, what) in views.items():
+        dual = viewpoint_camera(scene.sweeps, names, source, fraction, scene.mask)
+        recip = render_reciprocal(scene.objects, scene.camera, light, scene.mask,
+                                  supersample=supersample, dual=dual)
+        data[f"reciprocal_{viewpoint}"] = (vu + ("channel",), recip["reciprocal"], "radiance",
+                                           f"reciprocal render of viewpoint {viewpoint}: from {what}, "
+                                           "the camera as a light")
+        data[f"dual_cam_visible_{viewpoint}"] = (vu, recip["dual_cam_visible"], "1",
+                                                 f"dual point of viewpoint {viewpoint} seen by the camera")
+    return data
+
+
+def _extreme_point_views(scene):
+    """The views of the penumbra's outer edges: from the source's extreme points.
+
+    The wire of sweep u moves along e_u, so it first blocks the source point of least e_u
+    coordinate and last frees the one of greatest; likewise along e_v. With the light's
+    plane parallel to the mask plane a point's u time depends on its e_u coordinate alone,
+    so the corner (least u, least v) of the samples' bounding box, seen through the wires'
+    leading edges, has both sweeps' first times (``penumbra_first``; a corner of the
+    bounding square for a disc, off the disc itself), the opposite corner through the
+    trailing edges their last times (``penumbra_last``). None when the planes are not
+    parallel.
+    """
+    mask, light = scene.mask, scene.light
+    positions = light_samples(light)[0]
+    if abs(abs(mask.normal @ light.normal) - 1.0) > 1e-9 or scene.sweeps["u"].velocity @ mask.e_u <= 0 \
+            or scene.sweeps["v"].velocity @ mask.e_v <= 0:
+        return {}
+    u, v = (positions - light.center) @ mask.e_u, (positions - light.center) @ mask.e_v
+    return {"penumbra_first": (light.center + u.min() * mask.e_u + v.min() * mask.e_v, 0.0,
+                               "the samples' bounding-box corner the wires reach first, through their leading edges"),
+            "penumbra_last": (light.center + u.max() * mask.e_u + v.max() * mask.e_v, 1.0,
+                              "the samples' bounding-box corner the wires leave last, through their trailing edges")}
+
+
 def _light_attrs(light):
     light_d = {"type": type(light).__name__}
     for key in ("position", "direction", "intensity", "irradiance", "normal", "size", "shape"):
@@ -745,7 +821,8 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
         With ``reference`` (rows, cols, 3) float32 (under the scene's light),
         ``ground_truth`` (xarray.Dataset, the standard GT names of docs/contracts.md plus
         P, N, cosines, distances, calibration GT; ``t_<sweep>`` for every sweep, ``lit_<sweep>``
-        for a sweep with its own light; the reciprocal render on the (u, v) grid of the dual
+        for a sweep with its own light; under an area light the dip intervals and the
+        viewpoints' reciprocal renders of ``_area_light_truth``; the reciprocal render on the (u, v) grid of the dual
         camera, or of ``lab.virtual.SweepPairCamera`` of ``scene.dual_sweeps`` with
         u = t_a, v = t_b) and ``homography`` ((3, 3), or None without calibration or when
         the scene's optics bend the camera rays, which leaves no plane homography).
@@ -812,6 +889,7 @@ def prepare_capture(scene, *, supersample=4, calibration=True):
                               f"pixel-centre point faces the light of sweep {n}, light visible")
                  for n in names if f"lit_{n}" in gt})
     data.update(_edge_point_truth(scene))
+    data.update(_area_light_truth(scene, gt["P"], supersample))
     homography = None
     if calibration:
         cal = calibration_scene(scene)

@@ -310,12 +310,20 @@ class DistantLight:
              irradiance=_vec(self.irradiance, "irradiance"))
 
 
+#: shapes of an area light
+AREA_SHAPES = ("disc", "square", "sphere", "tube")
+
+
 @dataclass(frozen=True, eq=False)
 class AreaLight:
-    """Small isotropic area light (disc or square) perpendicular to `normal`.
+    """Small isotropic area light: a disc or square perpendicular to `normal`, a sphere, or a
+    tube (a uniform line source) along the first axis of the plane perpendicular to `normal`
+    (``normal x up``: the mask plane's e_u when the mask faces the same way).
 
-    Sampled with a fixed stratified pattern of ``samples_per_side**2`` point lights that
-    share `intensity` (3,) (total radiant intensity, W/sr).
+    `size` is the disc's or sphere's diameter, the square's side, the tube's length. Sampled
+    with a fixed stratified pattern of point lights that share `intensity` (3,) (total radiant
+    intensity, W/sr): ``samples_per_side**2`` for a disc, square or tube,
+    ``samples_per_side**3`` for a sphere (see :func:`light_samples`).
     """
 
     position: np.ndarray
@@ -326,7 +334,7 @@ class AreaLight:
     samples_per_side: int = 4
 
     def __post_init__(self):
-        check_in(self.shape, "shape", ("disc", "square"))
+        check_in(self.shape, "shape", AREA_SHAPES)
         if int(self.samples_per_side) < 1:
             raise ValueError(f"samples_per_side must be >= 1; got {self.samples_per_side}")
         _set(self, position=_vec(self.position, "position"),
@@ -349,6 +357,39 @@ def _frame(normal, up=UP):
     return e_u, np.cross(normal, e_u)
 
 
+def _sphere_offsets(k, radius):
+    """(k**3, 3) offsets inside a ball whose projection on any plane is a uniform disc.
+
+    A sphere of uniform radiance casts the shadows of a uniform disc of its radius facing
+    each scene point. Points in the ball with density ``1 / sqrt(radius**2 - r**2)``
+    project to a uniform disc along every direction (its Abel transform is constant), so
+    one fixed sample set is exact for every point: k shells at the radial strata's middles
+    (``r = radius sin(theta)``, ``theta - sin(theta) cos(theta)`` uniform in
+    ``[0, pi/2]``) times k**2 directions of a Fibonacci sphere, rotated per shell.
+    """
+    targets = (np.arange(k) + 0.5) / k * (np.pi / 2)
+    theta = np.array([_invert_increasing(lambda t: t - np.sin(t) * np.cos(t), g, 0.0, np.pi / 2)
+                      for g in targets])
+    n = k * k
+    z = 1.0 - (2.0 * np.arange(n) + 1.0) / n
+    ring = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    golden = np.pi * (3.0 - np.sqrt(5.0))
+    shells = []
+    for i, t in enumerate(theta):
+        phi = golden * np.arange(n) + 2.0 * np.pi * i / k
+        unit = np.column_stack([ring * np.cos(phi), ring * np.sin(phi), z])
+        shells.append(radius * np.sin(t) * unit)
+    return np.concatenate(shells)
+
+
+def _invert_increasing(func, value, low, high, steps=60):
+    """x in [low, high] with func(x) = value, for an increasing func (bisection)."""
+    for _ in range(steps):
+        mid = 0.5 * (low + high)
+        low, high = (mid, high) if func(mid) < value else (low, mid)
+    return 0.5 * (low + high)
+
+
 def light_samples(light):
     """Return the light's samples.
 
@@ -369,6 +410,9 @@ def light_samples(light):
         return light.position[None], None, light.intensity[None]
     if isinstance(light, DistantLight):
         return None, light.direction[None], light.irradiance[None]
+    if isinstance(light, AreaLight) and light.shape == "sphere":
+        pos = light.position + _sphere_offsets(light.samples_per_side, 0.5 * light.size)
+        return pos, None, np.repeat(light.intensity[None] / len(pos), len(pos), axis=0)
     if isinstance(light, AreaLight):
         k = light.samples_per_side
         a, b = np.meshgrid((np.arange(k) + 0.5) / k, (np.arange(k) + 0.5) / k, indexing="ij")
@@ -378,6 +422,8 @@ def light_samples(light):
             r = 0.5 * light.size * np.sqrt(a)
             phi = 2 * np.pi * b
             x, y = r * np.cos(phi), r * np.sin(phi)
+        elif light.shape == "tube":  # k*k strata along e1 (the mask's e_u for the presets)
+            x, y = ((np.arange(k * k) + 0.5) / (k * k) - 0.5) * light.size, np.zeros(k * k)
         else:
             x, y = (a - 0.5) * light.size, (b - 0.5) * light.size
         pos = light.position + x[:, None] * e1 + y[:, None] * e2

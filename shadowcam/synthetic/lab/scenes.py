@@ -10,17 +10,19 @@ calibration_scene : the scene holding only its calibration (back) plane.
 CAMERA_KINDS : primal camera kinds of the presets (perspective, orthographic).
 SCENES, make_scene : presets by name (tabletop, tabletop_squares, panels) and the factory.
 scene_from_description, DESCRIPTION_KEYS : a scene from a capture description (the scene
-    keys of a manifest's ``synthetic:`` block: light, camera, sweeps, optics, ...).
+    keys of a manifest's ``synthetic:`` block: light, camera, sweeps, optics, wire radius,
+    area light, ...).
+AREA_LIGHT_KEYS : keys of an ``area_light`` description.
 """
 
 from dataclasses import dataclass, replace
 
 import numpy as np
 
-from shadowcam._shared.validation import check_in
+from shadowcam._shared.validation import check_in, check_positive
 from shadowcam.synthetic.lab.optics import optics_setup
 from shadowcam.synthetic.lab.scene import (
-    AreaLight, BackPlane, Box, DistantLight, GroundPlane, MaskPlane, Material, OrthographicCamera,
+    AREA_SHAPES, AreaLight, BackPlane, Box, DistantLight, GroundPlane, MaskPlane, Material, OrthographicCamera,
     PinholeCamera, PointLight, Sphere, Texture, look_at_camera, make_mask_plane, make_wire_sweeps,
 )
 from shadowcam.synthetic.lab.sweeps import make_sweeps
@@ -140,8 +142,36 @@ def _panels(**options):
 SCENES = {"tabletop": _tabletop, "tabletop_squares": _tabletop_squares, "panels": _panels}
 
 
+def _area_light(light, area_light):
+    """The scene's area light with the shape, size and samples of `area_light` (a mapping)."""
+    if not isinstance(light, AreaLight):
+        raise ValueError(f"area_light: describes an area light, but the scene's light is a "
+                         f"{type(light).__name__}; set the light to 'area' (a manifest's top-level "
+                         f"`light: area`) or drop the key")
+    if not hasattr(area_light, "get"):
+        raise ValueError(f"area_light: expected a mapping with shape, size, samples; got {area_light!r}")
+    unknown = set(area_light) - set(AREA_LIGHT_KEYS)
+    if unknown:
+        raise ValueError(f"area_light: unknown key(s) {sorted(unknown)}; known: {list(AREA_LIGHT_KEYS)}")
+    shape = area_light.get("shape", light.shape)
+    check_in(shape, "area_light.shape", AREA_SHAPES)
+    size = check_positive(area_light.get("size", light.size), "area_light.size", finite=True)
+    samples = area_light.get("samples", light.samples_per_side)
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise ValueError(f"area_light.samples: must be an integer >= 1 (samples per side), got {samples!r}")
+    return replace(light, shape=shape, size=float(size), samples_per_side=int(samples))
+
+
+#: keys of a scene's ``area_light`` description -> meaning
+AREA_LIGHT_KEYS = {"shape": "disc, square, sphere or tube (AREA_SHAPES)",
+                   "size": "diameter of the disc or sphere, side of the square, length of the tube "
+                           "(scene units)",
+                   "samples": "samples per side (k**2 point lights; k**3 for a sphere)"}
+
+
 def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="point",
-               camera_kind="perspective", sweeps=None, dual_sweeps=None, optics=None):
+               camera_kind="perspective", sweeps=None, dual_sweeps=None, optics=None,
+               wire_radius_frames=None, area_light=None):
     """Build a preset scene.
 
     Parameters
@@ -177,6 +207,15 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
         ``{"kind": "glass", "shape": "slab", "index": 1.5}``; the other keys are the options
         of ``optics.mirror_setup`` / ``optics.glass_setup`` (which need the perspective
         camera). None = direct view.
+    wire_radius_frames : float, optional
+        Radius of every sweep's wire in mask steps (frames of the standard pair); a wire
+        wider than the source seen through it casts an umbra between two penumbrae.
+        None = one mask step (a dip about two frames wide).
+    area_light : dict, optional
+        With ``light_kind="area"``: ``shape`` ({"disc", "square", "sphere", "tube"}; a tube
+        lies along the mask plane's e_u), ``size`` (diameter of the disc or sphere, side of
+        the square, length of the tube) and ``samples`` (per side);
+        omitted keys keep the preset's disc of diameter 0.006 with 4 samples per side.
 
     Returns
     -------
@@ -192,10 +231,15 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
     objects, light, camera, mask = SCENES[name](seed=int(seed), height=int(height),
                                                 width=int(width), frames=int(frames),
                                                 light_kind=light_kind, **builder_options)
+    if area_light is not None:
+        light = _area_light(light, area_light)
+    radius = None
+    if wire_radius_frames is not None:
+        radius = check_positive(wire_radius_frames, "wire_radius_frames", finite=True) * mask.delta
     if sweeps is None:
-        sweep_set = make_wire_sweeps(mask)
+        sweep_set = make_wire_sweeps(mask, radius=radius)
     else:
-        sweep_set = make_sweeps(mask, sweeps, light=light)
+        sweep_set = make_sweeps(mask, sweeps, light=light, radius=radius)
         if dual_sweeps is None and len(sweep_set) >= 2:
             dual_sweeps = tuple(sweep_set)[:2]
     if dual_sweeps is not None:
@@ -214,7 +258,8 @@ def make_scene(name, *, seed=0, height=192, width=192, frames=96, light_kind="po
 #: capture-description key -> make_scene argument (the scene part of a ``synthetic:`` block)
 DESCRIPTION_KEYS = {"scene": "name", "seed": "seed", "height": "height", "width": "width",
                     "frames": "frames", "light": "light_kind", "camera": "camera_kind",
-                    "sweeps": "sweeps", "dual_sweeps": "dual_sweeps", "optics": "optics"}
+                    "sweeps": "sweeps", "dual_sweeps": "dual_sweeps", "optics": "optics",
+                    "wire_radius_frames": "wire_radius_frames", "area_light": "area_light"}
 
 
 def scene_from_description(description):
@@ -229,7 +274,8 @@ def scene_from_description(description):
         ``sweeps.make_sweeps``, e.g. ``{"name": "w", "angle_deg": 30, "speed": 1.0,
         "light_offset": [0, 0, -0.02]}``), ``dual_sweeps`` (two sweep names), ``optics``
         (optical elements, e.g. ``{"kind": "glass", "shape": "slab", "index": 1.5}``; see
-        ``make_scene``). Other keys
+        ``make_scene``), ``wire_radius_frames`` (wire radius in mask steps), ``area_light``
+        (``{shape, size, samples}`` of an area light). Other keys
         (frame format, noise, supersample, ...) describe the rendering, not the scene, and
         are left to the caller. Missing keys take ``make_scene``'s defaults, so a
         description without light/camera/sweeps gives exactly today's scene.
