@@ -771,10 +771,11 @@ def without_interval(summary, interval):
     its window as lit (lower level, higher noise). This removes those frames
     (``beyond_*`` of `interval`) from the running sums, adds back the light the
     penumbra frames above half depth outside the window lack (a straight ramp
-    through each crossing with its measured slope, :func:`_without_ramps`), and
+    through each crossing with its measured slope, :func:`_without_ramps`; only
+    where the dip runs beyond the window), and
     moves each crossing along its local slope to the half depth of the corrected
     level (first order; exact on a linear penumbra). Pixels with nothing beyond
-    the window and no ramp frame outside it keep their values bit for bit.
+    the window keep their values bit for bit.
 
     Returns
     -------
@@ -798,8 +799,9 @@ def without_interval(summary, interval):
     lit_level = np.where(changed, new_level, level)
     lit_count = np.where(changed, summary.lit_count - interval.beyond_count, summary.lit_count)
     new_noise = np.where(changed, np.sqrt(new_variance), noise)
-    ramp_level = _without_ramps(lit_level, lit_count, summary, interval)
-    changed |= ramp_level != lit_level
+    # only a dip that runs beyond the window has its ramps' frames counted as lit to first
+    # order; a narrower one's ramp beyond the window is at most a noisy frame's worth
+    ramp_level = np.where(changed, _without_ramps(lit_level, lit_count, summary, interval), lit_level)
     new_summary = replace(summary, lit_level=ramp_level, noise=new_noise, lit_count=lit_count)
     threshold = np.where(changed, half_depth(new_summary), interval.threshold)
     shift = threshold - interval.threshold
