@@ -719,15 +719,63 @@ def track_intervals(blocks, summary, *, threshold=None):
     return tracker.result()
 
 
+def _ramp_deficit(level, minimum, crossing, slope, first, last):
+    """Light missing from the frames ``first..last`` of a straight penumbra ramp above half depth.
+
+    The ramp reaches half depth ``(level + minimum) / 2`` at `crossing` with `slope`
+    (signal per frame, positive) and the lit level ``R = (level - minimum) / (2 slope)``
+    frames further out; a frame ``j`` of it lacks ``slope * (R - |j - crossing|)``.
+    `first` and `last` bound the frames on the ramp's lit side of the crossing (in any
+    order). Returns the sum over the integer frames within both (0 where none).
+    """
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        reach = 0.5 * (level - minimum) / slope
+        lo = np.maximum(np.minimum(first, last), np.ceil(crossing - reach))
+        hi = np.minimum(np.maximum(first, last), np.floor(crossing + reach))
+        count = hi - lo + 1
+        # sum of |j - crossing| over j in lo..hi, all on one side of the crossing
+        distance = np.abs(0.5 * (lo + hi) - crossing) * count
+        deficit = slope * (reach * count - distance)
+    return np.where(np.isfinite(deficit) & (count > 0) & (slope > 0), deficit, 0.0)
+
+
+def _without_ramps(lit_level, lit_count, summary, interval, *, iterations=8):
+    """Lit level with the penumbra frames above half depth (outside the window) taken out.
+
+    The frames between the lit level and the half-depth crossing on each side of a dip
+    wider than the tracker's window count as lit in its running sums although the light
+    is partly hidden there. The lit level is the unoccluded irradiance: the counted mean
+    plus the light those ramp frames lack, on a straight ramp through each crossing with
+    its measured slope (:func:`_ramp_deficit`), solved with the level it depends on by
+    fixed-point iteration (the ramp frames are a fraction of the counted ones, so it
+    contracts). Pixels with no ramp frame outside the window keep `lit_level` exactly.
+    """
+    centre = summary.minimum_frame.astype(np.float64)
+    h, n_frames = summary.half_window, summary.n_frames
+    minimum = summary.minimum_value.astype(np.float64)
+    count = np.maximum(lit_count, 1).astype(np.float64)
+    level = lit_level
+    for _ in range(iterations):
+        deficit = (_ramp_deficit(level, minimum, interval.entry, interval.entry_slope,
+                                 np.zeros_like(centre), np.minimum(np.floor(interval.entry), centre - h - 1))
+                   + _ramp_deficit(level, minimum, interval.exit, interval.exit_slope,
+                                   np.maximum(np.ceil(interval.exit), centre + h + 1), np.full_like(centre, n_frames - 1)))
+        level = np.where(deficit > 0, lit_level + deficit / count, lit_level)
+    return level
+
+
 def without_interval(summary, interval):
     """The lit statistics of `summary` with the whole dip interval taken out, and the crossings moved to match.
 
     The tracker's lit level and noise count the frames of a dip wider than
     its window as lit (lower level, higher noise). This removes those frames
-    (``beyond_*`` of `interval`) from the running sums and moves each
-    crossing along its local slope to the half depth of the corrected level
-    (first order; exact on a linear penumbra). Pixels with nothing beyond the
-    window keep their values bit for bit.
+    (``beyond_*`` of `interval`) from the running sums, adds back the light the
+    penumbra frames above half depth outside the window lack (a straight ramp
+    through each crossing with its measured slope, :func:`_without_ramps`; only
+    where the dip runs beyond the window), and
+    moves each crossing along its local slope to the half depth of the corrected
+    level (first order; exact on a linear penumbra). Pixels with nothing beyond
+    the window keep their values bit for bit.
 
     Returns
     -------
@@ -748,9 +796,13 @@ def without_interval(summary, interval):
         new_level = lit_sum / (n - k)
         new_variance = np.maximum(lit_square / (n - k) - new_level**2, 0) * (n - k) / np.maximum(n - k - 1, 1)
     changed = (k > 0) & (n - k >= 3)
-    new_summary = replace(summary, lit_level=np.where(changed, new_level, level),
-                          noise=np.where(changed, np.sqrt(new_variance), noise),
-                          lit_count=np.where(changed, summary.lit_count - interval.beyond_count, summary.lit_count))
+    lit_level = np.where(changed, new_level, level)
+    lit_count = np.where(changed, summary.lit_count - interval.beyond_count, summary.lit_count)
+    new_noise = np.where(changed, np.sqrt(new_variance), noise)
+    # only a dip that runs beyond the window has its ramps' frames counted as lit to first
+    # order; a narrower one's ramp beyond the window is at most a noisy frame's worth
+    ramp_level = np.where(changed, _without_ramps(lit_level, lit_count, summary, interval), lit_level)
+    new_summary = replace(summary, lit_level=ramp_level, noise=new_noise, lit_count=lit_count)
     threshold = np.where(changed, half_depth(new_summary), interval.threshold)
     shift = threshold - interval.threshold
     with np.errstate(invalid="ignore", divide="ignore"):

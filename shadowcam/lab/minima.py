@@ -220,14 +220,11 @@ class _WindowPass:
         self.next += signal.shape[0]
 
 
-def _line_level(window, trusted_left, trusted_right):
-    """Lit level at each window slot, ``(K, W, P)``: the line through the means of the first
-    and last two valid samples; a side whose window runs past the sequence (untrusted: its
-    first valid samples may lie in the dip) counts only when its samples are within a tenth
-    of the dip's depth of the other side's level, else takes the other side's level (NaN if neither)."""
-    n = window.shape[1]
+def _side_means(window):
+    """Mean value and mean slot of the first and of the last two valid samples of each
+    window ``(K, W, P)``: ``(left, x_left), (right, x_right)``, each ``(K, P)``."""
     valid = np.isfinite(window)
-    idx = np.arange(n)[None, :, None]
+    idx = np.arange(window.shape[1])[None, :, None]
 
     def side(from_left):
         rank = np.cumsum(valid if from_left else valid[:, ::-1], axis=1)
@@ -238,7 +235,46 @@ def _line_level(window, trusted_left, trusted_right):
             return (np.where(pick, window, 0).sum(axis=1) / count,
                     np.where(pick, idx, 0).sum(axis=1) / count)
 
-    (left, x_left), (right, x_right) = side(True), side(False)
+    return side(True), side(False)
+
+
+def _own_dip(window, detectable, inside):
+    """Windows ``(K, W, P)`` with the samples of another light's shadow set to the lit level.
+
+    Under a steady light the lit level is the same before and after a dip, and a shadow
+    only removes light: a window end lower than the other end by more than `detectable`
+    ((P,)) lies in another shadow (or, where the window was cut at another minimum, in
+    this dip). On that side the dip ends at the sample nearest the centre that is back at
+    the other end's level (within `detectable`); the slots beyond it that lie `inside` the
+    sequence ((K, W, P) bool), cut or not, take that level (lit, as far as this dip goes).
+    A side with no such sample, or whose ends agree, is left as it is.
+    """
+    (left, _), (right, _) = _side_means(window)
+    n = window.shape[1]
+    centre = (n - 1) // 2
+    slots = np.arange(n)[None, :, None]
+    out = window.copy()
+    with np.errstate(invalid="ignore"):
+        for low, high, side in ((left, right, slots < centre), (right, left, slots > centre)):
+            shadowed = high - low > detectable[None]
+            back = side & (window >= (high - detectable[None])[:, None])
+            # the back-at-level sample nearest the centre on this side
+            distance = np.where(back, np.abs(slots - centre), n)
+            nearest = distance.min(axis=1)
+            beyond = side & (np.abs(slots - centre) > nearest[:, None]) & (shadowed & (nearest < n))[:, None]
+            out = np.where(beyond & inside, high[:, None], out)
+    return out
+
+
+def _line_level(window, trusted_left, trusted_right):
+    """Lit level at each window slot, ``(K, W, P)``: the line through the means of the first
+    and last two valid samples; a side whose window runs past the sequence (untrusted: its
+    first valid samples may lie in the dip) counts only when its samples are within a tenth
+    of the dip's depth of the other side's level, else takes the other side's level (NaN if neither)."""
+    n = window.shape[1]
+    valid = np.isfinite(window)
+    idx = np.arange(n)[None, :, None]
+    (left, x_left), (right, x_right) = _side_means(window)
     # an untrusted side still counts when its samples are within a tenth of the dip's depth
     # of the trusted side's level (the dip closes inside the sequence, before them)
     lowest = np.nanmin(np.where(valid, window, np.inf), axis=1)
@@ -366,6 +402,8 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         cuts = (present & dip)[other]
         nearest &= ~cuts[None, None] | (own <= np.abs(slot_frame - centres[other][None, None]))
     cut = np.where(nearest, window, np.nan)
+    if steady_level:
+        cut = _own_dip(cut, significance * noise, ~outside_sequence)
     cut_by_other = ~nearest & np.isfinite(window)
     level = _line_level(cut, ~outside_sequence[:, 0], ~outside_sequence[:, -1]).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -196,3 +196,24 @@ def test_wide_dip_half_depth_of_the_true_lit_level(plateau, ramp, phase, floor):
                                atol=0.5 * bound / (0.8 / ramp) + 0.1)
     # and the first pass alone is off by the plateau
     assert 1.0 + floor - tracker.result().lit_level[0, 0] > bound
+
+
+@settings(max_examples=30, deadline=None)
+@given(plateau=st.integers(10, 200), ramp=st.integers(4, 10), phase=st.floats(0, 1), floor=st.floats(0, 1))
+def test_wide_dip_lit_level_leaves_out_the_penumbra_ramps(plateau, ramp, phase, floor):
+    # the ramp frames above half depth outside the window lack light too: with them taken
+    # out the lit level is the unoccluded one to 1 % of the depth (the straight ramp through
+    # the smoothed crossing; sampling of its ends), and the crossings land within 0.1 frame
+    # of the exact ones (the first-order move along a short ramp's smoothed corner)
+    from shadowcam.lab.dip_tracker import without_interval
+
+    n = 3 * (plateau + 2 * ramp) + 60
+    signal, entry, exit_ = trapezoid(n, entry=30 + ramp / 2 + phase, plateau=plateau, ramp=ramp,
+                                     depth=0.8, floor=floor)
+    frames = signal.astype(np.float32)[:, None, None]
+    tracker = DipTracker((1, 1), half_window=4)
+    tracker.update(frames)
+    first = tracker.result()
+    summary, interval = without_interval(first, track_intervals([frames], first))
+    assert abs(1.0 + floor - summary.lit_level[0, 0]) <= 0.01 * 0.8
+    np.testing.assert_allclose([interval.entry[0, 0], interval.exit[0, 0]], [entry, exit_], atol=0.1)

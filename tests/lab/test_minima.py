@@ -136,3 +136,30 @@ def test_a_dip_wider_than_the_window_is_flagged_not_timed(width):
     # a window that holds it times it
     m = find_minima(frames, frames.shape[1:], count=1, half_window=int(width // 2) + 2)
     np.testing.assert_allclose(m.time, 45.0, atol=1 / (8 * width) + 2e-3)
+
+
+
+@settings(max_examples=30, deadline=None)
+@given(centre=st.floats(28.0, 36.0), width=st.floats(1.5, 3.0), gap=st.floats(2.5, 5.0),
+       trough=st.floats(6.0, 14.0), trough_depth=st.floats(0.1, 0.3), after=st.booleans())
+def test_another_shadow_inside_the_window_does_not_move_a_dip(centre, width, gap, trough,
+                                                              trough_depth, after):
+    """A steady light's dip keeps its exact time and is timed (not flagged) when another
+    light's wide, shallow shadow (a tube's) begins `gap` frames or so from it, inside its
+    timing window: the frames between them are back at the lit level, so the other
+    shadow's samples are no part of this dip. The other shadow's near edge is put on a
+    frame boundary, so that each of its samples is either lit or deeper than noise-free
+    detection (a partly shadowed sample shallower than the detectable depth stays in the
+    window's level, see docs/benchmarks.md)."""
+    side = 1.0 if after else -1.0
+    edge = np.floor(centre + side * (width / 2 + gap)) + 0.5
+    alone = box_dips(72, [centre], [width], [0.5])
+    both = box_dips(72, [centre, edge + side * trough / 2], [width, trough], [0.5, trough_depth])
+    m_alone = find_minima(alone, alone.shape[1:], count=2, half_window=4)
+    m_both = find_minima(both, both.shape[1:], count=2, half_window=4)
+    k_alone = int(np.nanargmin(np.abs(m_alone.estimate[:, 0, 0] - centre)))
+    k_both = int(np.nanargmin(np.abs(m_both.estimate[:, 0, 0] - centre)))
+    assert m_alone.reason[k_alone, 0, 0] == OK
+    assert np.all(m_both.reason[k_both] == OK)
+    np.testing.assert_allclose(m_both.time[k_both], m_alone.time[k_alone], atol=1e-6)
+    np.testing.assert_allclose(m_both.contrast[k_both], m_alone.contrast[k_alone], atol=1e-6)

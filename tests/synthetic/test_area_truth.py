@@ -106,8 +106,12 @@ def test_wide_area_light_shadow_is_timed_like_a_thin_one(area_scene, radius_fram
     # target 0.1 frame; measured 0.103 / 0.105 here (40 px, 2 x 2 sub-samples against the
     # pixel-centre truth), 0.092 at 48 px
     assert np.percentile(np.abs(after["shadow_time"] - 0.5 * (entry + exit_))[ok], 95) <= 0.11
-    # entry / exit: the residual bias of the lit level (penumbra frames above half depth
-    # still counted as lit) moves them inward on the wide dip, outward on the short one;
-    # measured p95 0.26 / 0.34 frame (target 0.2: docs/benchmarks.md, open problems)
-    assert np.percentile(np.abs(after["interval_entry"] - entry)[ok], 95) <= 0.4
-    assert np.percentile(np.abs(after["interval_exit"] - exit_)[ok], 95) <= 0.4
+    # entry / exit, with the lit level freed of the penumbra frames above half depth where
+    # the dip runs beyond the window: measured p95 0.14 / 0.14 frame on the 16-frame dip
+    # (target 0.2). The 8-frame dip fits the window and keeps 0.34 / 0.35: its umbra is
+    # shorter than the smoothing, so the smoothed minimum lies above the umbra and the
+    # smoothed crossings outward; the exact lit level leaves them there (0.47), so the
+    # level is not what is left (docs/benchmarks.md, open problems)
+    bound = 0.2 if radius_frames == 8 else 0.4
+    assert np.percentile(np.abs(after["interval_entry"] - entry)[ok], 95) <= bound
+    assert np.percentile(np.abs(after["interval_exit"] - exit_)[ok], 95) <= bound

@@ -56,7 +56,10 @@ def render_light_set_capture(synthetic, *, light="point"):
     Parameters
     ----------
     synthetic : mapping
-        The manifest's ``synthetic`` block with ``lights``.
+        The manifest's ``synthetic`` block with ``lights``; its optional ``shutter`` is the
+        exposure of each frame as a fraction of the frame interval (absent: an instant
+        exposure), as for the single-light lab renderer
+        (:func:`~shadowcam.synthetic.lab.render.sweep_frames`).
     light : str
         The manifest's ``light`` (``point``).
 
@@ -75,13 +78,14 @@ def render_light_set_capture(synthetic, *, light="point"):
     scene = make_scene(synthetic["scene"], seed=int(synthetic["seed"]), height=int(synthetic["height"]),
                        width=int(synthetic["width"]), frames=int(synthetic["frames"]), light_kind=light)
     lights = make_lights(synthetic["lights"], scene)
+    shutter = float(synthetic.get("shutter", 0.0))
     paths, source = trace_light_set(scene.objects, scene.camera, lights,
                                     supersample=int(synthetic.get("supersample", 3)))
     data = {"reference": (("y", "x", "channel"), render_image(paths).astype(np.float32))}
     for name in ("u", "v"):
         sweep = scene.sweeps[name]
         data[f"frames_{name}"] = ((f"t_{name}", "y", "x", "channel"),
-                                  sweep_frames(paths, sweep, scene.mask).astype(np.float32))
+                                  sweep_frames(paths, sweep, scene.mask, shutter=shutter).astype(np.float32))
         truth = light_set_ground_truth(scene.objects, scene.camera, lights, sweep, paths, source)
         for key in ("t_center", "t_first", "t_last"):
             data[f"{key}_{name}"] = (("light", "y", "x"), truth[key])
