@@ -80,9 +80,11 @@ rule lightfield_rays:
     resources:
         mem_mb=get_lightfield_mem_mb,
         runtime=15,
+    params:
+        anchor=config["lightfield"]["ray_anchor"],
     shell:
         "shadowcam lightfield-rays --capture {input.capture} --sweeps {input.sweeps}"
-        " --out {output} > {log} 2>&1"
+        " --anchor {params.anchor} --out {output} > {log} 2>&1"
 
 
 rule lightfield_render:
