@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Throughput and memory of the light-field steps, and the error of a sweep's time map.
 
-    .venv/bin/python scripts/benchmark_lightfield.py [--size 96] [--frames 48 96] [--time-error]
+    .venv/bin/python scripts/benchmark_lightfield.py [--size 96] [--frames 48 96] [--time-error | --rays-error]
 
 Throughput: renders one sweep (near screen, wire along x) of `--size` x `--size` DNG brackets
 per frame count into a scratch folder, then times, in process, the HDR merge
@@ -16,6 +16,12 @@ renderer's truth (the flux-weighted mask coordinate of each pixel's rays), for t
 shadow-time methods ``edge_fit`` and ``dip_centroid`` with and without noise: error std,
 the part explained by the frame phase ``t mod 1`` (two harmonics), and the error's
 correlation between neighbouring pixels. Run with PYTHONPATH set to the repository under test.
+
+``--rays-error``: the rays of the library capture (noisy) per shadow-time method and ray anchor
+(``rays_dataset(anchor=...)``): direction error against the source's ray at the anchor pixel's
+true mask point, renders at 350 / 675 mm at 1 x and 2 x the near camera's pitch against the
+naive baseline (rel. RMSE with one gain, band-passed DoG(1, 4 px) error) and the far field's
+median error at the capture's angular resolution.
 """
 
 import argparse
@@ -114,14 +120,77 @@ def time_error():
                           f" row {lag[0]:+.2f} col {lag[1]:+.2f}; shadow moves {1 / speed:.2f} px per frame")
 
 
+def rays_error():
+    from shadowcam.lightfield import accuracy, hdr, rays, screen
+    from shadowcam.lightfield.photometry_export import far_field_grid, rays_resolution_deg
+    from shadowcam.lightfield.render import irradiance_on_plane
+    from shadowcam.synthetic.lightfield.capture import LightFieldCapture, sweep_frames
+
+    capture = LightFieldCapture(shape=(96, 96), n_frames=48, quadrature=1200)
+    q = capture.responsivity()
+    stacks, truths = {}, {}
+    for s in range(2):
+        for axis in "xy":
+            truths[s, axis] = {}
+            frames = sweep_frames(capture, s, axis, responsivity=q, truth=truths[s, axis])
+            stacks[s, axis] = list(hdr.merge_stream(
+                frames, capture.exposure_times, black_level=capture.sensor.black_level,
+                white_level=capture.sensor.white_level, gain=capture.sensor.gain,
+                read_noise=capture.sensor.read_noise, responsivity=q))
+    near_pitch = capture.homography(0)[0, 1]
+    targets = {}
+    for factor in (1, 2):
+        for z in (350.0, 675.0):
+            pitch = factor * near_pitch * z / capture.positions_mm[0]
+            shape = (capture.shape[0] // factor,) * 2
+            targets[factor, z] = shape, pitch, capture.source.irradiance(centre=(0, 0, z), shape=shape, pixel_size=pitch)
+    far_truth = {}
+    for method in ("edge_fit", "dip_centroid"):
+        maps = []
+        for s in range(2):
+            found = {a: rays.sweep_mask_positions(iter(stacks[s, a]), capture.shape, mask_start=capture.mask_start,
+                                                  mask_step=capture.step, method=method) for a in "xy"}
+            xy, area = screen.screen_coordinates(capture.homography(s), capture.shape)
+            maps.append(rays.screen_mask_map(found["x"], found["y"], xy=xy, area=area,
+                                             position_mm=capture.positions_mm[s]))
+        for anchor in rays.ANCHORS:
+            ray_set = rays.rays_dataset(maps[0], maps[1], anchor=anchor)
+            s = 1 if anchor == "far" else 0
+            true = capture.source.rays(truths[s, "x"]["mask_centre"], truths[s, "y"]["mask_centre"])
+            d = ray_set["direction"].values
+            ok = (ray_set["flag"].values == 0) & np.all(np.isfinite(true), -1)
+            error = np.hypot(*(d - true)[..., :2][ok].T)
+            print(f"{method:12s} anchor {anchor:4s}: direction error median {np.median(error):.5f},"
+                  f" p90 {np.percentile(error, 90):.5f}")
+            for (factor, z), (shape, pitch, truth) in targets.items():
+                nearest = maps[0 if z < capture.positions_mm[1] else 1]
+                rendered = irradiance_on_plane(ray_set, centre=(0, 0, z), shape=shape, pixel_size=pitch).values
+                base = accuracy.naive_baseline(nearest["irradiance"], nearest["xy"],
+                                               position_mm=nearest["position_mm"], target_position_mm=z,
+                                               target_shape=shape, pixel_size=pitch)
+                ratio = accuracy.relative_rmse_gain(rendered, truth) / accuracy.relative_rmse_gain(base, truth)
+                band = accuracy.bandpass_error(rendered, truth) / accuracy.bandpass_error(base, truth)
+                print(f"    {z:.0f} mm {factor} x pitch: render / baseline {ratio:.2f}, band-passed {band:.2f}")
+            resolution = rays_resolution_deg(ray_set)
+            estimate = far_field_grid(ray_set["direction"].values, ray_set["flux"].values, resolution_deg=resolution)
+            size = estimate.shape[0]
+            if size not in far_truth:
+                far_truth[size] = capture.source.far_field_grid(resolution_deg=resolution, size=size).values
+            error = accuracy.far_field_error(estimate.values, far_truth[size])
+            print(f"    far field at {resolution:.2f} deg: median error {100 * error:.2f} %")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", type=int, default=96)
     parser.add_argument("--frames", type=int, nargs="+", default=[48, 96])
     parser.add_argument("--time-error", action="store_true", help="the time-map error analysis instead")
+    parser.add_argument("--rays-error", action="store_true", help="the rays' error per method and anchor instead")
     args = parser.parse_args()
     if args.time_error:
         time_error()
+    elif args.rays_error:
+        rays_error()
     else:
         throughput(args.size, args.frames)
 

@@ -40,7 +40,7 @@ STEPS = {
     "methods-comparison": "methods_comparison", "light-methods": "light_methods",
     "outdoor-sample": "outdoor_sample",
     "bench-report": "bench_report", "render-lightfield": "render_lightfield",  # light field: and lightfield-<stage>
-    **{f"lightfield-{s}": f"lightfield_{s.replace('-', '_')}" for s in "hdr shadow-times rays render export accuracy report".split()}}
+    **{f"lightfield-{s}": f"lightfield_{s.replace('-', '_')}" for s in "hdr shadow-times rays render export truth accuracy report".split()}}
 
 
 def build_parser(steps=None):

@@ -9,15 +9,16 @@ field of the rays on the equal-area direction chart at the capture's angular res
 (near + far camera pitch over the screen separation) against the true intensity
 integrated over the same cells: median relative error over cells above 5 % of the peak
 (target 5 %); the fraction of pixels with a ray
-(:func:`shadowcam.lightfield.accuracy.lightfield_accuracy`). Writes JSON and a quantity table CSV.
+(:func:`shadowcam.lightfield.accuracy.lightfield_accuracy`). The ground truth is
+``lightfield-truth``'s dataset. Writes JSON and a quantity table CSV.
 
 Example::
 
-    shadowcam lightfield-accuracy --manifest data_manifest/synthetic_lightfield.yaml \\
-        --capture results/synthetic_lightfield/lightfield/capture \\
+    shadowcam lightfield-accuracy --capture results/synthetic_lightfield/lightfield/capture \\
         --sweeps results/synthetic_lightfield/lightfield/shadow_times/*.nc \\
         --rays results/synthetic_lightfield/lightfield/rays.nc \\
         --renders results/synthetic_lightfield/lightfield/renders.nc \\
+        --truth results/synthetic_lightfield/lightfield/truth.nc \\
         --json results/synthetic_lightfield/lightfield/accuracy.json \\
         --csv results/synthetic_lightfield/lightfield/accuracy.csv
 
@@ -30,21 +31,20 @@ run : score and write the report.
 import json
 from pathlib import Path
 
+import numpy as np
+
 from shadowcam._shared.atomic import atomic_path
 from shadowcam._shared.quantity_table import table_to_csv
-from shadowcam.io.capture_plan import capture_plan
 from shadowcam.io.datasets import open_dataset
-from shadowcam.io.manifest import load_manifest
 from shadowcam.lightfield.accuracy import accuracy_rows, lightfield_accuracy
 from shadowcam.lightfield.photometry_export import far_field_grid, rays_resolution_deg
 from shadowcam.lightfield.stages import read_description, screen_maps
-from shadowcam.synthetic.lightfield.capture import capture_from_plan
 
 
 def add_parser(subparsers, name):
     """Register ``lightfield-accuracy`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="accuracy of a rendered light field")
-    for option, text in (("manifest", "data_manifest/<ds>.yaml (rendered, kind lightfield)"),
+    for option, text in (("truth", "ground-truth netCDF of lightfield-truth"),
                          ("capture", "capture folder with capture.json"), ("rays", "rays netCDF of lightfield-rays"),
                          ("renders", "renders netCDF of lightfield-render (lux)"),
                          ("json", "output JSON of the scores"), ("csv", "output quantity table CSV")):
@@ -55,16 +55,17 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Score the light field against the renderer's ground truth."""
-    source = capture_from_plan(capture_plan(args.manifest), load_manifest(args.manifest)["synthetic"]).source
+    truth, renders = open_dataset(args.truth), open_dataset(args.renders)
+    if not np.allclose(truth["position"].values, renders["position"].values):
+        raise ValueError(f"{args.truth} holds the truth at {truth['position'].values} mm but {args.renders} renders "
+                         f"{renders['position'].values} mm: run lightfield-truth on these renders again")
     sweeps = {tuple(Path(p).stem.rsplit("_", 1)): open_dataset(p) for p in args.sweeps}
     ray_set = open_dataset(args.rays)
     far = far_field_grid(ray_set["direction"].values, ray_set["flux"].values,
                          resolution_deg=rays_resolution_deg(ray_set))
-    far_truth = source.far_field_grid(resolution_deg=far.attrs["resolution_deg"], size=far.shape[0]).values
     scores = lightfield_accuracy(
-        open_dataset(args.renders), far, screen_maps(sweeps, read_description(args.capture)),
-        lambda z, shape, pitch: source.irradiance(centre=(0.0, 0.0, z), shape=shape, pixel_size=pitch),
-        far_truth=far_truth, flags=ray_set["flag"].values)
+        renders, far, screen_maps(sweeps, read_description(args.capture)),
+        truth["irradiance"].values, far_truth=truth["far_field"].values, flags=ray_set["flag"].values)
     with atomic_path(args.json) as tmp:
         tmp.write_text(json.dumps(scores, indent=1))
     with atomic_path(args.csv) as tmp:

@@ -1,7 +1,9 @@
 """``shadowcam lightfield-rays``: the rays of a light field from its screens' mask positions.
 
-A ray joins the near and the far screen's points with the same mask coordinates; its
-flux is the near screen's irradiance times the pixel's screen area
+A ray joins the near and the far screen's points with the same mask coordinates; it
+starts at a pixel of the ``--anchor`` screen (default the far one, whose partner point on
+the near screen moves least with the pixel's mask error) and its flux is that screen's
+irradiance times the pixel's screen area
 (:func:`shadowcam.lightfield.stages.rays_from_sweeps`). The netCDF ray table
 (``origin``, ``direction`` in mm, ``flux`` in lm, ``confidence``, ``flag``) is the
 open ray-set form (docs/contracts.md).
@@ -10,7 +12,7 @@ Example::
 
     shadowcam lightfield-rays --capture results/synthetic_lightfield/lightfield/capture \\
         --sweeps results/synthetic_lightfield/lightfield/shadow_times/{near_h,near_v,far_h,far_v}.nc \\
-        --out results/synthetic_lightfield/lightfield/rays.nc
+        --anchor far --out results/synthetic_lightfield/lightfield/rays.nc
 
 Offers
 ------
@@ -21,6 +23,7 @@ run : assemble and write the rays.
 from pathlib import Path
 
 from shadowcam.io.datasets import open_dataset, write_dataset
+from shadowcam.lightfield.rays import ANCHORS
 from shadowcam.lightfield.stages import rays_from_sweeps, read_description
 
 
@@ -29,6 +32,8 @@ def add_parser(subparsers, name):
     parser = subparsers.add_parser(name, help="rays of a light field")
     parser.add_argument("--capture", required=True, help="capture folder with capture.json")
     parser.add_argument("--sweeps", nargs="+", required=True, help="<screen>_<h|v>.nc of lightfield-shadow-times")
+    parser.add_argument("--anchor", choices=ANCHORS, default="far",
+                        help="screen whose pixels carry the rays (default far: the smaller direction error)")
     parser.add_argument("--out", required=True, help="output rays netCDF")
     return parser
 
@@ -36,5 +41,5 @@ def add_parser(subparsers, name):
 def run(args):
     """Assemble the rays."""
     sweeps = {tuple(Path(p).stem.rsplit("_", 1)): open_dataset(p) for p in args.sweeps}
-    ray_set = rays_from_sweeps(sweeps, read_description(args.capture))
+    ray_set = rays_from_sweeps(sweeps, read_description(args.capture), anchor=args.anchor)
     write_dataset(ray_set, args.out, inputs=tuple(sweeps.values()), step="lightfield-rays")

@@ -133,8 +133,8 @@ def lightfield_accuracy(renders, far_field, screens, truth, *, far_truth, flags)
         (:func:`shadowcam.lightfield.photometry_export.far_field_grid`, cd).
     screens : list of dict
         Captured screens nearest first: ``position_mm``, ``irradiance`` (H, W) lux, ``xy`` (H, W, 2) mm.
-    truth : callable
-        ``truth(position_mm, shape, pixel_size)`` -> (rows, cols) true irradiance on the render grid.
+    truth : (P, rows, cols) ndarray
+        True irradiance (lux) on each render's grid, in the renders' position order.
     far_truth : (S, S) ndarray, keyword-only
         True intensity integrated over the same cells (cd).
     flags : (H, W) ndarray, keyword-only
@@ -150,12 +150,13 @@ def lightfield_accuracy(renders, far_field, screens, truth, *, far_truth, flags)
         ``resolution_deg``; ``coverage``:
         fraction of pixels with a ray.
     """
+    truth = check_array(truth, "truth", ndim=3, shape=renders["irradiance"].shape)
     positions = [s["position_mm"] for s in screens]
     out = {"renders": {}, "coverage": float(np.mean(np.asarray(flags) == 0))}
     for k, z in enumerate(renders["position"].values):
         image = renders["irradiance"].values[k]
         pitch = float(renders["pixel_size"].values[k])
-        expected = truth(float(z), image.shape, pitch)
+        expected = truth[k]
         nearest = screens[int(np.argmin(np.abs(np.asarray(positions) - z)))]
         baseline = naive_baseline(nearest["irradiance"], nearest["xy"], position_mm=nearest["position_mm"],
                                   target_position_mm=float(z), target_shape=image.shape, pixel_size=pitch)

@@ -5,10 +5,10 @@ x) and a vertical one (a horizontal wire moving along y). Their shadow times at 
 camera pixel, turned into mask positions ``x_mask = start + step * time``, name the
 mask point the pixel's light passed through (paper VI, Fig. 17). A ray is the line
 through the near screen's point and the far screen's point with the same mask
-coordinates: its origin is on the near screen, its direction goes to the far one (the
-far point interpolated over the far screen's mask coordinates, Clough-Tocher C1 cubic on
-their Delaunay triangulation). Its flux is the near screen's irradiance times the pixel's
-screen area.
+coordinates: its origin is a pixel of the anchor screen (the far one by default), its
+direction goes to the other screen's point (interpolated over that screen's mask
+coordinates, Clough-Tocher C1 cubic on their Delaunay triangulation). Its flux is the
+anchor screen's irradiance times the pixel's screen area.
 
 The shadow times come from the lab wing's streaming dip tracker
 (:func:`shadowcam.lab.shadow_time.track_sweep`, memory independent of the number of
@@ -17,6 +17,7 @@ frames) fed HDR-merged frames (:func:`shadowcam.lightfield.hdr.merge_stream`).
 Offers
 ------
 REASONS : ray flag code -> meaning.
+ANCHORS : the screens a ray can start from.
 sweep_mask_positions : frames of one sweep (streamed) -> mask position per pixel, its std, flags, lit level.
 screen_mask_map : the two sweeps of one screen + its geometry -> the screen's mask-coordinate map.
 rays_dataset : near and far screen maps -> the rays dataset (row, col, axis).
@@ -117,14 +118,28 @@ def screen_mask_map(horizontal, vertical, *, xy, area, position_mm):
 #: (``"fit"``), be left out (``"drop"``), or take the nearest found ray's (``"nearest"``)
 EDGE_RAYS = ("fit", "drop", "nearest")
 
+#: the screen whose pixels carry the rays: the far one (default; its partner point lies on the
+#: near screen, of smaller magnification) or the near one
+ANCHORS = ("far", "near")
 
-def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edge_rays="fit"):
+
+def rays_dataset(near, far, *, anchor="far", mask_std_scale=0.05, smooth_directions=False, edge_rays="fit"):
     """The rays through the near and the far screens' points of equal mask coordinates.
+
+    Each ray starts at a pixel of the `anchor` screen (its point is known exactly) and goes
+    through the point of the other screen with the pixel's mask coordinates (interpolated over
+    that screen's mask map). The anchor pixel's mask error moves that point by the other
+    screen's magnification (screen mm per mask mm), so the direction error is the other
+    screen's magnification times the anchor's mask error over the separation: anchored on the
+    far screen, the other point is on the near screen, whose magnification is the smaller for
+    a diverging beam.
 
     Parameters
     ----------
     near, far : dict
         :func:`screen_mask_map` of the near and the far screen.
+    anchor : {"far", "near"}, keyword-only
+        :data:`ANCHORS`: the screen whose pixels carry the rays (origins, flux, grid).
     mask_std_scale : float, keyword-only
         Mask-coordinate standard deviation (mm) at which the confidence is ``exp(-1/2)``.
     smooth_directions : bool, keyword-only
@@ -139,20 +154,29 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
     Returns
     -------
     xarray.Dataset
-        On the near screen's pixel grid ``(row, col)``: ``origin`` and ``direction``
-        ``(row, col, axis)`` (mm; direction with unit z), ``irradiance`` (lux at the near
+        On the anchor screen's pixel grid ``(row, col)``: ``origin`` and ``direction``
+        ``(row, col, axis)`` (mm; direction with unit z), ``irradiance`` (lux at the anchor
         screen), ``flux`` (lm through the pixel), ``mask`` ``(row, col, mask_axis)`` mm,
         ``confidence`` in [0, 1], ``direction_std`` (per axis, from the noise model; of the
-        fit when smoothed) and ``flag`` (:data:`REASONS`). A pixel whose ray is not found
+        fit when smoothed) and ``flag`` (:data:`REASONS`; ``no_shadow_near`` means no shadow on
+        the anchor screen, ``no_match_far`` no match on the other). A pixel whose ray is not found
         (flag > 0, confidence 0, ``mask`` NaN) keeps its flag; by `edge_rays` its direction
         is the local fit's from its neighbours (with that fit's std), or NaN with flux 0
         (left out of renders), or the nearest found ray's. Attributes: the screens' positions and
         camera pitches (``near_pitch_mm``, ``far_pitch_mm``: square root of the median
-        pixel area).
+        pixel area), ``anchor`` and ``origin_position_mm``.
     """
+    check_in(anchor, "anchor", ANCHORS)
+    if not far["position_mm"] > near["position_mm"]:
+        raise ValueError(f"far position_mm must be > near position_mm ({near['position_mm']}); got {far['position_mm']}")
+    screens = {"near": near, "far": far}
+    attrs = {"near_position_mm": near["position_mm"], "far_position_mm": far["position_mm"],
+             "convention": "lengths in mm; +z from the source",
+             "near_pitch_mm": float(np.sqrt(np.median(near["area"]))),
+             "far_pitch_mm": float(np.sqrt(np.median(far["area"]))), "anchor": anchor}
+    near, far = screens[anchor], screens["near" if anchor == "far" else "far"]  # anchor, other
     z1, z2 = near["position_mm"], far["position_mm"]
-    if not z2 > z1:
-        raise ValueError(f"far position_mm must be > near position_mm ({z1}); got {z2}")
+    attrs["origin_position_mm"] = z1
     check_positive(mask_std_scale, "mask_std_scale", finite=True)
     check_in(edge_rays, "edge_rays", EDGE_RAYS)
     shape = near["ok"].shape
@@ -160,8 +184,8 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
     flag[~near["ok"]] = NO_SHADOW_NEAR
     far_ok = far["ok"]
     if far_ok.sum() < 3:
-        raise ValueError(f"far screen must have at least 3 pixels with shadow times of both sweeps; got "
-                         f"{int(far_ok.sum())}: check the far screen's sweeps")
+        raise ValueError(f"{'near' if anchor == 'far' else 'far'} screen must have at least 3 pixels with shadow "
+                         f"times of both sweeps; got {int(far_ok.sum())}: check that screen's sweeps")
     magnification = far_magnification(far["mask"], far["xy"], far_ok)
     interpolate = LinearNDInterpolator(far["mask"][far_ok], np.c_[far["xy"][far_ok], far["mask_std"][far_ok],
                                                                   magnification[far_ok]])
@@ -182,7 +206,7 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
     x1 = near["xy"]
     origin = np.concatenate([x1, np.full(shape + (1,), z1)], -1)
     measured = np.where(good[..., None], (matched[..., :2] - x1) / (z2 - z1), np.nan)
-    noise = np.where(good, direction_noise(near["mask_std"], matched[..., 2], matched[..., 3], separation_mm=z2 - z1),
+    noise = np.where(good, direction_noise(near["mask_std"], matched[..., 2], matched[..., 3], separation_mm=abs(z2 - z1)),
                      np.nan)
     noise = np.where(np.isfinite(noise) | ~good, noise, np.nanmedian(noise) if np.isfinite(noise).any() else 1.0)
     if smooth_directions or edge_rays == "fit":
@@ -215,9 +239,9 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
     dims2, dims3 = ("row", "col"), ("row", "col", "axis")
     return xr.Dataset(
         {
-            "origin": (dims3, origin, {"units": "mm", "long_name": "ray origin on the near screen"}),
+            "origin": (dims3, origin, {"units": "mm", "long_name": "ray origin on the anchor screen"}),
             "direction": (dims3, direction, {"units": "1", "long_name": "ray direction (dz = 1)"}),
-            "irradiance": (dims2, irradiance, {"units": "lx", "long_name": "near-screen irradiance"}),
+            "irradiance": (dims2, irradiance, {"units": "lx", "long_name": "anchor-screen irradiance"}),
             "flux": (dims2, flux, {"units": "lm", "long_name": "flux of the ray tube through the pixel"}),
             "mask": (("row", "col", "mask_axis"), mask, {"units": "mm", "long_name": "mask point of the ray"}),
             "direction_std": (dims2, slope_std, {"units": "1", "long_name": "per-axis std of the ray direction"}),
@@ -227,9 +251,7 @@ def rays_dataset(near, far, *, mask_std_scale=0.05, smooth_directions=False, edg
         },
         coords={"row": np.arange(shape[0]), "col": np.arange(shape[1]), "axis": ["x", "y", "z"],
                 "mask_axis": ["x", "y"]},
-        attrs={"near_position_mm": z1, "far_position_mm": z2, "convention": "lengths in mm; +z from the source",
-               "near_pitch_mm": float(np.sqrt(np.median(near["area"]))),
-               "far_pitch_mm": float(np.sqrt(np.median(far["area"])))},
+        attrs=attrs,
     )
 
 

@@ -224,13 +224,15 @@ def splat_tubes(u, v, flux, *, shape, pitch):
     Returns
     -------
     (rows, cols) float64 ndarray
-        Flux per cell (flux outside the grid is dropped).
+        Flux per cell (flux outside the grid is dropped); >= 0 where every flux is.
     """
     tri_u, tri_v = tube_triangles(u, v)
     weights = np.broadcast_to(0.25 * np.asarray(flux, np.float64), tri_u.shape[:3])
     cols = tri_u.reshape(-1, 3) / pitch + (shape[1] - 1) / 2
     rows = tri_v.reshape(-1, 3) / pitch + (shape[0] - 1) / 2
-    return splat_polygons(rows, cols, weights.ravel(), shape)
+    grid = splat_polygons(rows, cols, weights.ravel(), shape)
+    # shares of a flux >= 0 are >= 0: the quadrant areas' differences leave round-off below 0
+    return np.maximum(grid, 0.0) if not np.any(weights < 0) else grid
 
 
 def irradiance_on_plane(rays, *, centre, shape, pixel_size, normal=(0.0, 0.0, 1.0), up=(0.0, 1.0, 0.0)):

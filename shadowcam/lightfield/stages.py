@@ -237,14 +237,14 @@ def screen_maps(sweeps, description):
     return maps
 
 
-def rays_from_sweeps(sweeps, description, *, mask_std_scale=0.05):
+def rays_from_sweeps(sweeps, description, *, anchor="far", mask_std_scale=0.05):
     """The rays dataset of a capture: its two nearest screens' :func:`screen_maps` joined.
 
     Parameters
     ----------
     sweeps, description
         As :func:`screen_maps`.
-    mask_std_scale : float, keyword-only
+    anchor, mask_std_scale : keyword-only
         As :func:`shadowcam.lightfield.rays.rays_dataset`.
 
     Returns
@@ -252,7 +252,7 @@ def rays_from_sweeps(sweeps, description, *, mask_std_scale=0.05):
     xarray.Dataset
     """
     maps = screen_maps(sweeps, description)
-    return rays.rays_dataset(maps[0], maps[1], mask_std_scale=mask_std_scale)
+    return rays.rays_dataset(maps[0], maps[1], anchor=anchor, mask_std_scale=mask_std_scale)
 
 
 def render_grid(description, shape, position_mm, *, pitch_factor):

@@ -63,15 +63,42 @@ def _screen(z, shape=(24, 24), pitch=1.0, hole=None):
 
 def test_edge_rays_get_the_local_fit_direction_and_are_flagged():
     hole = (slice(0, 24), slice(0, 3))                    # beam edge: no correspondence on the left
-    ray_set = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="fit")
+    ray_set = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="fit", anchor="near")
     xy = _screen(100.0)["xy"]
     expected = xy / 100.0                                 # a point source at the origin: d = x / z
     assert np.all(ray_set["flag"].values[hole] == rays.NO_SHADOW_NEAR)
     assert np.allclose(ray_set["direction"].values[..., :2], expected, atol=1e-9)  # linear field: exact
     assert np.all(np.isfinite(ray_set["direction_std"].values[hole]))
-    nearest = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="nearest")
+    nearest = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="nearest", anchor="near")
     assert not np.allclose(nearest["direction"].values[hole][..., :2], expected[hole], atol=1e-3)
-    dropped = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="drop")
+    dropped = rays.rays_dataset(_screen(100.0, hole=hole), _screen(200.0), edge_rays="drop", anchor="near")
     assert np.all(dropped["flux"].values[hole] == 0) and np.all(dropped["flux"].values[:, 3:] > 0)
     with pytest.raises(ValueError, match="edge_rays"):
         rays.rays_dataset(_screen(100.0), _screen(200.0), edge_rays="borrow")
+
+
+def test_far_anchored_rays_err_by_the_near_screens_smaller_magnification():
+    # rays from a point source at the origin, mask at 50 mm, screens at 100 and 200 mm: screen mm
+    # per mask mm 2 (near) and 4 (far); independent mask noise of the same std on both screens.
+    # A ray's direction error is the other screen's magnification times the anchor's mask error
+    # over the separation: 4 sigma / 100 anchored near, 2 sigma / 100 anchored far.
+    rng = np.random.default_rng(3)
+    sigma = 0.02
+    errors = {}
+    for anchor in rays.ANCHORS:
+        near, far = _screen(100.0, shape=(48, 48), pitch=0.5), _screen(200.0, shape=(48, 48), pitch=0.5)
+        for screen in (near, far):
+            screen["mask"] = screen["mask"] + rng.normal(0.0, sigma, screen["mask"].shape)
+            screen["mask_std"] = np.full(screen["ok"].shape, sigma * np.sqrt(2))
+        ray_set = rays.rays_dataset(near, far, anchor=anchor)
+        origin = ray_set["origin"].values
+        assert np.all(origin[..., 2] == (100.0 if anchor == "near" else 200.0))
+        truth = origin[..., :2] / origin[..., 2:]                  # d = x / z through the anchor pixel
+        inner = (slice(4, -4), slice(4, -4))
+        d = ray_set["direction"].values[..., :2]
+        errors[anchor] = np.sqrt(np.mean((d - truth)[inner] ** 2))  # per-axis rms
+    # per axis: g_other * (anchor's mask error - the other map's, interpolated) / 100, at most
+    # g_other sqrt(2) sigma / 100; the two anchors' ratio is the magnifications' 2 / 4 (15 % for
+    # 1600 rays' rms)
+    assert errors["far"] / errors["near"] == pytest.approx(0.5, rel=0.15)
+    assert errors["near"] == pytest.approx(4 * sigma * np.sqrt(2) / 100.0, rel=0.2)

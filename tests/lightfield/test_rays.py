@@ -35,7 +35,7 @@ def _curved_screen(z, n=32, pitch=1.0):
 def test_far_point_follows_the_curvature_of_the_far_map():
     near, far = _curved_screen(100.0), _curved_screen(200.0)
     truth = _direction(near["mask"])                       # exact mask points: only the far map's interpolation errs
-    got = rays.rays_dataset(near, far)["direction"].values[..., :2]
+    got = rays.rays_dataset(near, far, anchor="near")["direction"].values[..., :2]
     inner = (slice(2, -2), slice(2, -2))                   # away from the far grid's hull
     error = np.hypot(*(got - truth)[inner].reshape(-1, 2).T)
     linear = LinearNDInterpolator(far["mask"].reshape(-1, 2), far["xy"].reshape(-1, 2))(near["mask"])
@@ -48,6 +48,6 @@ def test_far_point_follows_the_curvature_of_the_far_map():
 def test_a_dark_pixels_negative_hdr_estimate_carries_no_flux():
     near, far = _curved_screen(100.0), _curved_screen(200.0)
     near["irradiance"] = np.where(np.arange(32)[None, :] < 4, -0.01, 1.0) * np.ones((32, 1))  # read noise below 0
-    ray_set = rays.rays_dataset(near, far)
+    ray_set = rays.rays_dataset(near, far, anchor="near")
     assert np.all(ray_set["flux"].values[:, :4] == 0) and np.all(ray_set["flux"].values[:, 4:] > 0)
     assert np.all(ray_set["irradiance"].values[:, :4] < 0)  # the measurement itself is kept

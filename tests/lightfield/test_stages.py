@@ -65,7 +65,7 @@ def _screen(z, irradiance):
 def test_a_pixel_saturated_in_every_bracket_gets_the_saturated_reason_not_a_guessed_flux():
     near_e = np.full((9, 9), 100.0)
     near_e[4, 6] = np.nan  # every bracket saturated in the HDR merge
-    ray_set = rays.rays_dataset(_screen(250.0, near_e), _screen(450.0, np.full((9, 9), 30.0)))
+    ray_set = rays.rays_dataset(_screen(250.0, near_e), _screen(450.0, np.full((9, 9), 30.0)), anchor="near")
     assert ray_set["flag"].values[4, 6] == rays.SATURATED
     assert rays.REASONS[rays.SATURATED] == "saturated"
     assert np.isnan(ray_set["flux"].values[4, 6]) and ray_set["confidence"].values[4, 6] == 0

@@ -23,7 +23,7 @@ def test_lightfield_manifest_runs_end_to_end_with_exports_and_report(tmp_path, w
     dry = snakemake(["-n", "--quiet", "rules", *config], workdir)
     assert dry.returncode == 0, dry.stdout
     for rule in ("render_lightfield", "lightfield_hdr", "lightfield_shadow_times", "lightfield_rays",
-                 "lightfield_render", "lightfield_export", "lightfield_accuracy", "lightfield_report"):
+                 "lightfield_render", "lightfield_export", "lightfield_truth", "lightfield_accuracy", "lightfield_report"):
         assert rule in dry.stdout, rule
     assert "decode" not in dry.stdout and "dual_view" not in dry.stdout
     result = snakemake(["--cores", "2", *config], workdir)
@@ -51,10 +51,10 @@ def test_lightfield_manifest_runs_end_to_end_with_exports_and_report(tmp_path, w
 
     scores = json.loads((out / "accuracy.json").read_text())
     between, beyond = scores["renders"]["350"], scores["renders"]["675"]
-    assert between["ratio"] <= 0.5 and beyond["ratio"] <= 0.5  # at pitch_factor 2 (config)
+    assert between["ratio"] <= 0.5 and beyond["ratio"] <= 0.5  # pitch_factor 2, far anchor (config): measured 0.26 / 0.22
     assert between["bandpass_render"] >= 0.9 and beyond["bandpass_render"] >= 0.9
-    # open: the far field is 7.8 % off at the capture's resolution (target 5 %); hold it to the measured figure
-    assert scores["far_field"]["median_error"] <= 0.09
+    # open: the far field is 6.0 % off at the capture's resolution (target 5 %); hold it to the measured figure
+    assert scores["far_field"]["median_error"] <= 0.065
     assert scores["coverage"] >= 0.5
     table_csv = (out / "accuracy.csv").read_text()
     assert "far-field intensity median |error|" in table_csv and "<= 5" in table_csv
@@ -79,4 +79,4 @@ def test_captured_lightfield_manifest_runs_with_bracket_times_from_the_files(
         assert (ray_set["flag"].values == 0).mean() >= 0.4
     for name in ("renders.nc", "source.ies", "source.ldt", "figures/inputs.png", "figures/time_maps.png"):
         assert (out / name).is_file(), name
-    assert not (out / "accuracy.json").exists()  # no ground truth in a captured manifest
+    assert not (out / "accuracy.json").exists() and not (out / "truth.nc").exists()  # no ground truth when captured

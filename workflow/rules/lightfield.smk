@@ -1,7 +1,8 @@
 # Stage: light-field captures (manifest kind lightfield, paper VI, Fig. 17): render the
 # capture (synthetic) or describe it from the manifest (captured), merge each sweep's
 # exposure brackets to HDR, the wire's shadow times per screen and sweep, the rays, renders at config lightfield.render_positions_m,
-# the IES / EULUMDAT candela files, accuracy (with ground truth) and the report figures.
+# the IES / EULUMDAT candela files, the ground truth once (rendered captures), accuracy
+# and the report figures.
 # Outputs live under results/{ds}/lightfield/; input functions in lightfield_inputs.smk.
 
 
@@ -79,9 +80,11 @@ rule lightfield_rays:
     resources:
         mem_mb=get_lightfield_mem_mb,
         runtime=15,
+    params:
+        anchor=config["lightfield"]["ray_anchor"],
     shell:
         "shadowcam lightfield-rays --capture {input.capture} --sweeps {input.sweeps}"
-        " --out {output} > {log} 2>&1"
+        " --anchor {params.anchor} --out {output} > {log} 2>&1"
 
 
 rule lightfield_render:
@@ -133,13 +136,34 @@ rule lightfield_export:
         " --table {output.table} > {log} 2>&1"
 
 
-rule lightfield_accuracy:
+rule lightfield_truth:
     input:
         manifest="data_manifest/{ds}.yaml",
+        rays="results/{ds}/lightfield/rays.nc",
+        renders="results/{ds}/lightfield/renders.nc",
+    output:
+        "results/{ds}/lightfield/truth.nc",
+    log:
+        "logs/{ds}/lightfield_truth.log",
+    benchmark:
+        "benchmarks/{ds}/lightfield_truth.tsv"
+    conda:
+        "../envs/shadowcam.yaml"
+    resources:
+        mem_mb=get_lightfield_export_mem_mb,
+        runtime=15,
+    shell:
+        "shadowcam lightfield-truth --manifest {input.manifest} --rays {input.rays}"
+        " --renders {input.renders} --out {output} > {log} 2>&1"
+
+
+rule lightfield_accuracy:
+    input:
         capture=get_lightfield_capture,
         sweeps=get_lightfield_sweeps,
         rays="results/{ds}/lightfield/rays.nc",
         renders="results/{ds}/lightfield/renders.nc",
+        truth="results/{ds}/lightfield/truth.nc",
     output:
         json="results/{ds}/lightfield/accuracy.json",
         csv="results/{ds}/lightfield/accuracy.csv",
@@ -153,18 +177,18 @@ rule lightfield_accuracy:
         mem_mb=get_lightfield_export_mem_mb,
         runtime=15,
     shell:
-        "shadowcam lightfield-accuracy --manifest {input.manifest} --capture {input.capture}"
-        " --sweeps {input.sweeps} --rays {input.rays} --renders {input.renders}"
+        "shadowcam lightfield-accuracy --capture {input.capture} --sweeps {input.sweeps}"
+        " --rays {input.rays} --renders {input.renders} --truth {input.truth}"
         " --json {output.json} --csv {output.csv} > {log} 2>&1"
 
 
 rule lightfield_report:
     input:
-        manifest="data_manifest/{ds}.yaml",
         hdr=get_lightfield_hdr,
         sweeps=get_lightfield_sweeps,
         renders="results/{ds}/lightfield/renders.nc",
         table="results/{ds}/lightfield/far_field.nc",
+        truth=get_lightfield_truth,
     output:
         report(
             directory("results/{ds}/lightfield/figures"),
@@ -182,7 +206,9 @@ rule lightfield_report:
     resources:
         mem_mb=get_lightfield_export_mem_mb,
         runtime=15,
+    params:
+        truth=lambda wildcards, input: f"--truth {input.truth}" if input.truth else "",
     shell:
-        "shadowcam lightfield-report --manifest {input.manifest} --hdr {input.hdr}"
-        " --sweeps {input.sweeps} --renders {input.renders} --table {input.table}"
+        "shadowcam lightfield-report --hdr {input.hdr} --sweeps {input.sweeps}"
+        " --renders {input.renders} --table {input.table} {params.truth}"
         " --outdir {output} > {log} 2>&1"

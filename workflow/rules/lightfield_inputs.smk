@@ -38,6 +38,13 @@ def get_lightfield_hdr(wildcards):
     return lightfield_files(wildcards.ds, "hdr", ".npy")
 
 
+def get_lightfield_truth(wildcards):
+    """The ground truth of a rendered light field (for its report figures); none for a captured one."""
+    if not _lightfield_plan(wildcards.ds).has_ground_truth:
+        return []
+    return f"results/{wildcards.ds}/lightfield/truth.nc"
+
+
 def lightfield_targets(ds):
     """Final outputs of light-field dataset `ds` (list of str)."""
     out = f"results/{ds}/lightfield"
