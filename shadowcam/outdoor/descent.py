@@ -41,7 +41,7 @@ RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: 
 STATE_CODE = {name: code for code, name in RAMP_STATES.items()}
 #: pixels each side whose fitted durations steady a noisy ramp (:func:`fit_descents`)
 NEIGHBOUR_RADIUS = 3
-#: pixels fitted at once (bounds the (N, K, 4, 4) normal equations)
+#: pixels fitted at once (bounds the (N, K) float64 series gathered from the buffer)
 _CHUNK = 4096
 
 

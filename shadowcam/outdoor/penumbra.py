@@ -16,7 +16,9 @@ The pixel's normalised luminance (coverage) is ``S + (L - S) v``: the lit and sh
 levels are fitted with the ramp, so level errors of the first pass do not move ``t_c``.
 
 :func:`fit_ramps` fits ``(t_c, D, L, S)`` (or ``(t_c, L, S)`` with ``D`` given) by
-Levenberg-Marquardt from a grid start, pixel by pixel in vectorised batches, with the
+Levenberg-Marquardt from a grid start, pixel by pixel in a compiled kernel
+(:mod:`shadowcam.outdoor.ramp_kernels`; work proportional to the samples, no per-pixel
+arrays beyond the series), with the
 centre's standard error from the fit residual. A ramp with fewer than ``min_samples``
 samples inside it is shorter than the sampling resolves: the fit's centre is then not
 determined by the law and the caller keeps the level crossing between the two frames
@@ -33,9 +35,14 @@ coherent_durations : the median fitted duration of each pixel's confident neighb
 import numpy as np
 
 from shadowcam._shared.validation import check_positive
+from shadowcam.outdoor.ramp_kernels import fit_ramp_pixels
 
 #: fit parameters, in order
 PARAMETERS = ("centre_s", "duration_s", "lit", "shadow")
+#: centre shifts of the grid start, in durations about the guess
+_SHIFTS = np.array([-0.4, -0.2, 0.0, 0.2, 0.4])
+#: centre step (intervals) below which a Levenberg-Marquardt fit has converged
+_TOLERANCE = 1e-9
 
 
 def visible_fraction(u):
@@ -76,35 +83,6 @@ def ramp_model(time_s, *, centre_s, duration_s, lit, shadow):
         raise ValueError("duration_s must be > 0")
     u = 2.0 * (np.asarray(time_s, dtype=np.float64) - centre_s) / duration_s
     return shadow + (np.asarray(lit) - shadow) * visible_fraction(u)
-
-
-def _levels(v, y, w):
-    """Least-squares lit and shadow levels of ``y = S (1 - v) + L v`` (weights `w` = finite samples)."""
-    a = v * w
-    b = (1.0 - v) * w
-    aa, bb, ab = (a * v).sum(-1), (b * (1.0 - v)).sum(-1), (a * (1.0 - v)).sum(-1)
-    ay, by = (a * y).sum(-1), (b * y).sum(-1)
-    det = aa * bb - ab * ab
-    ok = det > 1e-9 * np.maximum(aa * bb, 1e-30)
-    safe = np.where(ok, det, 1.0)
-    lit = np.where(ok, (ay * bb - by * ab) / safe, np.nan)
-    shadow = np.where(ok, (by * aa - ay * ab) / safe, np.nan)
-    return lit, shadow
-
-
-def _residual_and_jacobian(t, y, w, p, free):
-    tc, q, lit, shadow = (p[:, i:i + 1] for i in range(4))
-    duration = np.exp(q)
-    u = 2.0 * (t - tc) / duration
-    inside = np.abs(u) < 1.0
-    uc = np.clip(u, -1.0, 1.0)
-    v = (np.arccos(uc) - uc * np.sqrt(1.0 - uc * uc)) / np.pi
-    dv_du = np.where(inside, -(2.0 / np.pi) * np.sqrt(1.0 - uc * uc), 0.0)
-    r = (y - (shadow + (lit - shadow) * v)) * w
-    amp = (lit - shadow) * dv_du
-    columns = [amp * (-2.0 / duration), amp * (-u), v, 1.0 - v]
-    jac = np.stack(columns, axis=-1) * w[..., None] * free[:, None, :]
-    return r, jac, inside
 
 
 def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samples=3, iterations=30):
@@ -158,57 +136,25 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
     fixed = np.full(n, np.nan) if duration_s is None else np.asarray(duration_s, dtype=np.float64).reshape(-1)
     if fixed.shape != (n,):
         raise ValueError(f"duration_s must be ({n},); got shape {np.shape(duration_s)}")
-    w = np.isfinite(y) & np.isfinite(t)
-    y = np.where(w, y, 0.0)
-    t = np.where(w, t, 0.0)
-    wf = w.astype(np.float64)
-    # the grid depends on the series' length only (pixels fitted together or apart agree)
     span = float(interval_s) * max(y.shape[1] - 1, 1)
     start = np.where(np.isfinite(c0), c0, 0.0)
-    # grid start: durations from half an interval to twice the span, centres around the guess
-    best = np.full(n, np.inf)
-    p = np.zeros((n, 4))
-    for duration in interval_s * np.geomspace(0.5, max(2.0 * span / interval_s, 1.0), 14):
-        dur = np.where(np.isfinite(fixed), fixed, duration)
-        for shift in (-0.4, -0.2, 0.0, 0.2, 0.4):
-            tc = start + shift * dur
-            v = visible_fraction(2.0 * (t - tc[:, None]) / dur[:, None])
-            lit, shadow = _levels(v, y, wf)
-            sse = (((y - (shadow[:, None] + (lit - shadow)[:, None] * v)) * wf) ** 2).sum(-1)
-            better = np.isfinite(sse) & (sse < best)
-            best[better] = sse[better]
-            p[better] = np.stack([tc, np.log(dur), lit, shadow], axis=-1)[better]
+    # grid start (it depends on the series' length only: pixels fitted together or apart agree):
+    # durations from half an interval to twice the span, centres around the guess
+    durations = interval_s * np.geomspace(0.5, max(2.0 * span / interval_s, 1.0), 14)
+    bounds = np.log([0.05 * interval_s, 4.0 * span + interval_s])
+    p, sse, jtj, lag, n_inside, count = fit_ramp_pixels(
+        np.ascontiguousarray(t), np.ascontiguousarray(y), start, fixed, durations, _SHIFTS, bounds, int(iterations),
+        _TOLERANCE * float(interval_s))
     free = np.ones((n, 4))
     free[np.isfinite(fixed), 1] = 0.0
-    lam = np.full(n, 1e-3)
-    r, jac, inside = _residual_and_jacobian(t, y, wf, p, free)
-    sse = (r * r).sum(-1)
-    eye = np.eye(4)
-    for _ in range(int(iterations)):
-        jtj = np.einsum("nki,nkj->nij", jac, jac)
-        jtr = np.einsum("nki,nk->ni", jac, r)
-        diag = np.einsum("nii->ni", jtj)
-        scale = np.maximum(diag, 1e-12 * (diag.max(-1, keepdims=True) + 1e-30))
-        step = np.linalg.solve(jtj + lam[:, None, None] * scale[:, :, None] * eye + 1e-12 * eye,
-                               jtr[..., None])[..., 0] * free
-        trial = p + step
-        trial[:, 1] = np.clip(trial[:, 1], np.log(0.05 * interval_s), np.log(4.0 * span + interval_s))
-        r2, jac2, inside2 = _residual_and_jacobian(t, y, wf, trial, free)
-        sse2 = (r2 * r2).sum(-1)
-        good = np.isfinite(sse2) & (sse2 <= sse)
-        p[good], r[good], jac[good], inside[good], sse[good] = trial[good], r2[good], jac2[good], inside2[good], sse2[good]
-        lam = np.where(good, np.maximum(lam / 3.0, 1e-9), np.minimum(lam * 10.0, 1e9))
-    count = wf.sum(-1)
     n_params = free.sum(-1)
-    jtj = np.einsum("nki,nkj->nij", jac, jac) + (1.0 - free)[:, :, None] * eye  # fixed: unit diagonal
-    pair = w[:, 1:] & w[:, :-1]
+    jtj = jtj + (1.0 - free)[:, :, None] * np.eye(4)  # fixed: unit diagonal
     with np.errstate(invalid="ignore", divide="ignore"):
-        rho = np.clip((r[:, 1:] * r[:, :-1] * pair).sum(-1) / np.maximum(sse, 1e-300), 0.0, 0.95)
+        rho = np.clip(lag / np.maximum(sse, 1e-300), 0.0, 0.95)
         cond_ok = np.linalg.cond(jtj) < 1e12
         cov = np.linalg.pinv(jtj)
         sigma = np.sqrt(np.maximum(sse / np.maximum(count - n_params, 1), 0.0) * cov[:, 0, 0]
                         * (1.0 + rho) / (1.0 - rho))
-    n_inside = (inside & w).sum(-1)
     sigma = np.where(cond_ok & (n_inside >= 2) & np.isfinite(sigma), sigma, np.inf)
     duration = np.exp(p[:, 1])
     centre = np.where(np.isfinite(c0), p[:, 0], np.nan)

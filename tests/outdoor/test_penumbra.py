@@ -99,3 +99,19 @@ def test_neighbours_duration_is_the_median_of_the_confident_ones():
     assert np.isnan(coherent_durations(duration, np.zeros_like(confident), radius=1)).all()
     with pytest.raises(ValueError, match="radius"):
         coherent_durations(duration, confident, radius=-1)
+
+
+def test_each_pixel_is_fitted_alone_whatever_its_batch_and_its_gaps():
+    centre, series = _ramps(30, 6, noise=0.02, seed=11)
+    series[2, 50:53] = np.nan  # a gap inside the ramp
+    series[4, :20] = np.nan  # a short record
+    together = fit_ramps(series, TIMES, centre_s=centre, interval_s=INTERVAL)
+    for i in range(series.shape[0]):
+        alone = fit_ramps(series[i:i + 1], TIMES, centre_s=centre[i:i + 1], interval_s=INTERVAL)
+        for key in ("centre_s", "duration_s", "sigma_s", "n_inside"):
+            assert alone[key][0] == together[key][i]
+    # the gap's samples take no part: the same series without them (times kept) gives the same fit
+    kept = np.isfinite(series[2])
+    short = fit_ramps(series[2:3, kept], TIMES[kept], centre_s=centre[2:3], interval_s=INTERVAL)
+    assert short["n_inside"][0] == together["n_inside"][2]
+    assert abs(short["centre_s"][0] - centre[2]) / INTERVAL <= 0.5

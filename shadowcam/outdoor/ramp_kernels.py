@@ -1,0 +1,250 @@
+"""Compiled per-pixel fit of the disc-sun ramp (numba).
+
+One pixel at a time (pixels in parallel with ``prange``): its finite samples are gathered
+once, the grid start is scanned, then Levenberg-Marquardt steps are taken with the 4x4
+normal equations accumulated in the same pass as the residual and solved by Gaussian
+elimination; the steps stop once the damping is small and the centre's and the log
+duration's steps are below ``1e-9`` of an interval (a converged fit does not move further).
+All arithmetic is float64. The law and the fit are those of
+:func:`shadowcam.outdoor.penumbra.fit_ramps`, which validates the inputs and turns the
+normal equations into the centre's standard error.
+
+Offers
+------
+fit_ramp_pixels : grid start and Levenberg-Marquardt fit of every pixel's series.
+"""
+
+import numba as nb
+import numpy as np
+
+_INV_PI = 1.0 / np.pi
+_TWO_OVER_PI = 2.0 / np.pi
+
+
+@nb.njit(cache=True, inline="always")
+def _segment(u):
+    """(v, sqrt(1 - u^2)) of the clipped `u`: the visible fraction and its slope's root."""
+    if u >= 1.0:
+        return 0.0, 0.0
+    if u <= -1.0:
+        return 1.0, 0.0
+    root = np.sqrt(1.0 - u * u)
+    return (np.arccos(u) - u * root) * _INV_PI, root
+
+
+@nb.njit(cache=True)
+def _grid_sse(t, y, m, yy, tc, dur, out):
+    """Least-squares levels of the ramp (tc, dur) and its residual (one pass: ``yy - L a.y - S b.y`` at the
+    solution of the normal equations, `yy` the sum of squares); `out` = (lit, shadow); inf if degenerate."""
+    aa = 0.0
+    bb = 0.0
+    ab = 0.0
+    ay = 0.0
+    by = 0.0
+    for k in range(m):
+        v, _ = _segment(2.0 * (t[k] - tc) / dur)
+        c = 1.0 - v
+        aa += v * v
+        bb += c * c
+        ab += v * c
+        ay += v * y[k]
+        by += c * y[k]
+    det = aa * bb - ab * ab
+    if not det > 1e-9 * max(aa * bb, 1e-30):
+        return np.inf
+    lit = (ay * bb - by * ab) / det
+    shadow = (by * aa - ay * ab) / det
+    out[0] = lit
+    out[1] = shadow
+    return max(yy - lit * ay - shadow * by, 0.0)
+
+
+@nb.njit(cache=True)
+def _normal(t, y, m, p, free_q, jtj, jtr):
+    """Residual sum of squares at `p` and the normal equations ``J^T J``, ``J^T r`` (filled in place)."""
+    tc, q, lit, shadow = p[0], p[1], p[2], p[3]
+    duration = np.exp(q)
+    for i in range(4):
+        jtr[i] = 0.0
+        for j in range(4):
+            jtj[i, j] = 0.0
+    col = np.empty(4)
+    sse = 0.0
+    for k in range(m):
+        u = 2.0 * (t[k] - tc) / duration
+        v, root = _segment(u)
+        r = y[k] - (shadow + (lit - shadow) * v)
+        amp = (lit - shadow) * (-_TWO_OVER_PI) * root
+        col[0] = amp * (-2.0 / duration)
+        col[1] = amp * (-u) * free_q
+        col[2] = v
+        col[3] = 1.0 - v
+        sse += r * r
+        for i in range(4):
+            jtr[i] += col[i] * r
+            for j in range(i, 4):
+                jtj[i, j] += col[i] * col[j]
+    for i in range(4):
+        for j in range(i):
+            jtj[i, j] = jtj[j, i]
+    return sse
+
+
+@nb.njit(cache=True)
+def _solve4(a, b, x):
+    """Solve the 4x4 system ``a x = b`` by Gaussian elimination with partial pivoting (`a`, `b` overwritten)."""
+    for c in range(4):
+        piv = c
+        for r in range(c + 1, 4):
+            if abs(a[r, c]) > abs(a[piv, c]):
+                piv = r
+        if piv != c:
+            for j in range(4):
+                a[c, j], a[piv, j] = a[piv, j], a[c, j]
+            b[c], b[piv] = b[piv], b[c]
+        for r in range(c + 1, 4):
+            f = a[r, c] / a[c, c]
+            for j in range(c, 4):
+                a[r, j] -= f * a[c, j]
+            b[r] -= f * b[c]
+    for c in range(3, -1, -1):
+        s = b[c]
+        for j in range(c + 1, 4):
+            s -= a[c, j] * x[j]
+        x[c] = s / a[c, c]
+
+
+@nb.njit(cache=True, parallel=True)
+def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, iterations, tolerance):
+    """Fit ``S + (L - S) v(2 (t - t_c) / exp(q))`` to each pixel's finite samples.
+
+    Parameters
+    ----------
+    t_all, y_all : (N, K) float64 ndarray
+        Times and values; a sample takes part where both are finite.
+    start : (N,) float64 ndarray
+        Centre guess (finite).
+    fixed : (N,) float64 ndarray
+        Known duration (NaN: fitted).
+    durations, shifts : (D,), (S,) float64 ndarray
+        Grid start: durations, and centre shifts in durations about the guess.
+    log_bounds : (2,) float64 ndarray
+        Bounds of the log duration.
+    iterations : int
+        Largest number of Levenberg-Marquardt steps.
+    tolerance : float
+        Step of the centre (s) below which a fit with small damping has converged.
+
+    Returns
+    -------
+    p : (N, 4) float64 ndarray
+        ``(t_c, log D, L, S)``.
+    sse : (N,) float64 ndarray
+        Residual sum of squares.
+    jtj : (N, 4, 4) float64 ndarray
+        Normal matrix at `p` (the row and column of a fixed duration are zero).
+    lag : (N,) float64 ndarray
+        Sum of the products of consecutive residuals (both samples finite).
+    n_inside : (N,) int64 ndarray
+        Finite samples strictly inside the ramp.
+    count : (N,) int64 ndarray
+        Finite samples.
+    """
+    n, kk = y_all.shape
+    p_out = np.zeros((n, 4))
+    sse_out = np.zeros(n)
+    jtj_out = np.zeros((n, 4, 4))
+    lag_out = np.zeros(n)
+    inside_out = np.zeros(n, np.int64)
+    count_out = np.zeros(n, np.int64)
+    for i in nb.prange(n):
+        t = np.empty(kk)
+        y = np.empty(kk)
+        index = np.empty(kk, np.int64)
+        m = 0
+        for k in range(kk):
+            if np.isfinite(t_all[i, k]) and np.isfinite(y_all[i, k]):
+                t[m] = t_all[i, k]
+                y[m] = y_all[i, k]
+                index[m] = k
+                m += 1
+        count_out[i] = m
+        yy = 0.0
+        for k in range(m):
+            yy += y[k] * y[k]
+        levels = np.empty(2)
+        p = np.zeros(4)
+        best = np.inf
+        known = np.isfinite(fixed[i])
+        for d in range(durations.size):
+            dur = fixed[i] if known else durations[d]
+            for s in range(shifts.size):
+                tc = start[i] + shifts[s] * dur
+                sse = _grid_sse(t, y, m, yy, tc, dur, levels)
+                if np.isfinite(sse) and sse < best:
+                    best = sse
+                    p[0] = tc
+                    p[1] = np.log(dur)
+                    p[2] = levels[0]
+                    p[3] = levels[1]
+            if known:
+                break
+        free_q = 0.0 if known else 1.0
+        jtj = np.empty((4, 4))
+        jtr = np.empty(4)
+        a = np.empty((4, 4))
+        b = np.empty(4)
+        step = np.empty(4)
+        trial = np.empty(4)
+        jtj2 = np.empty((4, 4))
+        jtr2 = np.empty(4)
+        sse = _normal(t, y, m, p, free_q, jtj, jtr)
+        lam = 1e-3
+        for _ in range(iterations):
+            dmax = max(max(jtj[0, 0], jtj[1, 1]), max(jtj[2, 2], jtj[3, 3]))
+            floor = 1e-12 * (dmax + 1e-30)
+            for r in range(4):
+                for c in range(4):
+                    a[r, c] = jtj[r, c]
+                a[r, r] += lam * max(jtj[r, r], floor) + 1e-12
+                b[r] = jtr[r]
+            _solve4(a, b, step)
+            step[1] *= free_q
+            for r in range(4):
+                trial[r] = p[r] + step[r]
+            trial[1] = min(max(trial[1], log_bounds[0]), log_bounds[1])
+            sse2 = _normal(t, y, m, trial, free_q, jtj2, jtr2)
+            if np.isfinite(sse2) and sse2 <= sse:
+                small = lam <= 1e-2 and abs(step[0]) <= tolerance and abs(step[1]) <= 1e-9
+                for r in range(4):
+                    p[r] = trial[r]
+                    jtr[r] = jtr2[r]
+                    for c in range(4):
+                        jtj[r, c] = jtj2[r, c]
+                sse = sse2
+                lam = max(lam / 3.0, 1e-9)
+                if small:
+                    break
+            else:
+                lam = min(lam * 10.0, 1e9)
+        duration = np.exp(p[1])
+        lag = 0.0
+        previous = 0.0
+        inside = 0
+        for k in range(m):
+            u = 2.0 * (t[k] - p[0]) / duration
+            v, _ = _segment(u)
+            r = y[k] - (p[3] + (p[2] - p[3]) * v)
+            if k > 0 and index[k] == index[k - 1] + 1:
+                lag += r * previous
+            previous = r
+            if abs(u) < 1.0:
+                inside += 1
+        for r in range(4):
+            p_out[i, r] = p[r]
+            for c in range(4):
+                jtj_out[i, r, c] = jtj[r, c]
+        sse_out[i] = sse
+        lag_out[i] = lag
+        inside_out[i] = inside
+    return p_out, sse_out, jtj_out, lag_out, inside_out, count_out
