@@ -30,6 +30,7 @@ visible_fraction : the circular-segment law v(u).
 ramp_model : coverage of a pixel over time for given centre, duration and levels.
 fit_ramps : per-pixel fit of the law to luminance series, with the centre's uncertainty.
 coherent_durations : the median fitted duration of each pixel's confident neighbours.
+neighbour_median : the median of each pixel's confident neighbours' values.
 """
 
 import numpy as np
@@ -85,7 +86,7 @@ def ramp_model(time_s, *, centre_s, duration_s, lit, shadow):
     return shadow + (np.asarray(lit) - shadow) * visible_fraction(u)
 
 
-def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samples=3, iterations=30):
+def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=None, min_samples=3, iterations=30):
     """Fit the disc-sun ramp to each pixel's series.
 
     The law ``S + (L - S) v(2 (t - t_c) / D)`` is fitted by Levenberg-Marquardt from a grid
@@ -109,6 +110,9 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
         Median capture interval (s): sets the grid of start durations.
     duration_s : (N,) ndarray, optional, keyword-only
         Known durations (s): only the centre and the levels are fitted (NaN: fitted too).
+    shadow : (N,) ndarray, optional, keyword-only
+        Known shadow levels (NaN: fitted). With the duration known too, only the centre
+        and the lit level are fitted: a ramp whose second half the sequence's end cut.
     min_samples : int, keyword-only
         Samples inside the fitted ramp needed for its centre to be resolved.
     iterations : int, keyword-only
@@ -136,6 +140,9 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
     fixed = np.full(n, np.nan) if duration_s is None else np.asarray(duration_s, dtype=np.float64).reshape(-1)
     if fixed.shape != (n,):
         raise ValueError(f"duration_s must be ({n},); got shape {np.shape(duration_s)}")
+    level = np.full(n, np.nan) if shadow is None else np.asarray(shadow, dtype=np.float64).reshape(-1)
+    if level.shape != (n,):
+        raise ValueError(f"shadow must be ({n},); got shape {np.shape(shadow)}")
     span = float(interval_s) * max(y.shape[1] - 1, 1)
     start = np.where(np.isfinite(c0), c0, 0.0)
     # grid start (it depends on the series' length only: pixels fitted together or apart agree):
@@ -143,10 +150,11 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
     durations = interval_s * np.geomspace(0.5, max(2.0 * span / interval_s, 1.0), 14)
     bounds = np.log([0.05 * interval_s, 4.0 * span + interval_s])
     p, sse, jtj, lag, n_inside, count = fit_ramp_pixels(
-        np.ascontiguousarray(t), np.ascontiguousarray(y), start, fixed, durations, _SHIFTS, bounds, int(iterations),
+        np.ascontiguousarray(t), np.ascontiguousarray(y), start, fixed, level, durations, _SHIFTS, bounds, int(iterations),
         _TOLERANCE * float(interval_s))
     free = np.ones((n, 4))
     free[np.isfinite(fixed), 1] = 0.0
+    free[np.isfinite(level), 3] = 0.0
     n_params = free.sum(-1)
     jtj = jtj + (1.0 - free)[:, :, None] * np.eye(4)  # fixed: unit diagonal
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -163,7 +171,60 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
             "rms": np.sqrt(sse / np.maximum(count, 1)), "n_inside": n_inside, "resolved": resolved}
 
 
-def coherent_durations(duration_s, confident, *, radius=3):
+def neighbour_median(values, confident, *, radius=3, at=None):
+    """Median of each pixel's confident, finite neighbours (the pixel included).
+
+    Parameters
+    ----------
+    values : (H, W) ndarray
+    confident : (H, W) bool ndarray
+        Pixels whose values are trusted.
+    radius : int or (int, int), keyword-only
+        Half size of the neighbourhood (pixels), or ``(rows, cols)``.
+    at : tuple of (N,) int ndarray, optional, keyword-only
+        ``(rows, cols)`` of the pixels wanted (default: every pixel).
+
+    Returns
+    -------
+    (H, W) or (N,) float64 ndarray
+        NaN where the neighbourhood has no confident finite value.
+    """
+    values = np.asarray(values, dtype=np.float64)
+    confident = np.asarray(confident, dtype=bool)
+    if values.ndim != 2 or confident.shape != values.shape:
+        raise ValueError(f"values {values.shape} and confident {confident.shape} must be the same (H, W) shape")
+    rr, rc = (radius, radius) if np.ndim(radius) == 0 else radius
+    if int(rr) < 0 or int(rc) < 0:
+        raise ValueError(f"radius must be >= 0; got {radius}")
+    rr, rc = int(rr), int(rc)
+    if at is None:
+        rows, cols = (g.ravel() for g in np.indices(values.shape))
+    else:
+        rows, cols = (np.asarray(a, dtype=np.int64).reshape(-1) for a in at)
+    kept = np.where(confident & np.isfinite(values), values, np.nan).astype(np.float32)
+    padded = np.pad(kept, ((rr, rr), (rc, rc)), constant_values=np.nan)
+    dr, dc = (g.ravel() for g in np.indices((2 * rr + 1, 2 * rc + 1)))
+    out = np.full(rows.size, np.nan)
+    candidates = np.nonzero(_any_in_window(np.isfinite(kept), rr, rc)[rows, cols])[0]
+    step = max(1, 2**22 // dr.size)
+    for a in range(0, candidates.size, step):
+        idx = candidates[a:a + step]
+        window = padded[rows[idx, None] + dr[None, :], cols[idx, None] + dc[None, :]]
+        with np.errstate(all="ignore"):
+            out[idx] = np.nanmedian(window, axis=-1)
+    return out.reshape(values.shape) if at is None else out
+
+
+def _any_in_window(mask, rr, rc):
+    """Whether any pixel of the (2 rr + 1) x (2 rc + 1) window around each pixel is set."""
+    c = np.pad(mask, ((rr + 1, rr), (rc + 1, rc))).astype(np.int64).cumsum(0).cumsum(1)
+    h, w = mask.shape
+    total = (c[2 * rr + 1:2 * rr + 1 + h, 2 * rc + 1:2 * rc + 1 + w] - c[:h, 2 * rc + 1:2 * rc + 1 + w]
+             - c[2 * rr + 1:2 * rr + 1 + h, :w] + c[:h, :w])
+    return total > 0
+
+
+def coherent_durations(duration_s, confident, *, radius=3, at=None):
     """Median duration of each pixel's confident neighbours (the pixel included).
 
     Parameters
@@ -172,36 +233,19 @@ def coherent_durations(duration_s, confident, *, radius=3):
         Fitted penumbra durations (s).
     confident : (H, W) bool ndarray
         Pixels whose fit is trusted (resolved, small uncertainty, not cut by the sequence end).
-    radius : int, keyword-only
-        Half size of the square neighbourhood (pixels).
+    radius : int or (int, int), keyword-only
+        Half size of the neighbourhood (pixels), or ``(rows, cols)``.
+    at : tuple of (N,) int ndarray, optional, keyword-only
+        ``(rows, cols)`` of the pixels wanted (default: every pixel).
 
     Returns
     -------
-    (H, W) float64 ndarray
+    (H, W) or (N,) float64 ndarray
         NaN where the neighbourhood has no confident pixel.
     """
     duration = np.asarray(duration_s, dtype=np.float64)
-    confident = np.asarray(confident, dtype=bool)
-    if duration.ndim != 2 or confident.shape != duration.shape:
-        raise ValueError(f"duration_s {duration.shape} and confident {confident.shape} must be the same (H, W) shape")
-    if int(radius) < 0:
-        raise ValueError(f"radius must be >= 0; got {radius}")
-    r = int(radius)
-    values = np.where(confident & np.isfinite(duration) & (duration > 0), np.log(np.where(duration > 0, duration, 1.0)),
-                      np.nan).astype(np.float32)
-    padded = np.pad(values, r, constant_values=np.nan)
-    out = np.full(duration.shape, np.nan)
-    any_rows = np.nonzero(np.isfinite(values).any(axis=1))[0]
-    if any_rows.size == 0:
-        return out
-    lo, hi = max(0, any_rows[0] - r), min(duration.shape[0], any_rows[-1] + r + 1)
-    # row band by row band keeps the (rows, W, (2r+1)^2) window view small
-    for a in range(lo, hi, 256):
-        b = min(hi, a + 256)
-        view = np.lib.stride_tricks.sliding_window_view(padded[a:b + 2 * r], (2 * r + 1, 2 * r + 1))
-        flat = view.reshape(b - a, duration.shape[1], -1)
-        has = np.isfinite(flat).any(-1)
-        with np.errstate(all="ignore"):
-            med = np.nanmedian(np.where(has[..., None], flat, 0.0), axis=-1)
-        out[a:b] = np.where(has, np.exp(med), np.nan)
-    return out
+    if duration.ndim != 2:
+        raise ValueError(f"duration_s must be (H, W); got shape {duration.shape}")
+    with np.errstate(all="ignore"):
+        log = np.where(duration > 0, np.log(np.where(duration > 0, duration, 1.0)), np.nan)
+    return np.exp(neighbour_median(log, confident, radius=radius, at=at))

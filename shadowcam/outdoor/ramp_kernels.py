@@ -33,9 +33,13 @@ def _segment(u):
 
 
 @nb.njit(cache=True)
-def _grid_sse(t, y, m, yy, tc, dur, out):
-    """Least-squares levels of the ramp (tc, dur) and its residual (one pass: ``yy - L a.y - S b.y`` at the
-    solution of the normal equations, `yy` the sum of squares); `out` = (lit, shadow); inf if degenerate."""
+def _grid_sse(t, y, m, yy, tc, dur, shadow_known, out):
+    """Least-squares levels of the ramp (tc, dur) and its residual; `out` = (lit, shadow); inf if degenerate.
+
+    One pass: at the solution of the normal equations the residual is ``yy - L a.y - S b.y``
+    (`yy` the sum of squares of the series). With `shadow_known` finite (the series then
+    taken relative to it: ``y - S``, `yy` its sum of squares) only the lit level is solved.
+    """
     aa = 0.0
     bb = 0.0
     ab = 0.0
@@ -49,6 +53,14 @@ def _grid_sse(t, y, m, yy, tc, dur, out):
         ab += v * c
         ay += v * y[k]
         by += c * y[k]
+    if np.isfinite(shadow_known):
+        ay -= shadow_known * (aa + ab)  # sum of v (y - S)
+        if not aa > 1e-30:
+            return np.inf
+        amplitude = ay / aa
+        out[0] = shadow_known + amplitude
+        out[1] = shadow_known
+        return max(yy - amplitude * ay, 0.0)
     det = aa * bb - ab * ab
     if not det > 1e-9 * max(aa * bb, 1e-30):
         return np.inf
@@ -60,7 +72,7 @@ def _grid_sse(t, y, m, yy, tc, dur, out):
 
 
 @nb.njit(cache=True)
-def _normal(t, y, m, p, free_q, jtj, jtr):
+def _normal(t, y, m, p, free_q, free_s, jtj, jtr):
     """Residual sum of squares at `p` and the normal equations ``J^T J``, ``J^T r`` (filled in place)."""
     tc, q, lit, shadow = p[0], p[1], p[2], p[3]
     duration = np.exp(q)
@@ -78,7 +90,7 @@ def _normal(t, y, m, p, free_q, jtj, jtr):
         col[0] = amp * (-2.0 / duration)
         col[1] = amp * (-u) * free_q
         col[2] = v
-        col[3] = 1.0 - v
+        col[3] = (1.0 - v) * free_s
         sse += r * r
         for i in range(4):
             jtr[i] += col[i] * r
@@ -115,7 +127,7 @@ def _solve4(a, b, x):
 
 
 @nb.njit(cache=True, parallel=True)
-def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, iterations, tolerance):
+def fit_ramp_pixels(t_all, y_all, start, fixed, shadow_fixed, durations, shifts, log_bounds, iterations, tolerance):
     """Fit ``S + (L - S) v(2 (t - t_c) / exp(q))`` to each pixel's finite samples.
 
     Parameters
@@ -126,6 +138,8 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
         Centre guess (finite).
     fixed : (N,) float64 ndarray
         Known duration (NaN: fitted).
+    shadow_fixed : (N,) float64 ndarray
+        Known shadow level (NaN: fitted).
     durations, shifts : (D,), (S,) float64 ndarray
         Grid start: durations, and centre shifts in durations about the guess.
     log_bounds : (2,) float64 ndarray
@@ -142,7 +156,7 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
     sse : (N,) float64 ndarray
         Residual sum of squares.
     jtj : (N, 4, 4) float64 ndarray
-        Normal matrix at `p` (the row and column of a fixed duration are zero).
+        Normal matrix at `p` (the rows and columns of a fixed duration or shadow level are zero).
     lag : (N,) float64 ndarray
         Sum of the products of consecutive residuals (both samples finite).
     n_inside : (N,) int64 ndarray
@@ -169,9 +183,11 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
                 index[m] = k
                 m += 1
         count_out[i] = m
+        known_s = np.isfinite(shadow_fixed[i])
+        offset = shadow_fixed[i] if known_s else 0.0
         yy = 0.0
         for k in range(m):
-            yy += y[k] * y[k]
+            yy += (y[k] - offset) * (y[k] - offset)
         levels = np.empty(2)
         p = np.zeros(4)
         best = np.inf
@@ -180,7 +196,7 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
             dur = fixed[i] if known else durations[d]
             for s in range(shifts.size):
                 tc = start[i] + shifts[s] * dur
-                sse = _grid_sse(t, y, m, yy, tc, dur, levels)
+                sse = _grid_sse(t, y, m, yy, tc, dur, shadow_fixed[i], levels)
                 if np.isfinite(sse) and sse < best:
                     best = sse
                     p[0] = tc
@@ -190,6 +206,7 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
             if known:
                 break
         free_q = 0.0 if known else 1.0
+        free_s = 0.0 if known_s else 1.0
         jtj = np.empty((4, 4))
         jtr = np.empty(4)
         a = np.empty((4, 4))
@@ -198,7 +215,7 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
         trial = np.empty(4)
         jtj2 = np.empty((4, 4))
         jtr2 = np.empty(4)
-        sse = _normal(t, y, m, p, free_q, jtj, jtr)
+        sse = _normal(t, y, m, p, free_q, free_s, jtj, jtr)
         lam = 1e-3
         for _ in range(iterations):
             dmax = max(max(jtj[0, 0], jtj[1, 1]), max(jtj[2, 2], jtj[3, 3]))
@@ -210,10 +227,11 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, durations, shifts, log_bounds, i
                 b[r] = jtr[r]
             _solve4(a, b, step)
             step[1] *= free_q
+            step[3] *= free_s
             for r in range(4):
                 trial[r] = p[r] + step[r]
             trial[1] = min(max(trial[1], log_bounds[0]), log_bounds[1])
-            sse2 = _normal(t, y, m, trial, free_q, jtj2, jtr2)
+            sse2 = _normal(t, y, m, trial, free_q, free_s, jtj2, jtr2)
             if np.isfinite(sse2) and sse2 <= sse:
                 small = lam <= 1e-2 and abs(step[0]) <= tolerance and abs(step[1]) <= 1e-9
                 for r in range(4):

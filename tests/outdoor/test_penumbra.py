@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, ramp_model, visible_fraction
+from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, neighbour_median, ramp_model, visible_fraction
 
 INTERVAL = 5.0
 TIMES = np.arange(128) * INTERVAL
@@ -115,3 +115,37 @@ def test_each_pixel_is_fitted_alone_whatever_its_batch_and_its_gaps():
     short = fit_ramps(series[2:3, kept], TIMES[kept], centre_s=centre[2:3], interval_s=INTERVAL)
     assert short["n_inside"][0] == together["n_inside"][2]
     assert abs(short["centre_s"][0] - centre[2]) / INTERVAL <= 0.5
+
+
+@pytest.mark.parametrize("seen_after", [0.05, 0.25])
+def test_a_ramp_cut_after_its_centre_is_centred_with_the_duration_and_shadow_known(seen_after):
+    # the series ends `seen_after` durations after the centre: the second half of the ramp is not seen
+    duration = 50 * INTERVAL
+    rng = np.random.default_rng(12)
+    centre = rng.uniform(60.0, 70.0, 200) * INTERVAL
+    end = centre + seen_after * duration
+    clean = ramp_model(TIMES[None, :], centre_s=centre[:, None], duration_s=duration, lit=1.0, shadow=0.1)
+    series = np.where(TIMES[None, :] <= end[:, None], clean, np.nan)
+    known = {"duration_s": np.full(200, duration), "shadow": np.full(200, 0.1)}
+    exact = fit_ramps(series, TIMES, centre_s=centre + 3 * INTERVAL, interval_s=INTERVAL, **known)
+    assert exact["resolved"].all()
+    np.testing.assert_allclose(exact["centre_s"], centre, atol=1e-3 * INTERVAL)
+    np.testing.assert_allclose(exact["lit"], 1.0, atol=1e-6)
+    np.testing.assert_allclose(exact["shadow"], 0.1, atol=0.0)  # fixed
+    noisy = fit_ramps(series + rng.normal(0.0, 0.02, series.shape), TIMES, centre_s=centre + 3 * INTERVAL,
+                      interval_s=INTERVAL, **known)
+    error = np.abs(noisy["centre_s"] - centre)
+    assert np.median(error) / INTERVAL <= 0.5
+    assert np.mean(error <= 3 * noisy["sigma_s"]) >= 0.95  # the standard error is honest
+    with pytest.raises(ValueError, match="shadow"):
+        fit_ramps(series, TIMES, centre_s=centre, interval_s=INTERVAL, shadow=np.zeros(3))
+
+
+def test_neighbour_median_reads_a_rectangle_of_confident_values():
+    values = np.arange(60, dtype=float).reshape(10, 6)
+    confident = np.zeros((10, 6), bool)
+    confident[0, 2] = confident[9, 2] = True
+    out = neighbour_median(values, confident, radius=(9, 1), at=(np.array([5, 5]), np.array([2, 5])))
+    assert out[0] == pytest.approx((values[0, 2] + values[9, 2]) / 2) and np.isnan(out[1])
+    full = neighbour_median(values, confident, radius=(4, 0))
+    assert full[4, 2] == values[0, 2] and full[5, 2] == values[9, 2] and np.isnan(full[4, 3])
