@@ -113,7 +113,7 @@ class DescentBuffer:
         return values, np.where(held, frame, -1)
 
 
-def _fit(buffer, rows, cols, time_s, centre, interval, duration=None, shadow=None):
+def _fit(buffer, rows, cols, time_s, centre, interval, duration=None, shadow=None, speed_change=False):
     out = []
     for a in range(0, rows.size, _CHUNK):
         s = slice(a, a + _CHUNK)
@@ -121,11 +121,11 @@ def _fit(buffer, rows, cols, time_s, centre, interval, duration=None, shadow=Non
         t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
         out.append(fit_ramps(values, t, centre_s=centre[s], interval_s=interval,
                              duration_s=None if duration is None else duration[s],
-                             shadow=None if shadow is None else shadow[s]))
+                             shadow=None if shadow is None else shadow[s], speed_change=speed_change))
     return {key: np.concatenate([o[key] for o in out]) for key in out[0]} if out else None
 
 
-def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS, cut_rows=0):
+def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS, cut_rows=0, speed_change=False):
     """Fit the penumbra law to every pixel's final descent.
 
     Parameters
@@ -145,6 +145,9 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
         Rows each side (at least `radius`; columns: `radius`) whose confident fits give a ramp
         cut by the sequence's end its duration and shadow level: the penumbra's width in rows
         (:func:`shadowcam.outdoor.strips.edge_width`), across which the cut ramps lie.
+    speed_change : bool, keyword-only
+        Fit the ramps whose duration is free with an edge speed that changes linearly over
+        the ramp (:func:`shadowcam.outdoor.penumbra.fit_ramps`).
 
     Returns
     -------
@@ -168,7 +171,7 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
            "ramp_sigma_s": np.full(shape, np.nan, np.float32), "ramp_state": state}
     if rows.size == 0:
         return out
-    fit = _fit(buffer, rows, cols, time_s, crossing[rows, cols], interval)
+    fit = _fit(buffer, rows, cols, time_s, crossing[rows, cols], interval, speed_change=speed_change)
     end = time_s[-1]
     limit = max_sigma * interval
     cut = fit["centre_s"] + 0.5 * fit["duration_s"] > end + 0.5 * interval

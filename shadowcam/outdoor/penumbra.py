@@ -86,7 +86,8 @@ def ramp_model(time_s, *, centre_s, duration_s, lit, shadow):
     return shadow + (np.asarray(lit) - shadow) * visible_fraction(u)
 
 
-def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=None, min_samples=3, iterations=30):
+def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=None, speed_change=False, min_samples=3,
+              iterations=30):
     """Fit the disc-sun ramp to each pixel's series.
 
     The law ``S + (L - S) v(2 (t - t_c) / D)`` is fitted by Levenberg-Marquardt from a grid
@@ -113,6 +114,10 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=N
     shadow : (N,) ndarray, optional, keyword-only
         Known shadow levels (NaN: fitted). With the duration known too, only the centre
         and the lit level are fitted: a ramp whose second half the sequence's end cut.
+    speed_change : bool, keyword-only
+        Let the edge's speed change linearly over the ramp (where the duration is fitted):
+        ``u = 2 tau (1 + beta tau)``, ``tau = (t - t_c) / D``, ``|beta| <= 0.45`` (the sun
+        along a sloping, curved skyline); the centre is still where half the disc is occluded.
     min_samples : int, keyword-only
         Samples inside the fitted ramp needed for its centre to be resolved.
     iterations : int, keyword-only
@@ -121,7 +126,7 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=N
     Returns
     -------
     dict of (N,) ndarray
-        ``centre_s``, ``duration_s``, ``lit``, ``shadow``; ``sigma_s`` (standard error of
+        ``centre_s``, ``duration_s``, ``lit``, ``shadow``, ``speed_change`` (``beta``); ``sigma_s`` (standard error of
         the centre; inf where undetermined), ``rms`` (residual rms),
         ``n_inside`` (samples strictly inside the ramp), ``resolved`` (``n_inside >=
         min_samples`` and a finite centre).
@@ -151,12 +156,13 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=N
     bounds = np.log([0.05 * interval_s, 4.0 * span + interval_s])
     p, sse, jtj, lag, n_inside, count = fit_ramp_pixels(
         np.ascontiguousarray(t), np.ascontiguousarray(y), start, fixed, level, durations, _SHIFTS, bounds, int(iterations),
-        _TOLERANCE * float(interval_s))
-    free = np.ones((n, 4))
+        _TOLERANCE * float(interval_s), bool(speed_change))
+    free = np.ones((n, 5))
     free[np.isfinite(fixed), 1] = 0.0
     free[np.isfinite(level), 3] = 0.0
+    free[:, 4] = 0.0 if not speed_change else np.where(np.isfinite(fixed), 0.0, 1.0)
     n_params = free.sum(-1)
-    jtj = jtj + (1.0 - free)[:, :, None] * np.eye(4)  # fixed: unit diagonal
+    jtj = jtj + (1.0 - free)[:, :, None] * np.eye(5)  # fixed: unit diagonal
     with np.errstate(invalid="ignore", divide="ignore"):
         rho = np.clip(lag / np.maximum(sse, 1e-300), 0.0, 0.95)
         cond_ok = np.linalg.cond(jtj) < 1e12
@@ -168,7 +174,8 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=N
     centre = np.where(np.isfinite(c0), p[:, 0], np.nan)
     resolved = (n_inside >= int(min_samples)) & np.isfinite(centre) & (count > n_params)
     return {"centre_s": centre, "duration_s": duration, "lit": p[:, 2], "shadow": p[:, 3], "sigma_s": sigma,
-            "rms": np.sqrt(sse / np.maximum(count, 1)), "n_inside": n_inside, "resolved": resolved}
+            "speed_change": p[:, 4], "rms": np.sqrt(sse / np.maximum(count, 1)), "n_inside": n_inside,
+            "resolved": resolved}
 
 
 def neighbour_median(values, confident, *, radius=3, at=None):

@@ -149,3 +149,32 @@ def test_neighbour_median_reads_a_rectangle_of_confident_values():
     assert out[0] == pytest.approx((values[0, 2] + values[9, 2]) / 2) and np.isnan(out[1])
     full = neighbour_median(values, confident, radius=(4, 0))
     assert full[4, 2] == values[0, 2] and full[5, 2] == values[9, 2] and np.isnan(full[4, 3])
+
+
+def _changing_edge(tau, beta):
+    """Edge distance (disc radii) when its speed changes linearly: 2 tau (1 + beta tau), monotonic (held beyond the disc)."""
+    turned = 1.0 + 2.0 * beta * tau <= 0.0
+    return np.where(turned, -2.0 * np.sign(beta), 2.0 * tau * (1.0 + beta * tau))
+
+
+@settings(max_examples=20, deadline=None)
+@given(beta=st.floats(-0.4, 0.4), duration=st.floats(20.0, 60.0), phase=st.floats(0.0, 1.0))
+def test_a_ramp_whose_edge_speed_changes_is_centred_exactly_with_the_speed_change_fitted(beta, duration, phase):
+    centre = (60.0 + phase) * INTERVAL
+    series = (0.1 + 0.9 * visible_fraction(_changing_edge((TIMES - centre) / (duration * INTERVAL), beta)))[None]
+    fit = fit_ramps(series, TIMES, centre_s=np.array([centre + 3 * INTERVAL]), interval_s=INTERVAL, speed_change=True)
+    assert fit["resolved"][0]
+    assert abs(fit["centre_s"][0] - centre) / INTERVAL <= 1e-3
+    assert fit["speed_change"][0] == pytest.approx(beta, abs=1e-3)
+    assert fit["duration_s"][0] / INTERVAL == pytest.approx(duration, rel=1e-3)
+
+
+def test_the_constant_speed_law_is_off_centre_on_a_ramp_whose_speed_doubles():
+    # u = 2 tau (1 + 0.4 tau): the edge's speed is 0.6 / 1.4 of its mean at the ramp's start / end
+    centre, duration = 60.0 * INTERVAL, 50.0 * INTERVAL
+    series = (0.1 + 0.9 * visible_fraction(_changing_edge((TIMES - centre) / duration, 0.4)))[None]
+    constant = fit_ramps(series, TIMES, centre_s=np.array([centre]), interval_s=INTERVAL)
+    changing = fit_ramps(series, TIMES, centre_s=np.array([centre]), interval_s=INTERVAL, speed_change=True)
+    assert abs(constant["centre_s"][0] - centre) / INTERVAL > 0.5  # 0.79 intervals early
+    assert abs(changing["centre_s"][0] - centre) / INTERVAL <= 1e-3
+    np.testing.assert_array_equal(constant["speed_change"], 0.0)
