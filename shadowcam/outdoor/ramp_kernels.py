@@ -1,10 +1,11 @@
 """Compiled per-pixel fit of the disc-sun ramp (numba), optionally with an edge speed that changes.
 
 One pixel at a time (pixels in parallel with ``prange``): its finite samples are gathered
-once, the grid start is scanned, then Levenberg-Marquardt steps are taken with the 4x4
-normal equations accumulated in the same pass as the residual and solved by Gaussian
-elimination; the steps stop once the damping is small and the centre's and the log
-duration's steps are below ``1e-9`` of an interval (a converged fit does not move further).
+once, the grid start is scanned, then Levenberg-Marquardt steps are taken with the 5x5
+normal equations (centre, log duration, levels, speed change; fixed parameters' columns
+zero) accumulated in the same pass as the residual and solved by Gaussian elimination; the
+steps stop once the damping is small, the centre's step is below the tolerance and the log
+duration's and speed change's below ``1e-9`` (a converged fit does not move further).
 All arithmetic is float64. The law and the fit are those of
 :func:`shadowcam.outdoor.penumbra.fit_ramps`, which validates the inputs and turns the
 normal equations into the centre's standard error.
