@@ -244,7 +244,7 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
     Returns
     -------
     arrival_s : (H, W) float64 ndarray
-        The ramp centre where the state is ``fitted`` or ``neighbours_duration``; NaN where
+        The ramp centre where the state is ``fitted``, ``neighbours_duration`` or ``cut_centred``; NaN where
         it is ``cut`` (reason ``ramp_cut``) or ``ambiguous`` (reason ``ambiguous_ramp``).
     reason : (H, W) uint8 ndarray
     """
@@ -254,7 +254,7 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
     check_same_shape({"arrival_s": arrival, "reason": reason, "ramp_centre_s": np.asarray(ramp_centre_s),
                       "ramp_state": state})
     final = (reason == REASON_CODE["edge_crossing"]) | (reason == REASON_CODE["coverage_crossing"])
-    fitted = final & ((state == STATE_CODE["fitted"]) | (state == STATE_CODE["neighbours_duration"]))
+    fitted = final & np.isin(state, [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred")])
     arrival[fitted] = np.asarray(ramp_centre_s, dtype=np.float64)[fitted]
     reason[fitted] = REASON_CODE["penumbra_fit"]
     for name, code in (("cut", "ramp_cut"), ("ambiguous", "ambiguous_ramp")):

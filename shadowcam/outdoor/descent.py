@@ -18,11 +18,18 @@ duration the ramp either ended by the last frame (the fit stands) or is shorter 
 sampling resolves (the crossing stands). Each pixel gets a state (:data:`RAMP_STATES`): ramps
 shorter than the sampling resolves (``short``) keep the level crossing, and so do ramps whose
 fit stays uncertain (a cloud's shade over the ramp) but agrees with the crossing within two
-standard errors; ramps still under way at the last frame (``cut``: the shadow level is not
-observed) and uncertain fits that contradict the crossing (``ambiguous``) get no time.
+standard errors. A ramp still under way at the last frame whose centre the sequence saw
+(the lit level and the descent's first half) is identifiable once its duration and its
+shadow level are known: both are taken from the confident fits within the penumbra's width
+in rows (the same sun behind the same skyline, the same shadowed ground), and only its
+centre and lit level are fitted (``cut_centred``). Ramps whose centre is after the last
+frame or that have no confident neighbours (``cut``) and uncertain fits that contradict the
+crossing (``ambiguous``) get no time.
 
-Every step but the neighbours' duration is per pixel; that one reads ``radius`` pixels
-each side, within the halo of a column strip (:mod:`shadowcam.outdoor.strips`).
+Every step but the neighbours' duration and shadow level is per pixel; those read
+``radius`` columns each side, within the halo of a column strip
+(:mod:`shadowcam.outdoor.strips`), and ``radius`` or ``cut_rows`` rows (a strip holds
+every row).
 
 Offers
 ------
@@ -34,14 +41,15 @@ fit_descents : per-pixel centre, duration, uncertainty and state of the final de
 import numpy as np
 
 from shadowcam._shared.validation import check_positive
-from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps
+from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, neighbour_median
 
 #: ramp state code -> meaning
-RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: "cut", 5: "ambiguous"}
+RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: "cut", 5: "ambiguous",
+               6: "cut_centred"}
 STATE_CODE = {name: code for code, name in RAMP_STATES.items()}
 #: pixels each side whose fitted durations steady a noisy ramp (:func:`fit_descents`)
 NEIGHBOUR_RADIUS = 3
-#: pixels fitted at once (bounds the (N, K, 4, 4) normal equations)
+#: pixels fitted at once (bounds the (N, K) float64 series gathered from the buffer)
 _CHUNK = 4096
 
 
@@ -105,18 +113,19 @@ class DescentBuffer:
         return values, np.where(held, frame, -1)
 
 
-def _fit(buffer, rows, cols, time_s, centre, interval, duration=None):
+def _fit(buffer, rows, cols, time_s, centre, interval, duration=None, shadow=None, speed_change=False):
     out = []
     for a in range(0, rows.size, _CHUNK):
         s = slice(a, a + _CHUNK)
         values, frame = buffer.series(rows[s], cols[s])
         t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
         out.append(fit_ramps(values, t, centre_s=centre[s], interval_s=interval,
-                             duration_s=None if duration is None else duration[s]))
+                             duration_s=None if duration is None else duration[s],
+                             shadow=None if shadow is None else shadow[s], speed_change=speed_change))
     return {key: np.concatenate([o[key] for o in out]) for key in out[0]} if out else None
 
 
-def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS):
+def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS, cut_rows=0, speed_change=False):
     """Fit the penumbra law to every pixel's final descent.
 
     Parameters
@@ -132,11 +141,18 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
         Largest standard error of the centre, in median intervals, for a centre to be given.
     radius : int, keyword-only
         Neighbourhood of the duration's coherence (pixels each side).
+    cut_rows : int, keyword-only
+        Rows each side (at least `radius`; columns: `radius`) whose confident fits give a ramp
+        cut by the sequence's end its duration and shadow level: the penumbra's width in rows
+        (:func:`shadowcam.outdoor.strips.edge_width`), across which the cut ramps lie.
+    speed_change : bool, keyword-only
+        Fit the ramps whose duration is free with an edge speed that changes linearly over
+        the ramp (:func:`shadowcam.outdoor.penumbra.fit_ramps`).
 
     Returns
     -------
     dict of (H, W) ndarray
-        ``ramp_centre_s`` (NaN unless state fitted / neighbours_duration), ``ramp_duration_s``,
+        ``ramp_centre_s`` (NaN unless state fitted / neighbours_duration / cut_centred), ``ramp_duration_s``,
         ``ramp_sigma_s`` (float32) and ``ramp_state`` (uint8, :data:`RAMP_STATES`).
     """
     crossing = np.asarray(crossing_s, dtype=np.float64)
@@ -155,7 +171,7 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
            "ramp_sigma_s": np.full(shape, np.nan, np.float32), "ramp_state": state}
     if rows.size == 0:
         return out
-    fit = _fit(buffer, rows, cols, time_s, crossing[rows, cols], interval)
+    fit = _fit(buffer, rows, cols, time_s, crossing[rows, cols], interval, speed_change=speed_change)
     end = time_s[-1]
     limit = max_sigma * interval
     cut = fit["centre_s"] + 0.5 * fit["duration_s"] > end + 0.5 * interval
@@ -166,6 +182,9 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
                                                           STATE_CODE["fitted"]], STATE_CODE["ambiguous"])
     good = np.zeros(shape, dtype=bool)
     good[rows, cols] = confident
+    first_duration = duration.copy()
+    first_shadow = np.full(shape, np.nan)
+    first_shadow[rows, cols] = fit["shadow"]
     neighbours = coherent_durations(duration, good, radius=radius)
     nbr = neighbours[rows, cols]
     # the neighbours' duration (the same sun behind the same skyline) steadies a noisy ramp, and
@@ -184,12 +203,32 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
         was_cut = state[r, c] == STATE_CODE["cut"]
         state[r, c] = np.select([ok, too_short, was_cut], [STATE_CODE["neighbours_duration"], STATE_CODE["short"],
                                                            STATE_CODE["cut"]], STATE_CODE["ambiguous"])
+    # a ramp the sequence's end cut after its centre (the lit level and the descent's first half
+    # seen): the duration and the shadow level are its confident neighbours' (the same sun behind
+    # the same skyline, the same ground in shadow), and only the centre and the lit level are fitted
+    cut = state[rows, cols] == STATE_CODE["cut"]
+    if cut.any():
+        r, c = rows[cut], cols[cut]
+        window = (max(int(cut_rows), int(radius)), int(radius))
+        nbr_duration = coherent_durations(first_duration, good, radius=window, at=(r, c))
+        nbr_shadow = neighbour_median(first_shadow, good, radius=window, at=(r, c))
+        known = np.isfinite(nbr_duration) & np.isfinite(nbr_shadow)
+        if known.any():
+            r, c = r[known], c[known]
+            refit = _fit(buffer, r, c, time_s, crossing[r, c], interval, duration=nbr_duration[known],
+                         shadow=nbr_shadow[known])
+            seen = refit["centre_s"] <= end
+            ok = refit["resolved"] & (refit["sigma_s"] <= limit) & seen
+            centre[r[ok], c[ok]] = refit["centre_s"][ok]
+            duration[r[ok], c[ok]] = nbr_duration[known][ok]
+            sigma[r[ok], c[ok]] = refit["sigma_s"][ok]
+            state[r[ok], c[ok]] = STATE_CODE["cut_centred"]
     # an uncertain fit that does not contradict the level crossing (within two standard
     # errors) leaves it standing; one that does gives no time
     with np.errstate(invalid="ignore"):
         agrees = (state == STATE_CODE["ambiguous"]) & (np.abs(centre - crossing) <= 2.0 * sigma)
     state[agrees] = STATE_CODE["short"]
-    keep = (state == STATE_CODE["fitted"]) | (state == STATE_CODE["neighbours_duration"])
+    keep = np.isin(state, [STATE_CODE["fitted"], STATE_CODE["neighbours_duration"], STATE_CODE["cut_centred"]])
     out["ramp_centre_s"] = np.where(keep, centre, np.nan).astype(np.float32)
     out["ramp_duration_s"] = np.where(state > 0, duration, np.nan).astype(np.float32)
     out["ramp_sigma_s"] = np.where(state > 0, sigma, np.nan).astype(np.float32)

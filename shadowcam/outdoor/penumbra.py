@@ -16,7 +16,9 @@ The pixel's normalised luminance (coverage) is ``S + (L - S) v``: the lit and sh
 levels are fitted with the ramp, so level errors of the first pass do not move ``t_c``.
 
 :func:`fit_ramps` fits ``(t_c, D, L, S)`` (or ``(t_c, L, S)`` with ``D`` given) by
-Levenberg-Marquardt from a grid start, pixel by pixel in vectorised batches, with the
+Levenberg-Marquardt from a grid start, pixel by pixel in a compiled kernel
+(:mod:`shadowcam.outdoor.ramp_kernels`; work proportional to the samples, no per-pixel
+arrays beyond the series), with the
 centre's standard error from the fit residual. A ramp with fewer than ``min_samples``
 samples inside it is shorter than the sampling resolves: the fit's centre is then not
 determined by the law and the caller keeps the level crossing between the two frames
@@ -28,14 +30,20 @@ visible_fraction : the circular-segment law v(u).
 ramp_model : coverage of a pixel over time for given centre, duration and levels.
 fit_ramps : per-pixel fit of the law to luminance series, with the centre's uncertainty.
 coherent_durations : the median fitted duration of each pixel's confident neighbours.
+neighbour_median : the median of each pixel's confident neighbours' values.
 """
 
 import numpy as np
 
 from shadowcam._shared.validation import check_positive
+from shadowcam.outdoor.ramp_kernels import fit_ramp_pixels
 
 #: fit parameters, in order
 PARAMETERS = ("centre_s", "duration_s", "lit", "shadow")
+#: centre shifts of the grid start, in durations about the guess
+_SHIFTS = np.array([-0.4, -0.2, 0.0, 0.2, 0.4])
+#: centre step (intervals) below which a Levenberg-Marquardt fit has converged
+_TOLERANCE = 1e-9
 
 
 def visible_fraction(u):
@@ -78,36 +86,8 @@ def ramp_model(time_s, *, centre_s, duration_s, lit, shadow):
     return shadow + (np.asarray(lit) - shadow) * visible_fraction(u)
 
 
-def _levels(v, y, w):
-    """Least-squares lit and shadow levels of ``y = S (1 - v) + L v`` (weights `w` = finite samples)."""
-    a = v * w
-    b = (1.0 - v) * w
-    aa, bb, ab = (a * v).sum(-1), (b * (1.0 - v)).sum(-1), (a * (1.0 - v)).sum(-1)
-    ay, by = (a * y).sum(-1), (b * y).sum(-1)
-    det = aa * bb - ab * ab
-    ok = det > 1e-9 * np.maximum(aa * bb, 1e-30)
-    safe = np.where(ok, det, 1.0)
-    lit = np.where(ok, (ay * bb - by * ab) / safe, np.nan)
-    shadow = np.where(ok, (by * aa - ay * ab) / safe, np.nan)
-    return lit, shadow
-
-
-def _residual_and_jacobian(t, y, w, p, free):
-    tc, q, lit, shadow = (p[:, i:i + 1] for i in range(4))
-    duration = np.exp(q)
-    u = 2.0 * (t - tc) / duration
-    inside = np.abs(u) < 1.0
-    uc = np.clip(u, -1.0, 1.0)
-    v = (np.arccos(uc) - uc * np.sqrt(1.0 - uc * uc)) / np.pi
-    dv_du = np.where(inside, -(2.0 / np.pi) * np.sqrt(1.0 - uc * uc), 0.0)
-    r = (y - (shadow + (lit - shadow) * v)) * w
-    amp = (lit - shadow) * dv_du
-    columns = [amp * (-2.0 / duration), amp * (-u), v, 1.0 - v]
-    jac = np.stack(columns, axis=-1) * w[..., None] * free[:, None, :]
-    return r, jac, inside
-
-
-def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samples=3, iterations=30):
+def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=None, speed_change=False, min_samples=3,
+              iterations=30):
     """Fit the disc-sun ramp to each pixel's series.
 
     The law ``S + (L - S) v(2 (t - t_c) / D)`` is fitted by Levenberg-Marquardt from a grid
@@ -131,6 +111,13 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
         Median capture interval (s): sets the grid of start durations.
     duration_s : (N,) ndarray, optional, keyword-only
         Known durations (s): only the centre and the levels are fitted (NaN: fitted too).
+    shadow : (N,) ndarray, optional, keyword-only
+        Known shadow levels (NaN: fitted). With the duration known too, only the centre
+        and the lit level are fitted: a ramp whose second half the sequence's end cut.
+    speed_change : bool, keyword-only
+        Let the edge's speed change linearly over the ramp (where the duration is fitted):
+        ``u = 2 tau (1 + beta tau)``, ``tau = (t - t_c) / D``, ``|beta| <= 0.45`` (the sun
+        along a sloping, curved skyline); the centre is still where half the disc is occluded.
     min_samples : int, keyword-only
         Samples inside the fitted ramp needed for its centre to be resolved.
     iterations : int, keyword-only
@@ -139,7 +126,7 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
     Returns
     -------
     dict of (N,) ndarray
-        ``centre_s``, ``duration_s``, ``lit``, ``shadow``; ``sigma_s`` (standard error of
+        ``centre_s``, ``duration_s``, ``lit``, ``shadow``, ``speed_change`` (``beta``); ``sigma_s`` (standard error of
         the centre; inf where undetermined), ``rms`` (residual rms),
         ``n_inside`` (samples strictly inside the ramp), ``resolved`` (``n_inside >=
         min_samples`` and a finite centre).
@@ -158,66 +145,93 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, min_samp
     fixed = np.full(n, np.nan) if duration_s is None else np.asarray(duration_s, dtype=np.float64).reshape(-1)
     if fixed.shape != (n,):
         raise ValueError(f"duration_s must be ({n},); got shape {np.shape(duration_s)}")
-    w = np.isfinite(y) & np.isfinite(t)
-    y = np.where(w, y, 0.0)
-    t = np.where(w, t, 0.0)
-    wf = w.astype(np.float64)
-    # the grid depends on the series' length only (pixels fitted together or apart agree)
+    level = np.full(n, np.nan) if shadow is None else np.asarray(shadow, dtype=np.float64).reshape(-1)
+    if level.shape != (n,):
+        raise ValueError(f"shadow must be ({n},); got shape {np.shape(shadow)}")
     span = float(interval_s) * max(y.shape[1] - 1, 1)
     start = np.where(np.isfinite(c0), c0, 0.0)
-    # grid start: durations from half an interval to twice the span, centres around the guess
-    best = np.full(n, np.inf)
-    p = np.zeros((n, 4))
-    for duration in interval_s * np.geomspace(0.5, max(2.0 * span / interval_s, 1.0), 14):
-        dur = np.where(np.isfinite(fixed), fixed, duration)
-        for shift in (-0.4, -0.2, 0.0, 0.2, 0.4):
-            tc = start + shift * dur
-            v = visible_fraction(2.0 * (t - tc[:, None]) / dur[:, None])
-            lit, shadow = _levels(v, y, wf)
-            sse = (((y - (shadow[:, None] + (lit - shadow)[:, None] * v)) * wf) ** 2).sum(-1)
-            better = np.isfinite(sse) & (sse < best)
-            best[better] = sse[better]
-            p[better] = np.stack([tc, np.log(dur), lit, shadow], axis=-1)[better]
-    free = np.ones((n, 4))
+    # grid start (it depends on the series' length only: pixels fitted together or apart agree):
+    # durations from half an interval to twice the span, centres around the guess
+    durations = interval_s * np.geomspace(0.5, max(2.0 * span / interval_s, 1.0), 14)
+    bounds = np.log([0.05 * interval_s, 4.0 * span + interval_s])
+    p, sse, jtj, lag, n_inside, count = fit_ramp_pixels(
+        np.ascontiguousarray(t), np.ascontiguousarray(y), start, fixed, level, durations, _SHIFTS, bounds, int(iterations),
+        _TOLERANCE * float(interval_s), bool(speed_change))
+    free = np.ones((n, 5))
     free[np.isfinite(fixed), 1] = 0.0
-    lam = np.full(n, 1e-3)
-    r, jac, inside = _residual_and_jacobian(t, y, wf, p, free)
-    sse = (r * r).sum(-1)
-    eye = np.eye(4)
-    for _ in range(int(iterations)):
-        jtj = np.einsum("nki,nkj->nij", jac, jac)
-        jtr = np.einsum("nki,nk->ni", jac, r)
-        diag = np.einsum("nii->ni", jtj)
-        scale = np.maximum(diag, 1e-12 * (diag.max(-1, keepdims=True) + 1e-30))
-        step = np.linalg.solve(jtj + lam[:, None, None] * scale[:, :, None] * eye + 1e-12 * eye,
-                               jtr[..., None])[..., 0] * free
-        trial = p + step
-        trial[:, 1] = np.clip(trial[:, 1], np.log(0.05 * interval_s), np.log(4.0 * span + interval_s))
-        r2, jac2, inside2 = _residual_and_jacobian(t, y, wf, trial, free)
-        sse2 = (r2 * r2).sum(-1)
-        good = np.isfinite(sse2) & (sse2 <= sse)
-        p[good], r[good], jac[good], inside[good], sse[good] = trial[good], r2[good], jac2[good], inside2[good], sse2[good]
-        lam = np.where(good, np.maximum(lam / 3.0, 1e-9), np.minimum(lam * 10.0, 1e9))
-    count = wf.sum(-1)
+    free[np.isfinite(level), 3] = 0.0
+    free[:, 4] = 0.0 if not speed_change else np.where(np.isfinite(fixed), 0.0, 1.0)
     n_params = free.sum(-1)
-    jtj = np.einsum("nki,nkj->nij", jac, jac) + (1.0 - free)[:, :, None] * eye  # fixed: unit diagonal
-    pair = w[:, 1:] & w[:, :-1]
+    jtj = jtj + (1.0 - free)[:, :, None] * np.eye(5)  # fixed: unit diagonal
     with np.errstate(invalid="ignore", divide="ignore"):
-        rho = np.clip((r[:, 1:] * r[:, :-1] * pair).sum(-1) / np.maximum(sse, 1e-300), 0.0, 0.95)
+        rho = np.clip(lag / np.maximum(sse, 1e-300), 0.0, 0.95)
         cond_ok = np.linalg.cond(jtj) < 1e12
         cov = np.linalg.pinv(jtj)
         sigma = np.sqrt(np.maximum(sse / np.maximum(count - n_params, 1), 0.0) * cov[:, 0, 0]
                         * (1.0 + rho) / (1.0 - rho))
-    n_inside = (inside & w).sum(-1)
     sigma = np.where(cond_ok & (n_inside >= 2) & np.isfinite(sigma), sigma, np.inf)
     duration = np.exp(p[:, 1])
     centre = np.where(np.isfinite(c0), p[:, 0], np.nan)
     resolved = (n_inside >= int(min_samples)) & np.isfinite(centre) & (count > n_params)
     return {"centre_s": centre, "duration_s": duration, "lit": p[:, 2], "shadow": p[:, 3], "sigma_s": sigma,
-            "rms": np.sqrt(sse / np.maximum(count, 1)), "n_inside": n_inside, "resolved": resolved}
+            "speed_change": p[:, 4], "rms": np.sqrt(sse / np.maximum(count, 1)), "n_inside": n_inside,
+            "resolved": resolved}
 
 
-def coherent_durations(duration_s, confident, *, radius=3):
+def neighbour_median(values, confident, *, radius=3, at=None):
+    """Median of each pixel's confident, finite neighbours (the pixel included).
+
+    Parameters
+    ----------
+    values : (H, W) ndarray
+    confident : (H, W) bool ndarray
+        Pixels whose values are trusted.
+    radius : int or (int, int), keyword-only
+        Half size of the neighbourhood (pixels), or ``(rows, cols)``.
+    at : tuple of (N,) int ndarray, optional, keyword-only
+        ``(rows, cols)`` of the pixels wanted (default: every pixel).
+
+    Returns
+    -------
+    (H, W) or (N,) float64 ndarray
+        NaN where the neighbourhood has no confident finite value.
+    """
+    values = np.asarray(values, dtype=np.float64)
+    confident = np.asarray(confident, dtype=bool)
+    if values.ndim != 2 or confident.shape != values.shape:
+        raise ValueError(f"values {values.shape} and confident {confident.shape} must be the same (H, W) shape")
+    rr, rc = (radius, radius) if np.ndim(radius) == 0 else radius
+    if int(rr) < 0 or int(rc) < 0:
+        raise ValueError(f"radius must be >= 0; got {radius}")
+    rr, rc = int(rr), int(rc)
+    if at is None:
+        rows, cols = (g.ravel() for g in np.indices(values.shape))
+    else:
+        rows, cols = (np.asarray(a, dtype=np.int64).reshape(-1) for a in at)
+    kept = np.where(confident & np.isfinite(values), values, np.nan).astype(np.float32)
+    padded = np.pad(kept, ((rr, rr), (rc, rc)), constant_values=np.nan)
+    dr, dc = (g.ravel() for g in np.indices((2 * rr + 1, 2 * rc + 1)))
+    out = np.full(rows.size, np.nan)
+    candidates = np.nonzero(_any_in_window(np.isfinite(kept), rr, rc)[rows, cols])[0]
+    step = max(1, 2**22 // dr.size)
+    for a in range(0, candidates.size, step):
+        idx = candidates[a:a + step]
+        window = padded[rows[idx, None] + dr[None, :], cols[idx, None] + dc[None, :]]
+        with np.errstate(all="ignore"):
+            out[idx] = np.nanmedian(window, axis=-1)
+    return out.reshape(values.shape) if at is None else out
+
+
+def _any_in_window(mask, rr, rc):
+    """Whether any pixel of the (2 rr + 1) x (2 rc + 1) window around each pixel is set."""
+    c = np.pad(mask, ((rr + 1, rr), (rc + 1, rc))).astype(np.int64).cumsum(0).cumsum(1)
+    h, w = mask.shape
+    total = (c[2 * rr + 1:2 * rr + 1 + h, 2 * rc + 1:2 * rc + 1 + w] - c[:h, 2 * rc + 1:2 * rc + 1 + w]
+             - c[2 * rr + 1:2 * rr + 1 + h, :w] + c[:h, :w])
+    return total > 0
+
+
+def coherent_durations(duration_s, confident, *, radius=3, at=None):
     """Median duration of each pixel's confident neighbours (the pixel included).
 
     Parameters
@@ -226,36 +240,19 @@ def coherent_durations(duration_s, confident, *, radius=3):
         Fitted penumbra durations (s).
     confident : (H, W) bool ndarray
         Pixels whose fit is trusted (resolved, small uncertainty, not cut by the sequence end).
-    radius : int, keyword-only
-        Half size of the square neighbourhood (pixels).
+    radius : int or (int, int), keyword-only
+        Half size of the neighbourhood (pixels), or ``(rows, cols)``.
+    at : tuple of (N,) int ndarray, optional, keyword-only
+        ``(rows, cols)`` of the pixels wanted (default: every pixel).
 
     Returns
     -------
-    (H, W) float64 ndarray
+    (H, W) or (N,) float64 ndarray
         NaN where the neighbourhood has no confident pixel.
     """
     duration = np.asarray(duration_s, dtype=np.float64)
-    confident = np.asarray(confident, dtype=bool)
-    if duration.ndim != 2 or confident.shape != duration.shape:
-        raise ValueError(f"duration_s {duration.shape} and confident {confident.shape} must be the same (H, W) shape")
-    if int(radius) < 0:
-        raise ValueError(f"radius must be >= 0; got {radius}")
-    r = int(radius)
-    values = np.where(confident & np.isfinite(duration) & (duration > 0), np.log(np.where(duration > 0, duration, 1.0)),
-                      np.nan).astype(np.float32)
-    padded = np.pad(values, r, constant_values=np.nan)
-    out = np.full(duration.shape, np.nan)
-    any_rows = np.nonzero(np.isfinite(values).any(axis=1))[0]
-    if any_rows.size == 0:
-        return out
-    lo, hi = max(0, any_rows[0] - r), min(duration.shape[0], any_rows[-1] + r + 1)
-    # row band by row band keeps the (rows, W, (2r+1)^2) window view small
-    for a in range(lo, hi, 256):
-        b = min(hi, a + 256)
-        view = np.lib.stride_tricks.sliding_window_view(padded[a:b + 2 * r], (2 * r + 1, 2 * r + 1))
-        flat = view.reshape(b - a, duration.shape[1], -1)
-        has = np.isfinite(flat).any(-1)
-        with np.errstate(all="ignore"):
-            med = np.nanmedian(np.where(has[..., None], flat, 0.0), axis=-1)
-        out[a:b] = np.where(has, np.exp(med), np.nan)
-    return out
+    if duration.ndim != 2:
+        raise ValueError(f"duration_s must be (H, W); got shape {duration.shape}")
+    with np.errstate(all="ignore"):
+        log = np.where(duration > 0, np.log(np.where(duration > 0, duration, 1.0)), np.nan)
+    return np.exp(neighbour_median(log, confident, radius=radius, at=at))

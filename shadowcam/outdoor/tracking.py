@@ -77,7 +77,8 @@ class EdgeTracker:
         the lit level is updated only `update_distance` rows beyond it, and a passing
         shade is measured that many rows further above the edge, so that neither takes
         the penumbra's own dimming (the real sun behind a far ridge: tens of rows) for a
-        change of the lit level or for a cloud.
+        change of the lit level or for a cloud; and the ramps the sequence's end cut take
+        their duration and shadow level from confident fits that many rows away.
     descent_frames : int, optional
         Frames of each pixel's final descent kept for the penumbra fit
         (:class:`shadowcam.outdoor.descent.DescentBuffer`; at least the penumbra's
@@ -112,6 +113,7 @@ class EdgeTracker:
         if not edge_width_rows >= 0:
             raise ValueError(f"edge_width_rows must be >= 0; got {edge_width_rows}")
         soft = float(np.ceil(edge_width_rows))
+        self._edge_width = int(soft)
         self.lit_update, self.update_distance = float(lit_update), float(update_distance) + soft
         self._shade_gap = SHADE_GAP + int(soft)
         self.edge_row = np.full((n_frames, width), np.nan, dtype=np.float32)
@@ -175,7 +177,8 @@ class EdgeTracker:
             "n_transitions": self.n_transitions,
             "band_fraction": self.band_fraction,
             **episodes,
-            **fit_descents(self.descent, episodes["coverage_arrival_s"], self.time_s, max_sigma=self.max_sigma),
+            **fit_descents(self.descent, episodes["coverage_arrival_s"], self.time_s, max_sigma=self.max_sigma,
+                           cut_rows=self._edge_width),
         }
 
 

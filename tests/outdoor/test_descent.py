@@ -144,3 +144,30 @@ def test_the_edge_width_is_measured_and_widens_the_strip_halo():
     assert strip_halo(shift, edge_width_rows=width) == strip_halo(shift) + int(np.ceil(width))
     with pytest.raises(ValueError, match="edge_width_rows"):
         strip_halo(shift, edge_width_rows=-1.0)
+
+
+def test_ramps_cut_after_their_centre_take_their_neighbours_duration_and_shadow_level():
+    rng = np.random.default_rng(13)
+    times = np.arange(100) * INTERVAL
+    rows = np.arange(40)[:, None] * np.ones((1, 5))
+    centre = (40.0 + 1.5 * rows) * INTERVAL  # the edge moves down; 40-frame ramps: rows >= 27 end after the last frame
+    series = ramp_model(times[:, None, None], centre_s=centre, duration_s=40 * INTERVAL, lit=1.0, shadow=0.05)
+    buffer, crossing, times = _stream(series + rng.normal(0, 0.01, series.shape), frames=128)
+    ended = centre + 20 * INTERVAL <= times[-1] + 0.5 * INTERVAL
+    cut = ~ended & np.isfinite(crossing)  # the last row has not crossed the coverage's half level
+    near = fit_descents(buffer, crossing, times)  # neighbours within 3 rows only
+    wide = fit_descents(buffer, crossing, times, cut_rows=16)
+    for out in (near, wide):
+        assert (out["ramp_state"][ended] == STATE_CODE["fitted"]).all()
+    # within 16 rows every cut ramp has ended neighbours (at the border its own fit may end in time);
+    # within 3 only the first rows do
+    assert np.isin(wide["ramp_state"][cut], [STATE_CODE["cut_centred"], STATE_CODE["fitted"]]).all()
+    assert (wide["ramp_state"][cut] == STATE_CODE["cut_centred"]).mean() >= 0.9
+    assert (near["ramp_state"][cut] == STATE_CODE["cut"]).sum() >= 5 * 8
+    error = np.abs(wide["ramp_centre_s"] - centre)[cut] / INTERVAL
+    assert np.median(error) <= 0.3 and error.max() <= 1.5
+    np.testing.assert_allclose(wide["ramp_duration_s"][cut] / INTERVAL, 40, rtol=0.1)
+    reason = np.full(centre.shape, REASON_CODE["coverage_crossing"], np.uint8)
+    arrival, reason = apply_ramps(crossing, reason, wide["ramp_centre_s"], wide["ramp_state"])
+    assert (reason[cut] == REASON_CODE["penumbra_fit"]).all()
+    np.testing.assert_array_equal(arrival[cut], wide["ramp_centre_s"][cut])

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, ramp_model, visible_fraction
+from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, neighbour_median, ramp_model, visible_fraction
 
 INTERVAL = 5.0
 TIMES = np.arange(128) * INTERVAL
@@ -99,3 +99,82 @@ def test_neighbours_duration_is_the_median_of_the_confident_ones():
     assert np.isnan(coherent_durations(duration, np.zeros_like(confident), radius=1)).all()
     with pytest.raises(ValueError, match="radius"):
         coherent_durations(duration, confident, radius=-1)
+
+
+def test_each_pixel_is_fitted_alone_whatever_its_batch_and_its_gaps():
+    centre, series = _ramps(30, 6, noise=0.02, seed=11)
+    series[2, 50:53] = np.nan  # a gap inside the ramp
+    series[4, :20] = np.nan  # a short record
+    together = fit_ramps(series, TIMES, centre_s=centre, interval_s=INTERVAL)
+    for i in range(series.shape[0]):
+        alone = fit_ramps(series[i:i + 1], TIMES, centre_s=centre[i:i + 1], interval_s=INTERVAL)
+        for key in ("centre_s", "duration_s", "sigma_s", "n_inside"):
+            assert alone[key][0] == together[key][i]
+    # the gap's samples take no part: the same series without them (times kept) gives the same fit
+    kept = np.isfinite(series[2])
+    short = fit_ramps(series[2:3, kept], TIMES[kept], centre_s=centre[2:3], interval_s=INTERVAL)
+    assert short["n_inside"][0] == together["n_inside"][2]
+    assert abs(short["centre_s"][0] - centre[2]) / INTERVAL <= 0.5
+
+
+@pytest.mark.parametrize("seen_after", [0.05, 0.25])
+def test_a_ramp_cut_after_its_centre_is_centred_with_the_duration_and_shadow_known(seen_after):
+    # the series ends `seen_after` durations after the centre: the second half of the ramp is not seen
+    duration = 50 * INTERVAL
+    rng = np.random.default_rng(12)
+    centre = rng.uniform(60.0, 70.0, 200) * INTERVAL
+    end = centre + seen_after * duration
+    clean = ramp_model(TIMES[None, :], centre_s=centre[:, None], duration_s=duration, lit=1.0, shadow=0.1)
+    series = np.where(TIMES[None, :] <= end[:, None], clean, np.nan)
+    known = {"duration_s": np.full(200, duration), "shadow": np.full(200, 0.1)}
+    exact = fit_ramps(series, TIMES, centre_s=centre + 3 * INTERVAL, interval_s=INTERVAL, **known)
+    assert exact["resolved"].all()
+    np.testing.assert_allclose(exact["centre_s"], centre, atol=1e-3 * INTERVAL)
+    np.testing.assert_allclose(exact["lit"], 1.0, atol=1e-6)
+    np.testing.assert_allclose(exact["shadow"], 0.1, atol=0.0)  # fixed
+    noisy = fit_ramps(series + rng.normal(0.0, 0.02, series.shape), TIMES, centre_s=centre + 3 * INTERVAL,
+                      interval_s=INTERVAL, **known)
+    error = np.abs(noisy["centre_s"] - centre)
+    assert np.median(error) / INTERVAL <= 0.5
+    assert np.mean(error <= 3 * noisy["sigma_s"]) >= 0.95  # the standard error is honest
+    with pytest.raises(ValueError, match="shadow"):
+        fit_ramps(series, TIMES, centre_s=centre, interval_s=INTERVAL, shadow=np.zeros(3))
+
+
+def test_neighbour_median_reads_a_rectangle_of_confident_values():
+    values = np.arange(60, dtype=float).reshape(10, 6)
+    confident = np.zeros((10, 6), bool)
+    confident[0, 2] = confident[9, 2] = True
+    out = neighbour_median(values, confident, radius=(9, 1), at=(np.array([5, 5]), np.array([2, 5])))
+    assert out[0] == pytest.approx((values[0, 2] + values[9, 2]) / 2) and np.isnan(out[1])
+    full = neighbour_median(values, confident, radius=(4, 0))
+    assert full[4, 2] == values[0, 2] and full[5, 2] == values[9, 2] and np.isnan(full[4, 3])
+
+
+def _changing_edge(tau, beta):
+    """Edge distance (disc radii) when its speed changes linearly: 2 tau (1 + beta tau), monotonic (held beyond the disc)."""
+    turned = 1.0 + 2.0 * beta * tau <= 0.0
+    return np.where(turned, -2.0 * np.sign(beta), 2.0 * tau * (1.0 + beta * tau))
+
+
+@settings(max_examples=20, deadline=None)
+@given(beta=st.floats(-0.4, 0.4), duration=st.floats(20.0, 60.0), phase=st.floats(0.0, 1.0))
+def test_a_ramp_whose_edge_speed_changes_is_centred_exactly_with_the_speed_change_fitted(beta, duration, phase):
+    centre = (60.0 + phase) * INTERVAL
+    series = (0.1 + 0.9 * visible_fraction(_changing_edge((TIMES - centre) / (duration * INTERVAL), beta)))[None]
+    fit = fit_ramps(series, TIMES, centre_s=np.array([centre + 3 * INTERVAL]), interval_s=INTERVAL, speed_change=True)
+    assert fit["resolved"][0]
+    assert abs(fit["centre_s"][0] - centre) / INTERVAL <= 1e-3
+    assert fit["speed_change"][0] == pytest.approx(beta, abs=1e-3)
+    assert fit["duration_s"][0] / INTERVAL == pytest.approx(duration, rel=1e-3)
+
+
+def test_the_constant_speed_law_is_off_centre_on_a_ramp_whose_speed_doubles():
+    # u = 2 tau (1 + 0.4 tau): the edge's speed is 0.6 / 1.4 of its mean at the ramp's start / end
+    centre, duration = 60.0 * INTERVAL, 50.0 * INTERVAL
+    series = (0.1 + 0.9 * visible_fraction(_changing_edge((TIMES - centre) / duration, 0.4)))[None]
+    constant = fit_ramps(series, TIMES, centre_s=np.array([centre]), interval_s=INTERVAL)
+    changing = fit_ramps(series, TIMES, centre_s=np.array([centre]), interval_s=INTERVAL, speed_change=True)
+    assert abs(constant["centre_s"][0] - centre) / INTERVAL > 0.5  # 0.79 intervals early
+    assert abs(changing["centre_s"][0] - centre) / INTERVAL <= 1e-3
+    np.testing.assert_array_equal(constant["speed_change"], 0.0)
