@@ -3,6 +3,7 @@ lab capture (synthetic_tiny: one dual view per viewpoint across the dip interval
 wide-shadow area-light capture (synthetic_area: each viewpoint against its own reciprocal
 render, paper Fig. 13), asking only for the files the assertions read."""
 
+import csv
 import json
 
 import numpy as np
@@ -70,3 +71,14 @@ def test_area_capture_viewpoints_match_their_reciprocal_renders(viewpoint_run):
         assert scores["rel_rmse_masked"] <= 0.25, (name, scores)
         assert scores["coverage_of_visible"] >= 0.7, (name, scores)
     assert (workdir / f"results/{AREA}/figures/viewpoints.png").is_file()
+    # the table (accuracy.csv, shown as figures/accuracy.html) has the same two sections
+    with open(workdir / f"results/{AREA}/accuracy.csv", newline="") as handle:
+        table = {row["quantity"]: row for row in csv.DictReader(handle)}
+    for name in VIEWPOINTS:
+        row = table[f"dual view relative RMSE, GT valid mask, viewpoint {name}"]
+        assert float(row["value"]) == pytest.approx(100 * report["viewpoints"][name]["rel_rmse_masked"], rel=5e-3)
+    for sweep in ("u", "v"):
+        row = table[f"dip interval centre |error| p95, sweep {sweep}"]
+        assert float(row["value"]) == pytest.approx(report["interval"][sweep]["centre"]["p95"], rel=5e-3)
+    html = (workdir / f"results/{AREA}/figures/accuracy.html").read_text()
+    assert "dip interval centre |error| p95, sweep u" in html and "viewpoint exit" in html
