@@ -576,6 +576,15 @@ TABLE_ROWS = {
         "reduction": ("dual coordinates RMSE lowered by the extra sweeps", "%", 100.0),
     },
 }
+#: rows of the dip-interval section, per sweep: the pixels with a measurable interval and
+#: the absolute error of its entry, centre and exit (frames)
+INTERVAL_ROWS = {
+    "n_truth": ("dip interval: pixels whose whole dip lies in the sweep", "pixel", 1.0),
+    "coverage": ("dip interval coverage", "%", 100.0),
+    **{f"{part}.{stat}": (f"dip interval {part} |error| {label}", "frame", 1.0)
+       for part in ("entry", "centre", "exit")
+       for stat, label in (("median", "median"), ("p95", "p95"), ("rmse", "RMSE"), ("max", "max"))},
+}
 #: target name -> the report key it checks (per sweep of ``shadow_time``; sweep None: a section)
 TARGET_KEYS = {"shadow_time_p95_frames": "p95", "shadow_time_coverage": "coverage",
                "false_time_rate": "false_time_rate", "dual_straightness_rms_px": "dual_rms"}
@@ -600,7 +609,9 @@ def accuracy_table(report):
     -------
     list of dict
         Rows of :func:`shadowcam._shared.quantity_table.quantity_row` (``quantity``, ``value``,
-        ``unit``, ``target``, ``pass``), values to three significant digits.
+        ``unit``, ``target``, ``pass``), values to three significant digits: the sections of
+        :data:`TABLE_ROWS`, then the dip interval per sweep (:data:`INTERVAL_ROWS`) and each
+        viewpoint's dual image (the ``dual_image`` rows, suffixed ``, viewpoint <name>``).
     """
     targets = {(TARGET_KEYS.get(t["target"]), t["sweep"]): t for t in report.get("targets", [])}
     rows = []
@@ -618,6 +629,19 @@ def accuracy_table(report):
                 if key in stats:
                     rows.append(quantity_row(quantity + suffix, stats[key], unit, scale=scale,
                                              target=targets.get((key, sweep))))
+    for sweep, stats in report.get("interval", {}).items():
+        flat = {f"{part}.{k}": v for part, node in stats.items() if isinstance(node, dict) for k, v in node.items()}
+        for key, (quantity, unit, scale) in INTERVAL_ROWS.items():
+            value = stats.get(key, flat.get(key))
+            if value is not None:
+                rows.append(quantity_row(f"{quantity}, sweep {sweep}", value, unit, scale=scale))
+    for name, stats in report.get("viewpoints", {}).items():
+        suffix = f", viewpoint {name}"
+        if "skipped" in stats:
+            rows.append(quantity_row(f"dual view{suffix}", f"skipped: {stats['skipped']}"))
+            continue
+        rows += [quantity_row(quantity + suffix, stats[key], unit, scale=scale)
+                 for key, (quantity, unit, scale) in TABLE_ROWS["dual_image"].items() if key in stats]
     if "dual_model" in report:
         model = report["dual_model"]
         rows.append(quantity_row("dual model", model["why"] or model["model"]))  # why starts with the model

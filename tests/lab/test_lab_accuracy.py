@@ -226,3 +226,39 @@ def test_pushbroom_errors_against_the_exact_time_assembly():
     assert pushbroom_errors(late, truth_time, reference, along="row")["rel_rmse"] > 0.1
     with pytest.raises(ValueError, match="pushbroom must have the shape"):
         pushbroom_errors(exact[:, :5], truth_time, reference, along="row")
+
+
+def test_accuracy_table_has_the_interval_and_viewpoint_rows():
+    """Entry late by 0.2, exit late by 0.4 frame on every pixel: centre late by 0.3; the
+    viewpoint rows carry their dual-image scores (or why they were skipped)."""
+    from shadowcam.lab.accuracy import accuracy_table, interval_errors
+
+    rows, cols = 6, 8
+    true_entry = np.tile(np.arange(cols, dtype=float) + 10.0, (rows, 1))
+    true_exit = true_entry + 3.0
+    lit = np.ones((rows, cols), bool)
+    lit[0] = False  # an unlit row is not counted
+    gt = xr.Dataset({"lit": (("row", "col"), lit),
+                     "interval_entry_u": (("row", "col"), true_entry),
+                     "interval_exit_u": (("row", "col"), true_exit)})
+    st = xr.Dataset({"interval_entry": (("sweep", "row", "col"), (true_entry + 0.2)[None]),
+                     "interval_exit": (("sweep", "row", "col"), (true_exit + 0.4)[None])},
+                    coords={"sweep": ["u"]}, attrs={"n_frames_u": 40})
+    report = {"interval": interval_errors(st, gt),
+              "viewpoints": {"entry": {"rel_rmse_masked": 0.25, "coverage_of_visible": 0.8, "n_mask": 300},
+                             "exit": {"skipped": "no reciprocal render"}},
+              "targets": [], "noise": "noise_free", "all_targets_pass": True}
+    table = {row["quantity"]: row for row in csv.DictReader(io.StringIO(report_to_csv(report)))}
+    assert len(table) == len(accuracy_table(report))  # one row per quantity
+    assert table["dip interval: pixels whose whole dip lies in the sweep, sweep u"]["value"] == "40"
+    assert (table["dip interval coverage, sweep u"]["value"], table["dip interval coverage, sweep u"]["unit"]) \
+        == ("100", "%")
+    for part, error in (("entry", 0.2), ("centre", 0.3), ("exit", 0.4)):
+        for stat in ("median", "p95", "RMSE", "max"):
+            row = table[f"dip interval {part} |error| {stat}, sweep u"]
+            assert float(row["value"]) == pytest.approx(error, abs=1e-9) and row["unit"] == "frame"
+    entry = table["dual view relative RMSE, GT valid mask, viewpoint entry"]
+    assert (entry["value"], entry["unit"]) == ("25", "%")
+    assert table["dual view coverage of what the camera sees, viewpoint entry"]["value"] == "80"
+    assert table["dual pixels in the GT valid mask, viewpoint entry"]["value"] == "300"
+    assert table["dual view, viewpoint exit"]["value"] == "skipped: no reciprocal render"
