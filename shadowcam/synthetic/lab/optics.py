@@ -417,6 +417,32 @@ def _seen_from(objects, optics, camera, target, x, y, *, tolerance, iterations, 
     return x, y, hit, footprint, bent
 
 
+def _checked_point_query(points, *, tolerance, iterations, step, starts):
+    """`points` as (N, 3) float64, after checking the options of a camera-pixel search."""
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise ValueError(f"points: expected (N, 3), got {points.shape}")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"tolerance: must be a positive number of pixels, got {tolerance!r}")
+    if int(iterations) < 1:
+        raise ValueError(f"iterations: must be >= 1, got {iterations!r}")
+    if not (np.isfinite(step) and step > 0):
+        raise ValueError(f"step: must be a positive number of pixels, got {step!r}")
+    if int(starts) < 1:
+        raise ValueError(f"starts: must be >= 1, got {starts!r}")
+    return points
+
+
+def _pixel_centre_hits(objects, optics, camera):
+    """Every pixel centre's ray through the optics: centres ``gx, gy`` (H*W,) and the
+    scene hits and bent rays of ``intersect_through_optics``."""
+    rows, cols = np.mgrid[0:camera.height, 0:camera.width]
+    gx, gy = cols.ravel() + 0.5, rows.ravel() + 0.5
+    origins, dirs = camera_rays(camera, gx, gy)
+    grid, bent = intersect_through_optics(objects, optics, origins, dirs)
+    return gx, gy, grid, bent
+
+
 def camera_pixels_of_points(objects, optics, camera, points, *, tolerance=0.01,
                             iterations=12, step=0.05, starts=4):
     """Camera pixel whose ray, bent by the optics, meets each scene point first.
@@ -455,26 +481,13 @@ def camera_pixels_of_points(objects, optics, camera, points, *, tolerance=0.01,
         Camera (col, row) pixel-centre index of each point (NaN where not seen).
     seen : (N,) bool
     """
-    points = np.asarray(points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points: expected (N, 3), got {points.shape}")
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"tolerance: must be a positive number of pixels, got {tolerance!r}")
-    if int(iterations) < 1:
-        raise ValueError(f"iterations: must be >= 1, got {iterations!r}")
-    if not (np.isfinite(step) and step > 0):
-        raise ValueError(f"step: must be a positive number of pixels, got {step!r}")
-    if int(starts) < 1:
-        raise ValueError(f"starts: must be >= 1, got {starts!r}")
+    points = _checked_point_query(points, tolerance=tolerance, iterations=iterations, step=step, starts=starts)
     from scipy.spatial import cKDTree
 
     n = len(points)
     xy = np.full((n, 2), np.nan)
     seen = np.zeros(n, dtype=bool)
-    rows, cols = np.mgrid[0:camera.height, 0:camera.width]
-    gx, gy = cols.ravel() + 0.5, rows.ravel() + 0.5
-    origins, dirs = camera_rays(camera, gx, gy)
-    grid, _ = intersect_through_optics(objects, optics, origins, dirs)
+    gx, gy, grid, _ = _pixel_centre_hits(objects, optics, camera)
     todo = np.flatnonzero(np.all(np.isfinite(points), axis=1))
     if not grid.hit.any() or not len(todo):
         return xy, seen
@@ -561,20 +574,11 @@ def camera_light_through_optics(objects, optics, camera, points, *, tolerance=0.
     origin : (N, B, 3) float64
         Where the branch's ray leaves the optics (the camera centre for a direct ray).
     """
-    points = np.asarray(points, dtype=np.float64)
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise ValueError(f"points: expected (N, 3), got {points.shape}")
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"tolerance: must be a positive number of pixels, got {tolerance!r}")
-    if int(starts) < 1:
-        raise ValueError(f"starts: must be >= 1, got {starts!r}")
+    points = _checked_point_query(points, tolerance=tolerance, iterations=iterations, step=step, starts=starts)
     from scipy.spatial import cKDTree
 
     n = len(points)
-    rows, cols = np.mgrid[0:camera.height, 0:camera.width]
-    gx, gy = cols.ravel() + 0.5, rows.ravel() + 0.5
-    origins, dirs = camera_rays(camera, gx, gy)
-    grid, bent_grid = intersect_through_optics(objects, optics, origins, dirs)
+    gx, gy, grid, bent_grid = _pixel_centre_hits(objects, optics, camera)
     branches = np.unique(bent_grid.interactions[grid.hit])
     to_light = np.full((n, len(branches), 3), np.nan)
     gain = np.zeros((n, len(branches)))
