@@ -169,42 +169,10 @@ def test_invalid_arguments_name_the_parameter():
         tracker.update(np.ones((3, 2, 3), np.float32))
 
 
-@settings(max_examples=30, deadline=None)
-@given(plateau=st.integers(10, 200), ramp=st.integers(4, 10), phase=st.floats(0, 1), floor=st.floats(0, 1))
-def test_wide_dip_half_depth_of_the_true_lit_level(plateau, ramp, phase, floor):
-    # the tracker's lit level counts the plateau beyond its window as lit; without_interval
-    # takes it out, and the crossings land on the true half depth
-    from shadowcam.lab.dip_tracker import without_interval
-
-    # the dip covers at most a third of the sweep (the correction is first order in the
-    # first pass's level error)
-    n = 3 * (plateau + 2 * ramp) + 60
-    signal, entry, exit_ = trapezoid(n, entry=30 + ramp / 2 + phase, plateau=plateau, ramp=ramp,
-                                     depth=0.8, floor=floor)
-    frames = signal.astype(np.float32)[:, None, None]
-    tracker = DipTracker((1, 1), half_window=4)
-    tracker.update(frames)
-    summary, interval = without_interval(*(lambda s: (s, track_intervals([frames], s)))(tracker.result()))
-    # what stays counted as lit: the ramps' frames at or above half depth, at most
-    # ramp / 2 + 1 each side, removing at most depth / 2 each; the crossing moves by half
-    # the level's error over the slope, plus up to 0.1 frame from the first-order move along
-    # a smoothed ramp's corner
-    bound = (ramp + 2) * 0.4 / summary.lit_count[0, 0]
-    assert 0 <= 1.0 + floor - summary.lit_level[0, 0] <= bound
-    assert summary.noise[0, 0] < 0.8 * np.sqrt(ramp / summary.lit_count[0, 0])
-    np.testing.assert_allclose([interval.entry[0, 0], interval.exit[0, 0]], [entry, exit_],
-                               atol=0.5 * bound / (0.8 / ramp) + 0.1)
-    # and the first pass alone is off by the plateau
-    assert 1.0 + floor - tracker.result().lit_level[0, 0] > bound
-
-
-@settings(max_examples=30, deadline=None)
-@given(plateau=st.integers(10, 200), ramp=st.integers(4, 10), phase=st.floats(0, 1), floor=st.floats(0, 1))
-def test_wide_dip_lit_level_leaves_out_the_penumbra_ramps(plateau, ramp, phase, floor):
-    # the ramp frames above half depth outside the window lack light too: with them taken
-    # out the lit level is the unoccluded one to 1 % of the depth (the straight ramp through
-    # the smoothed crossing; sampling of its ends), and the crossings land within 0.1 frame
-    # of the exact ones (the first-order move along a short ramp's smoothed corner)
+def _tracked_trapezoid(plateau, ramp, phase, floor):
+    """A trapezoid dip (depth 0.8) covering at most a third of the sweep (the level's
+    correction is first order in the first pass's level error), tracked by the first pass
+    and the interval pass: (first pass, corrected summary, interval, true entry, exit)."""
     from shadowcam.lab.dip_tracker import without_interval
 
     n = 3 * (plateau + 2 * ramp) + 60
@@ -215,5 +183,35 @@ def test_wide_dip_lit_level_leaves_out_the_penumbra_ramps(plateau, ramp, phase, 
     tracker.update(frames)
     first = tracker.result()
     summary, interval = without_interval(first, track_intervals([frames], first))
+    return first, summary, interval, entry, exit_
+
+
+@settings(max_examples=30, deadline=None)
+@given(plateau=st.integers(10, 200), ramp=st.integers(4, 10), phase=st.floats(0, 1), floor=st.floats(0, 1))
+def test_wide_dip_half_depth_of_the_true_lit_level(plateau, ramp, phase, floor):
+    # the tracker's lit level counts the plateau beyond its window as lit; without_interval
+    # takes it out, and the crossings land on the true half depth
+    first, summary, interval, entry, exit_ = _tracked_trapezoid(plateau, ramp, phase, floor)
+    # what stays counted as lit: the ramps' frames at or above half depth, at most
+    # ramp / 2 + 1 each side, removing at most depth / 2 each; the crossing moves by half
+    # the level's error over the slope, plus up to 0.1 frame from the first-order move along
+    # a smoothed ramp's corner
+    bound = (ramp + 2) * 0.4 / summary.lit_count[0, 0]
+    assert 0 <= 1.0 + floor - summary.lit_level[0, 0] <= bound
+    assert summary.noise[0, 0] < 0.8 * np.sqrt(ramp / summary.lit_count[0, 0])
+    np.testing.assert_allclose([interval.entry[0, 0], interval.exit[0, 0]], [entry, exit_],
+                               atol=0.5 * bound / (0.8 / ramp) + 0.1)
+    # and the first pass alone is off by the plateau
+    assert 1.0 + floor - first.lit_level[0, 0] > bound
+
+
+@settings(max_examples=30, deadline=None)
+@given(plateau=st.integers(10, 200), ramp=st.integers(4, 10), phase=st.floats(0, 1), floor=st.floats(0, 1))
+def test_wide_dip_lit_level_leaves_out_the_penumbra_ramps(plateau, ramp, phase, floor):
+    # the ramp frames above half depth outside the window lack light too: with them taken
+    # out the lit level is the unoccluded one to 1 % of the depth (the straight ramp through
+    # the smoothed crossing; sampling of its ends), and the crossings land within 0.1 frame
+    # of the exact ones (the first-order move along a short ramp's smoothed corner)
+    first, summary, interval, entry, exit_ = _tracked_trapezoid(plateau, ramp, phase, floor)
     assert abs(1.0 + floor - summary.lit_level[0, 0]) <= 0.01 * 0.8
     np.testing.assert_allclose([interval.entry[0, 0], interval.exit[0, 0]], [entry, exit_], atol=0.1)
