@@ -67,6 +67,16 @@ def _measured(call):
     return result, seconds, peak
 
 
+def _time_error_row(stage, method, seconds, throughput, peak, errors, coverage):
+    """One comparison row of a timing method: median and p95 of the absolute `errors`
+    (frames; NaN without any)."""
+    return {"stage": stage, "method": method, "seconds": seconds, "throughput": throughput,
+            "peak_mib": peak,
+            "p50": float(np.median(errors)) if errors.size else np.nan,
+            "p95": float(np.percentile(errors, 95)) if errors.size else np.nan,
+            "coverage": coverage}
+
+
 def compare_shadow_time_methods(sweeps, *, methods=None, half_window=4, cfa_pattern=None):
     """Speed and error of shadow-time methods on the same sweeps.
 
@@ -115,14 +125,8 @@ def compare_shadow_time_methods(sweeps, *, methods=None, half_window=4, cfa_patt
             errors.append(np.abs(result["shadow_time"] - truth)[has])
             n_truth += stats["n_truth"]
             n_found += stats["n_evaluated"]
-        err = np.concatenate(errors)
-        rows.append({
-            "stage": "shadow_time", "method": method, "seconds": seconds,
-            "throughput": pixel_frames / seconds, "peak_mib": peak,
-            "p50": float(np.median(err)) if err.size else np.nan,
-            "p95": float(np.percentile(err, 95)) if err.size else np.nan,
-            "coverage": n_found / n_truth if n_truth else np.nan,
-        })
+        rows.append(_time_error_row("shadow_time", method, seconds, pixel_frames / seconds, peak,
+                                    np.concatenate(errors), n_found / n_truth if n_truth else np.nan))
     return rows
 
 
@@ -163,13 +167,8 @@ def compare_minima_methods(capture, *, methods=None, half_window=4):
         errors = light_set_errors(views, capture)
         err = np.concatenate([error[scored] for error, scored in errors.values()])
         timed = err[np.isfinite(err)]
-        rows.append({
-            "stage": "several_minima", "method": method, "seconds": seconds,
-            "throughput": pixel_frames / seconds, "peak_mib": peak,
-            "p50": float(np.median(timed)) if timed.size else np.nan,
-            "p95": float(np.percentile(timed, 95)) if timed.size else np.nan,
-            "coverage": timed.size / err.size if err.size else np.nan,
-        })
+        rows.append(_time_error_row("several_minima", method, seconds, pixel_frames / seconds, peak, timed,
+                                    timed.size / err.size if err.size else np.nan))
     return rows
 
 
