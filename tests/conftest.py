@@ -422,7 +422,8 @@ def _make_lightfield_manifest(folder, *, name="captured_lf", shape=(32, 32), n_f
                          for s in rendered["screens"]],
              "mask": {"position_m": rendered["mask"]["position_mm"] / 1e3,
                       "start_m": rendered["mask"]["start_mm"] / 1e3, "step_m": rendered["mask"]["step_mm"] / 1e3},
-             "camera": {"gain_dn_per_e": rendered["sensor"]["gain"], "read_noise_dn": rendered["sensor"]["read_noise"]}}
+             "camera": {"gain_dn_per_e": rendered["sensor"]["gain"], "read_noise_dn": rendered["sensor"]["read_noise"],
+                        "footprint_variance_px2": rendered["sensor"]["footprint_variance_px2"]}}
     if exposure == "metadata":
         block["exposure"] = {"source": "metadata", "brackets": len(rendered["exposure_times"])}
     else:

@@ -455,7 +455,9 @@ def lightfield_facts(manifest):
         "exposure_source": "metadata" if screens[0]["exposure_times_s"][0] is None else "manifest",
         "mask": None if mask is None else {k.replace("_m", "_mm"): 1e3 * float(v) for k, v in mask.items()},
         "camera": {"gain_dn_per_e": float(camera.get("gain_dn_per_e", 1.0)),
-                   "read_noise_dn": float(camera.get("read_noise_dn", 1.0)), "given": sorted(camera)},
+                   "read_noise_dn": float(camera.get("read_noise_dn", 1.0)),
+                   "footprint_variance_px2": float(camera.get("footprint_variance_px2", 1.0 / 12.0)),
+                   "given": sorted(camera)},
     }
     return sweeps, facts
 

@@ -3,12 +3,17 @@
 Each screen position has a horizontal sweep (a vertical wire moving along the mask's
 x) and a vertical one (a horizontal wire moving along y). Their shadow times at a
 camera pixel, turned into mask positions ``x_mask = start + step * time``, name the
-mask point the pixel's light passed through (paper VI, Fig. 17). A ray is the line
-through the near screen's point and the far screen's point with the same mask
-coordinates: its origin is a pixel of the anchor screen (the far one by default), its
-direction goes to the other screen's point (interpolated over that screen's mask
-coordinates, Clough-Tocher C1 cubic on their Delaunay triangulation). Its flux is the
-anchor screen's irradiance times the pixel's screen area.
+mask point the pixel's light passed through (paper VI, Fig. 17). A ray's origin is a pixel of
+the anchor screen (the far one by default); its flux is the anchor screen's irradiance times
+the pixel's screen area. Its direction, given the mask plane's position (the default of the
+stages), is the line from the pixel's mask point on the mask plane to the pixel's flux
+centroid on the anchor screen: the wire blocks exactly the light through that mask point,
+and the anchor's mask error then tilts the ray by itself over the mask-to-anchor distance.
+Without it, the ray goes to the other screen's point with the pixel's mask coordinates
+(interpolated over that screen's mask coordinates, Clough-Tocher C1 cubic on their Delaunay
+triangulation), which tilts it by the other screen's magnification times the mask error over
+the screens' separation. Either way the other screen must see the mask point (else the ray
+is flagged ``no_match_far``).
 
 The shadow times come from the lab wing's streaming dip tracker
 (:func:`shadowcam.lab.shadow_time.track_sweep`, memory independent of the number of
@@ -33,6 +38,7 @@ from shadowcam._shared.atomic import atomic_path
 from shadowcam._shared.validation import check_in, check_positive, check_same_shape
 from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
 from shadowcam.lightfield.direction_fit import direction_noise, far_magnification, fit_directions
+from shadowcam.lightfield.screen import flux_centroids
 
 #: ray flag code -> meaning (0 = a ray)
 REASONS = {
@@ -123,16 +129,19 @@ EDGE_RAYS = ("fit", "drop", "nearest")
 ANCHORS = ("far", "near")
 
 
-def rays_dataset(near, far, *, anchor="far", mask_std_scale=0.05, smooth_directions=False, edge_rays="fit"):
-    """The rays through the near and the far screens' points of equal mask coordinates.
+def rays_dataset(near, far, *, anchor="far", mask_position_mm=None, footprint_variance=0.0, mask_std_scale=0.05,
+                 smooth_directions=False, edge_rays="fit"):
+    """The rays of a light field from its near and far screens' mask-coordinate maps.
 
-    Each ray starts at a pixel of the `anchor` screen (its point is known exactly) and goes
-    through the point of the other screen with the pixel's mask coordinates (interpolated over
-    that screen's mask map). The anchor pixel's mask error moves that point by the other
-    screen's magnification (screen mm per mask mm), so the direction error is the other
-    screen's magnification times the anchor's mask error over the separation: anchored on the
-    far screen, the other point is on the near screen, whose magnification is the smaller for
-    a diverging beam.
+    Each ray starts at a pixel of the `anchor` screen (its point is known exactly). With
+    `mask_position_mm` its direction is the line from the pixel's mask point (on the mask
+    plane) to the pixel's flux centroid on the anchor screen
+    (:func:`shadowcam.lightfield.screen.flux_centroids`): the anchor's mask error ``e`` tilts
+    it by ``e / (z_anchor - z_mask)``. Without it the ray goes through the point of the other
+    screen with the pixel's mask coordinates (interpolated over that screen's mask map): the
+    anchor pixel's mask error moves that point by the other screen's magnification (screen mm
+    per mask mm), a tilt of that magnification times ``e`` over the screens' separation.
+    In both, a pixel whose mask point the other screen does not see is flagged.
 
     Parameters
     ----------
@@ -140,6 +149,12 @@ def rays_dataset(near, far, *, anchor="far", mask_std_scale=0.05, smooth_directi
         :func:`screen_mask_map` of the near and the far screen.
     anchor : {"far", "near"}, keyword-only
         :data:`ANCHORS`: the screen whose pixels carry the rays (origins, flux, grid).
+    mask_position_mm : float, optional, keyword-only
+        z of the mask plane (< the near screen's): the rays go through the anchor pixels' mask
+        points. None: through the other screen's points.
+    footprint_variance : float, keyword-only
+        Per-axis second moment (px^2) of a camera pixel's footprint on the screen, for the
+        flux centroid of the anchor pixels (with `mask_position_mm`; 0 = the pixel centres).
     mask_std_scale : float, keyword-only
         Mask-coordinate standard deviation (mm) at which the confidence is ``exp(-1/2)``.
     smooth_directions : bool, keyword-only
@@ -164,16 +179,21 @@ def rays_dataset(near, far, *, anchor="far", mask_std_scale=0.05, smooth_directi
         is the local fit's from its neighbours (with that fit's std), or NaN with flux 0
         (left out of renders), or the nearest found ray's. Attributes: the screens' positions and
         camera pitches (``near_pitch_mm``, ``far_pitch_mm``: square root of the median
-        pixel area), ``anchor`` and ``origin_position_mm``.
+        pixel area), ``anchor``, ``origin_position_mm`` and ``through`` (``mask`` or ``screen``).
     """
     check_in(anchor, "anchor", ANCHORS)
+    if mask_position_mm is not None and not (np.isfinite(mask_position_mm)
+                                             and mask_position_mm < min(near["position_mm"], far["position_mm"])):
+        raise ValueError(f"mask_position_mm must be a finite z below both screens' ({near['position_mm']}, "
+                         f"{far['position_mm']}); got {mask_position_mm!r}: check the capture's mask position_mm")
     if not far["position_mm"] > near["position_mm"]:
         raise ValueError(f"far position_mm must be > near position_mm ({near['position_mm']}); got {far['position_mm']}")
     screens = {"near": near, "far": far}
     attrs = {"near_position_mm": near["position_mm"], "far_position_mm": far["position_mm"],
              "convention": "lengths in mm; +z from the source",
              "near_pitch_mm": float(np.sqrt(np.median(near["area"]))),
-             "far_pitch_mm": float(np.sqrt(np.median(far["area"]))), "anchor": anchor}
+             "far_pitch_mm": float(np.sqrt(np.median(far["area"]))), "anchor": anchor,
+             "through": "screen" if mask_position_mm is None else "mask"}
     near, far = screens[anchor], screens["near" if anchor == "far" else "far"]  # anchor, other
     z1, z2 = near["position_mm"], far["position_mm"]
     attrs["origin_position_mm"] = z1
@@ -205,9 +225,15 @@ def rays_dataset(near, far, *, anchor="far", mask_std_scale=0.05, smooth_directi
     good = flag == OK
     x1 = near["xy"]
     origin = np.concatenate([x1, np.full(shape + (1,), z1)], -1)
-    measured = np.where(good[..., None], (matched[..., :2] - x1) / (z2 - z1), np.nan)
-    noise = np.where(good, direction_noise(near["mask_std"], matched[..., 2], matched[..., 3], separation_mm=abs(z2 - z1)),
-                     np.nan)
+    if mask_position_mm is None:
+        measured = np.where(good[..., None], (matched[..., :2] - x1) / (z2 - z1), np.nan)
+        noise = direction_noise(near["mask_std"], matched[..., 2], matched[..., 3], separation_mm=abs(z2 - z1))
+    else:
+        lever = z1 - mask_position_mm
+        centroid = flux_centroids(x1, near["irradiance"], footprint_variance=footprint_variance)
+        measured = np.where(good[..., None], (centroid - near["mask"]) / lever, np.nan)
+        noise = near["mask_std"] / np.sqrt(2.0) / lever  # mask_std: both sweeps in quadrature
+    noise = np.where(good, noise, np.nan)
     noise = np.where(np.isfinite(noise) | ~good, noise, np.nanmedian(noise) if np.isfinite(noise).any() else 1.0)
     if smooth_directions or edge_rays == "fit":
         fitted = fit_directions(measured, noise)

@@ -9,6 +9,7 @@ Offers
 ------
 homography_from_markers : 3x3 homography from marker pixels to their screen coordinates (normalised DLT).
 screen_coordinates : ``(H, W, 2)`` screen ``x, y`` of every pixel centre and ``(H, W)`` pixel areas.
+flux_centroids : the screen point each pixel's flux is centred on (its footprint weighted by the irradiance).
 screen_positions : the validated screen entries of a light-field capture description.
 """
 
@@ -88,6 +89,50 @@ def screen_coordinates(homography, shape):
     xc0, yc0 = _apply(h, rows, cols - eps)
     area = np.abs((xr1 - xr0) * (yc1 - yc0) - (yr1 - yr0) * (xc1 - xc0))
     return np.stack([x, y], -1), area
+
+
+def flux_centroids(xy, irradiance, *, footprint_variance):
+    """Screen point of each pixel's flux: the centroid of its footprint weighted by the irradiance.
+
+    A pixel integrates the screen irradiance ``E`` over its footprint ``w`` (centred on the
+    pixel, second moment `footprint_variance` px^2 per axis). A wire's shadow darkens it at
+    the flux-weighted mean of the mask coordinates over that footprint, the mask point of
+    the ray through the flux-weighted centroid of the footprint, not through the pixel
+    centre. To first order in the footprint's size (any symmetric footprint) the centroid is
+    ``centre + footprint_variance * grad(E) / E`` in pixel units, ``grad`` by central
+    differences of the measured image, mapped to screen mm by the pixel grid's Jacobian. The
+    shift is clipped to the half-width of the box of that variance (``sqrt(3 var)`` px per
+    axis): a centroid lies inside the footprint.
+
+    Parameters
+    ----------
+    xy : (H, W, 2) ndarray
+        Screen ``x, y`` mm of each pixel centre (:func:`screen_coordinates`), H, W >= 2.
+    irradiance : (H, W) ndarray
+        The pixels' irradiance (any positive scale); not finite or <= 0: no shift.
+    footprint_variance : float, keyword-only
+        Per-axis second moment of a pixel's footprint on the screen, px^2 (>= 0; 1/12 for a
+        box pixel, 1/6 for a bilinear (tent) one).
+
+    Returns
+    -------
+    (H, W, 2) float64 ndarray
+        Screen ``x, y`` mm of each pixel's flux centroid.
+    """
+    xy = check_array(xy, "xy", ndim=3, dtype_kind="f")
+    irradiance = check_array(irradiance, "irradiance", shape=xy.shape[:2], dtype_kind="iuf").astype(np.float64)
+    if xy.shape[2] != 2 or min(xy.shape[:2]) < 2:
+        raise ValueError(f"xy must have shape (H, W, 2) with H, W >= 2; got {xy.shape}")
+    if not (np.isfinite(footprint_variance) and footprint_variance >= 0):
+        raise ValueError(f"footprint_variance must be a finite number >= 0 (px^2); got {footprint_variance!r}")
+    usable = np.isfinite(irradiance) & (irradiance > 0)
+    e = np.where(usable, irradiance, 0.0)
+    half_width = np.sqrt(3.0 * footprint_variance)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shift = [np.clip(footprint_variance * np.gradient(e, axis=axis) / e, -half_width, half_width)
+                 for axis in (0, 1)]
+    shift = [np.where(usable & np.isfinite(d), d, 0.0) for d in shift]
+    return xy + shift[0][..., None] * np.gradient(xy, axis=0) + shift[1][..., None] * np.gradient(xy, axis=1)
 
 
 def screen_positions(capture):

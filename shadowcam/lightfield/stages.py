@@ -100,7 +100,7 @@ def describe_capture(plan):
         "exposure_times": [float(t) for t in times],
         "sensor": {"black_level": float(np.mean(levels["black_sites"])), "white_level": float(np.min(levels["white_sites"])),
                    "gain": facts["camera"]["gain_dn_per_e"], "read_noise": facts["camera"]["read_noise_dn"],
-                   "responsivity": 1.0},
+                   "responsivity": 1.0, "footprint_variance_px2": facts["camera"]["footprint_variance_px2"]},
         "files": {name: list(sweep.files) for name, sweep in plan.sweeps.items()},
     }
 
@@ -240,6 +240,10 @@ def screen_maps(sweeps, description):
 def rays_from_sweeps(sweeps, description, *, anchor="far", mask_std_scale=0.05):
     """The rays dataset of a capture: its two nearest screens' :func:`screen_maps` joined.
 
+    The rays go through the anchor pixels' mask points on the description's mask plane
+    (``mask.position_mm``), from each pixel's flux centroid (the camera's
+    ``sensor.footprint_variance_px2``; 1/12, a box pixel, where the description has none).
+
     Parameters
     ----------
     sweeps, description
@@ -252,7 +256,9 @@ def rays_from_sweeps(sweeps, description, *, anchor="far", mask_std_scale=0.05):
     xarray.Dataset
     """
     maps = screen_maps(sweeps, description)
-    return rays.rays_dataset(maps[0], maps[1], anchor=anchor, mask_std_scale=mask_std_scale)
+    return rays.rays_dataset(maps[0], maps[1], anchor=anchor, mask_position_mm=description["mask"]["position_mm"],
+                             footprint_variance=description["sensor"].get("footprint_variance_px2", 1.0 / 12.0),
+                             mask_std_scale=mask_std_scale)
 
 
 def render_grid(description, shape, position_mm, *, pitch_factor):

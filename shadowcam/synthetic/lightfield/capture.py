@@ -38,6 +38,8 @@ from shadowcam.synthetic.lightfield.source import ReflectorSource
 from shadowcam.synthetic.sensor import SensorModel, simulate_raw
 
 _BINS_PER_STEP = 8
+#: per-axis second moment (px^2) of a camera pixel's footprint: the bilinear (tent) splat's
+FOOTPRINT_VARIANCE_PX2 = 1.0 / 6.0
 _WIRE_BINS = 12
 
 
@@ -249,7 +251,8 @@ def capture_description(capture, *, responsivity):
                  "n_frames": capture.n_frames},
         "exposure_times": [float(t) for t in capture.exposure_times],
         "sensor": {"black_level": sensor.black_level, "white_level": sensor.white_level, "gain": sensor.gain,
-                   "read_noise": sensor.read_noise, "responsivity": float(responsivity)},
+                   "read_noise": sensor.read_noise, "responsivity": float(responsivity),
+                   "footprint_variance_px2": FOOTPRINT_VARIANCE_PX2},
     }
 
 
