@@ -17,8 +17,10 @@ shadow-time methods ``edge_fit`` and ``dip_centroid`` with and without noise: er
 the part explained by the frame phase ``t mod 1`` (two harmonics), and the error's
 correlation between neighbouring pixels. Run with PYTHONPATH set to the repository under test.
 
-``--rays-error``: the rays of the library capture (noisy) per shadow-time method and ray anchor
-(``rays_dataset(anchor=...)``): direction error against the source's ray at the anchor pixel's
+``--rays-error [--noise-free]``: the rays of the library capture (noisy unless ``--noise-free``) per
+shadow-time method, ray anchor and the ray's second point (``rays_dataset(anchor=...,
+mask_position_mm=...)``: the other screen's point, or the mask point from the pixel's flux
+centroid): direction error against the source's ray at the anchor pixel's
 true mask point, renders at 350 / 675 mm at 1 x and 2 x the near camera's pitch against the
 naive baseline (rel. RMSE with one gain, band-passed DoG(1, 4 px) error) and the far field's
 median error at the capture's angular resolution.
@@ -120,13 +122,15 @@ def time_error():
                           f" row {lag[0]:+.2f} col {lag[1]:+.2f}; shadow moves {1 / speed:.2f} px per frame")
 
 
-def rays_error():
+def rays_error(noise=True):
     from shadowcam.lightfield import accuracy, hdr, rays, screen
     from shadowcam.lightfield.photometry_export import far_field_grid, rays_resolution_deg
     from shadowcam.lightfield.render import irradiance_on_plane
     from shadowcam.synthetic.lightfield.capture import LightFieldCapture, sweep_frames
 
-    capture = LightFieldCapture(shape=(96, 96), n_frames=48, quadrature=1200)
+    from shadowcam.synthetic.lightfield.capture import FOOTPRINT_VARIANCE_PX2
+
+    capture = LightFieldCapture(shape=(96, 96), n_frames=48, quadrature=1200, noise=noise)
     q = capture.responsivity()
     stacks, truths = {}, {}
     for s in range(2):
@@ -153,14 +157,15 @@ def rays_error():
             xy, area = screen.screen_coordinates(capture.homography(s), capture.shape)
             maps.append(rays.screen_mask_map(found["x"], found["y"], xy=xy, area=area,
                                              position_mm=capture.positions_mm[s]))
-        for anchor in rays.ANCHORS:
-            ray_set = rays.rays_dataset(maps[0], maps[1], anchor=anchor)
+        for anchor, through in [(a, t) for t in ("screen", "mask") for a in rays.ANCHORS]:
+            ray_set = rays.rays_dataset(maps[0], maps[1], anchor=anchor, **({} if through == "screen" else {
+                "mask_position_mm": capture.source.z_mask, "footprint_variance": FOOTPRINT_VARIANCE_PX2}))
             s = 1 if anchor == "far" else 0
             true = capture.source.rays(truths[s, "x"]["mask_centre"], truths[s, "y"]["mask_centre"])
             d = ray_set["direction"].values
             ok = (ray_set["flag"].values == 0) & np.all(np.isfinite(true), -1)
             error = np.hypot(*(d - true)[..., :2][ok].T)
-            print(f"{method:12s} anchor {anchor:4s}: direction error median {np.median(error):.5f},"
+            print(f"{method:12s} anchor {anchor:4s} through {through:6s}: direction error median {np.median(error):.5f},"
                   f" p90 {np.percentile(error, 90):.5f}")
             for (factor, z), (shape, pitch, truth) in targets.items():
                 nearest = maps[0 if z < capture.positions_mm[1] else 1]
@@ -186,11 +191,12 @@ def main():
     parser.add_argument("--frames", type=int, nargs="+", default=[48, 96])
     parser.add_argument("--time-error", action="store_true", help="the time-map error analysis instead")
     parser.add_argument("--rays-error", action="store_true", help="the rays' error per method and anchor instead")
+    parser.add_argument("--noise-free", action="store_true", help="--rays-error of the capture without noise")
     args = parser.parse_args()
     if args.time_error:
         time_error()
     elif args.rays_error:
-        rays_error()
+        rays_error(noise=not args.noise_free)
     else:
         throughput(args.size, args.frames)
 

@@ -1,10 +1,9 @@
 """``shadowcam lightfield-rays``: the rays of a light field from its screens' mask positions.
 
-A ray joins the near and the far screen's points with the same mask coordinates; it
-starts at a pixel of the ``--anchor`` screen (default the far one, whose partner point on
-the near screen moves least with the pixel's mask error) and its flux is that screen's
-irradiance times the pixel's screen area
-(:func:`shadowcam.lightfield.stages.rays_from_sweeps`). The netCDF ray table
+A ray starts at a pixel of the ``--anchor`` screen (default the near one, the finer
+screen image of the rings) and goes through the pixel's mask point on the mask plane; its
+flux is that screen's irradiance times the pixel's screen area; the other screen must see
+the same mask point (:func:`shadowcam.lightfield.stages.rays_from_sweeps`). The netCDF ray table
 (``origin``, ``direction`` in mm, ``flux`` in lm, ``confidence``, ``flag``) is the
 open ray-set form (docs/contracts.md).
 
@@ -12,7 +11,7 @@ Example::
 
     shadowcam lightfield-rays --capture results/synthetic_lightfield/lightfield/capture \\
         --sweeps results/synthetic_lightfield/lightfield/shadow_times/{near_h,near_v,far_h,far_v}.nc \\
-        --anchor far --out results/synthetic_lightfield/lightfield/rays.nc
+        --anchor near --out results/synthetic_lightfield/lightfield/rays.nc
 
 Offers
 ------
@@ -32,8 +31,8 @@ def add_parser(subparsers, name):
     parser = subparsers.add_parser(name, help="rays of a light field")
     parser.add_argument("--capture", required=True, help="capture folder with capture.json")
     parser.add_argument("--sweeps", nargs="+", required=True, help="<screen>_<h|v>.nc of lightfield-shadow-times")
-    parser.add_argument("--anchor", choices=ANCHORS, default="far",
-                        help="screen whose pixels carry the rays (default far: the smaller direction error)")
+    parser.add_argument("--anchor", choices=ANCHORS, default="near",
+                        help="screen whose pixels carry the rays (default near)")
     parser.add_argument("--out", required=True, help="output rays netCDF")
     return parser
 
