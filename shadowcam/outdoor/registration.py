@@ -281,8 +281,8 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     shift = start.copy()
     if float(flat.sum(dtype=np.float64)) < min_weight or np.linalg.cond(normal) > 1e8:
         return start, float("nan")
-    # the band-pass is a convolution, which commutes with the (convolution) cubic resampling: the
-    # frame is band-passed once and its band-pass resampled at every step
+    # the band-pass and the cubic resampling are both convolutions and commute: the frame is
+    # band-passed once and its band-pass resampled at every step (resampling log luminance)
     moving = bandpass_log(luma)
     for _ in range(max_iter):
         error = translate(moving, shift, method="opencv_cubic").ravel() - target
