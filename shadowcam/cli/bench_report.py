@@ -7,7 +7,7 @@ of its largest job; then the extrapolation to ``--extrapolate`` frames on ``--co
 cores: every stage is taken as linear in the number of frames (fixed costs included
 in the per-frame rate, so an overestimate for short runs), stages run as several
 jobs divide by the cores, and memory is the peak per job (it does not grow with the
-number of frames: compare two runs with ``--compare``) times the jobs that run at
+number of frames: compare runs with ``--compare``) times the jobs that run at
 once. Disk: the decoded frame store per frame. With ``--photometry`` and ``--shake``
 (a sample's sidecar, ``shadowcam outdoor-sample``) it also prints the registration
 error at that size against the applied shake; with ``--accuracy`` (the run's

@@ -7,7 +7,7 @@ RSS of its largest job; then extrapolates to a number of frames on a number of
 cores: every stage is taken as linear in the number of frames (fixed costs
 included in the per-frame rate, so an overestimate for short runs), stages run
 as several jobs divide by the cores, and memory is the peak per job (it does
-not grow with the number of frames: compare two runs) times the jobs that run
+not grow with the number of frames: compare runs of several lengths) times the jobs that run
 at once. Disk: the decoded frame store per frame.
 
 The scale targets of an outdoor time-lapse are ratios measured in one run:
@@ -15,7 +15,7 @@ the frame store's size over the RAW files' size, the end-to-end time (sum of
 every job's wall time) and the first pass (registration and gains) over the
 decode-only time of the same frames (the pipeline's own mosaic reader, timed
 in the same run), the largest job's peak RSS, and the growth of each stage's
-peak RSS from 100 to 1000 frames, extrapolated linearly through two runs of
+peak RSS from 100 to 1000 frames, a least-squares line through runs of
 different lengths.
 
 Offers
