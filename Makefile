@@ -24,7 +24,9 @@ BENCH_COMPRESSION ?= ljpeg none
 # bench-outdoor-size: the camera's size (COLSxROWS, 24 MP), the columns of the full-height strip
 # of it that is rendered at that resolution (the renderer's synthetic.outdoor.window; a whole
 # 24 MP frame takes too long to render on 2 shared cores), render samples per pixel side,
-# frames, frames per first-pass job, scratch dir
+# frames (the sweep is run at half, three quarters and all of them: the memory growth is the line
+# through the three; the renderer drops 2 frames, which needs >= 10 each), frames per first-pass
+# job, scratch dir
 BENCH_SIZE ?= 6000x4000
 BENCH_STRIP_COLS ?= 128
 BENCH_SUPERSAMPLE ?= 1
@@ -104,7 +106,7 @@ bench-outdoor-size: $(STAMP)
 	cp -r Snakefile workflow config profiles $(BENCH_DIR)/
 	printf 'decode: {chunk_frames: $(BENCH_CHUNK)}\noutdoor: {part_frames: $(BENCH_PART), edge_strips: $(BENCH_STRIPS)}\n' > $(BENCH_DIR)/bench.yaml
 	cols=$$(echo $(BENCH_SIZE) | cut -dx -f1); rows=$$(echo $(BENCH_SIZE) | cut -dx -f2); \
-	for n in $$(( $(BENCH_FRAMES) / 2 )) $(BENCH_FRAMES); do \
+	for n in $$(( $(BENCH_FRAMES) / 2 )) $$(( 3 * $(BENCH_FRAMES) / 4 )) $(BENCH_FRAMES); do \
 	  printf '%s\n' "name: bench$$n" "kind: outdoor" "description: sunset time-lapse rendered at $(BENCH_SIZE), a full-height strip of $(BENCH_STRIP_COLS) columns, disc sun" \
 	    "light: distant" "synthetic: {scene: ridge, seed: 3, height: $$rows, width: $$cols, frames: $$n, format: dng, bit_depth: 14, noise: true, supersample: $(BENCH_SUPERSAMPLE), exposure: 0.6," \
 	    "  outdoor: {start_elevation_deg: $(BENCH_START_ELEVATION), end_elevation_deg: $(BENCH_END_ELEVATION), sun_diameter_deg: 0.53, shake_px: 2.0, dng_compression: ljpeg, window: [0, $$(( (cols - $(BENCH_STRIP_COLS)) / 2 )), $$rows, $(BENCH_STRIP_COLS)]}}" \
@@ -117,6 +119,7 @@ bench-outdoor-size: $(STAMP)
 	$(BIN)/shadowcam bench-report --benchmarks $(BENCH_DIR)/benchmarks/bench$(BENCH_FRAMES) \
 	  --frames $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/frames/timelapse.zarr \
 	  --compare $(BENCH_DIR)/benchmarks/bench$$(( $(BENCH_FRAMES) / 2 )) --compare-frames $$(( $(BENCH_FRAMES) / 2 )) \
+	  --compare $(BENCH_DIR)/benchmarks/bench$$(( 3 * $(BENCH_FRAMES) / 4 )) --compare-frames $$(( 3 * $(BENCH_FRAMES) / 4 )) \
 	  --raw $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/capture/frames \
 	  --accuracy $(BENCH_DIR)/results/bench$(BENCH_FRAMES)/outdoor/accuracy.json \
 	  --render $(BENCH_DIR)/render/bench$(BENCH_FRAMES)

@@ -7,7 +7,7 @@ RSS of its largest job; then extrapolates to a number of frames on a number of
 cores: every stage is taken as linear in the number of frames (fixed costs
 included in the per-frame rate, so an overestimate for short runs), stages run
 as several jobs divide by the cores, and memory is the peak per job (it does
-not grow with the number of frames: compare two runs) times the jobs that run
+not grow with the number of frames: compare runs of several lengths) times the jobs that run
 at once. Disk: the decoded frame store per frame.
 
 The scale targets of an outdoor time-lapse are ratios measured in one run:
@@ -15,7 +15,7 @@ the frame store's size over the RAW files' size, the end-to-end time (sum of
 every job's wall time) and the first pass (registration and gains) over the
 decode-only time of the same frames (the pipeline's own mosaic reader, timed
 in the same run), the largest job's peak RSS, and the growth of each stage's
-peak RSS from 100 to 1000 frames, extrapolated linearly through two runs of
+peak RSS from 100 to 1000 frames, a least-squares line through runs of
 different lengths.
 
 Offers
@@ -26,7 +26,9 @@ benchmark_table : the per-stage table and the extrapolation, as text lines.
 registration_line : the registration error at a sample's size against its applied shake, as text.
 accuracy_line : the arrival-time accuracy of a run against its ground truth, as text.
 time_decode : decode-only time and size of RAW frames, with the pipeline's reader.
-memory_growth : per-stage peak RSS extrapolated linearly to two frame counts, and their ratio.
+memory_growth : per-stage peak RSS, a least-squares line through runs of several lengths, at two frame counts.
+growth_table : its lines, per stage.
+read_runs : the benchmarks of several runs, longest first.
 scale_targets : the four scale ratios of a run against their targets, as text lines.
 """
 
@@ -35,6 +37,8 @@ import math
 import re
 import time
 from pathlib import Path
+
+import numpy as np
 
 from shadowcam._shared.validation import check_in
 from shadowcam.outdoor.accuracy import registration_errors
@@ -220,42 +224,76 @@ def time_decode(paths):
             "mosaic_cpu_s": mosaic_cpu_s, "rgb_s": rgb_s, "direct": reader.direct}
 
 
-def memory_growth(stages, before, *, frames, before_frames, low=100, high=1000):
-    """Per-stage peak RSS of the largest job, extrapolated linearly to `low` and `high` frames.
-
-    Each stage's peak is taken as ``a + b * frames`` through the two runs
-    (the line through two noisy points: a small run's slope is mostly noise;
-    a negative slope, the longer run peaking lower, is taken as 0).
+def read_runs(paths, frames, *, clock="wall"):
+    """Read the benchmarks of several runs, longest first.
 
     Parameters
     ----------
-    stages, before : mapping
-        :func:`read_benchmarks` of a run of `frames` frames and of one of `before_frames`.
-    frames, before_frames : int
-        Their numbers of frames (different).
+    paths : sequence of str or Path
+        ``benchmarks/<ds>`` directories (:func:`read_benchmarks`).
+    frames : sequence of int
+        The frames of each run, in the same order.
+    clock : {"wall", "cpu"}
+        As :func:`read_benchmarks`.
+
+    Returns
+    -------
+    list of (mapping, int)
+        ``(stages, frames)`` per run, by decreasing frames.
+    """
+    if len(paths) != len(frames):
+        raise ValueError(f"runs: {len(paths)} benchmark directories but {len(frames)} frame counts; give one "
+                         "frame count per run (--compare-frames once per --compare)")
+    runs = [(read_benchmarks(path, clock=clock), int(n)) for path, n in zip(paths, frames)]
+    return sorted(runs, key=lambda run: -run[1])
+
+
+def memory_growth(runs, *, low=100, high=1000):
+    """Per-stage peak RSS of the largest job, extrapolated linearly to `low` and `high` frames.
+
+    Each stage's peak is fitted as ``a + b * frames`` by least squares through the
+    runs (two runs: the line through them; a small run's slope is mostly noise,
+    so three or more frame counts tell a slope from noise better). A negative
+    slope, the longer runs peaking lower, is taken as 0 (a peak cannot shrink as
+    frames are added), and the line then passes through the runs' mean peak.
+
+    Parameters
+    ----------
+    runs : sequence of (mapping, int)
+        ``(stages, frames)``: :func:`read_benchmarks` of a run and its number of frames;
+        at least two different frame counts.
     low, high : int
         Frame counts to extrapolate to.
 
     Returns
     -------
     dict
-        ``{stage: (peak_mb_at_low, peak_mb_at_high, ratio)}`` for the stages in both runs
+        ``{stage: (peak_mb_at_low, peak_mb_at_high, ratio)}`` for the stages in every run
         with a finite peak.
     """
-    if frames == before_frames or min(frames, before_frames, low, high) < 1:
-        raise ValueError(f"frames and before_frames must be different and >= 1; got {frames}, {before_frames}")
+    runs = [(stages, int(frames)) for stages, frames in runs]
+    counts = [frames for _, frames in runs]
+    if len(set(counts)) < 2 or min(counts + [low, high]) < 1:
+        raise ValueError(f"runs must have at least two different frame counts, all >= 1; got {counts}")
     out = {}
-    for stage, jobs in stages.items():
-        if stage not in before:
+    for stage in set.intersection(*(set(stages) for stages, _ in runs)):
+        peaks = np.array([max(r for _, r in stages[stage]) for stages, _ in runs])
+        if not np.isfinite(peaks).all():
             continue
-        peak, old = max(r for _, r in jobs), max(r for _, r in before[stage])
-        if not (math.isfinite(peak) and math.isfinite(old)):
-            continue
-        # a peak cannot shrink as frames are added: a smaller peak of the longer run is noise (slope 0)
-        slope = max(0.0, (peak - old) / (frames - before_frames))
-        at_low, at_high = peak + slope * (low - frames), peak + slope * (high - frames)
+        x = np.array(counts, dtype=np.float64)
+        slope = max(0.0, float(np.polyfit(x, peaks, 1)[0]))
+        base = float(np.mean(peaks - slope * x))
+        at_low, at_high = base + slope * low, base + slope * high
         out[stage] = (at_low, at_high, at_high / at_low if at_low > 0 else float("inf"))
     return out
+
+
+def growth_table(growth):
+    """Lines of :func:`memory_growth`: per stage, the peak at 100 and 1000 frames and their ratio."""
+    lines = [f"{'peak RSS per job (line through the runs)':44s} {'MB@100':>8s} {'MB@1000':>8s} {'ratio':>6s}"]
+    for stage, (low, high, ratio) in sorted(growth.items(), key=lambda item: -item[1][2]):
+        lines.append(f"{stage:44s} {low:8.0f} {high:8.0f} {ratio:6.2f}")
+    return lines
 
 
 def _job_seconds(stages, prefix=""):
@@ -277,7 +315,7 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None, before=
     decode : mapping
         :func:`time_decode` of the run's RAW frames.
     growth : mapping, optional
-        :func:`memory_growth` of the run against a shorter one; the worst
+        :func:`memory_growth` of the run and shorter ones; the worst
         stage whose jobs read the whole sweep is shown (a parted stage's jobs
         read a fixed number of frames whatever the sweep's length).
     before, before_frames : mapping and int, optional
@@ -331,6 +369,6 @@ def scale_targets(stages, *, n_frames, store_bytes, decode, growth=None, before=
         worst = max(whole, key=lambda stage: whole[stage][2])
         low, high, ratio = whole[worst]
         lines.append(row(f"peak RSS 1000 / 100 frames ({worst})", ratio, SCALE_TARGETS["growth"]))
-        lines.append(f"  (linear through the two runs: {low:.0f} MB at 100 frames, {high:.0f} MB at 1000; "
+        lines.append(f"  (least-squares line through the runs: {low:.0f} MB at 100 frames, {high:.0f} MB at 1000; "
                      "parted stages: jobs of a fixed number of frames)")
     return lines

@@ -235,7 +235,8 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     """Estimate the translation of a frame relative to the reference.
 
     Lucas & Kanade (1981), "An iterative image registration technique",
-    translation only, Gauss-Newton on band-passed log luminance.
+    translation only, Gauss-Newton on band-passed log luminance (the frame is band-passed once
+    and its band-pass resampled at each step).
 
     Parameters
     ----------
@@ -280,15 +281,18 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     shift = start.copy()
     if float(flat.sum(dtype=np.float64)) < min_weight or np.linalg.cond(normal) > 1e8:
         return start, float("nan")
+    # the band-pass and the cubic resampling are both convolutions and commute: the frame is
+    # band-passed once and its band-pass resampled at every step (resampling log luminance)
+    moving = bandpass_log(luma)
     for _ in range(max_iter):
-        error = bandpass_log(translate(luma, shift, method="opencv_cubic")).ravel() - target
+        error = translate(moving, shift, method="opencv_cubic").ravel() - target
         step = np.linalg.solve(normal, -np.array([_dot(weighted[0], error), _dot(weighted[1], error)]))
         shift += step
         if np.max(np.abs(shift - start)) > max_shift:
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = bandpass_log(translate(luma, shift, method="opencv_cubic")).ravel() - target
+    error = translate(moving, shift, method="opencv_cubic").ravel() - target
     residual = float(np.sqrt(_dot(flat * error, error) / max(float(flat.sum(dtype=np.float64)), 1.0)))
     return shift, residual
 

@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from shadowcam.evaluate.workflow_benchmark import (accuracy_line, benchmark_table, directory_bytes, memory_growth, read_benchmarks,
+from shadowcam.evaluate.workflow_benchmark import (accuracy_line, benchmark_table, directory_bytes, growth_table, memory_growth,
+                                                  read_benchmarks, read_runs,
                                                   scale_targets, time_decode)
 
 HEADER = "s\th:m:s\tmax_rss\tmax_vms\n"
@@ -47,17 +48,37 @@ def test_missing_benchmarks_and_store_size(tmp_path):
 
 def test_memory_growth_is_the_line_through_the_two_runs():
     # 500 MB at 8 frames, 516 MB at 16: 2 MB/frame -> 684 MB at 100, 2484 MB at 1000
-    growth = memory_growth({"arrival": [(1.0, 516.0)], "solo": [(1.0, 9.0)]}, {"arrival": [(1.0, 500.0)]},
-                           frames=16, before_frames=8)
+    growth = memory_growth([({"arrival": [(1.0, 516.0)], "solo": [(1.0, 9.0)]}, 16), ({"arrival": [(1.0, 500.0)]}, 8)])
     assert set(growth) == {"arrival"}
     low, high, ratio = growth["arrival"]
     assert low == pytest.approx(684.0) and high == pytest.approx(2484.0) and ratio == pytest.approx(2484 / 684)
-    flat = memory_growth({"a": [(1.0, 300.0), (1.0, 400.0)]}, {"a": [(1.0, 400.0)]}, frames=16, before_frames=8)
+    flat = memory_growth([({"a": [(1.0, 300.0), (1.0, 400.0)]}, 16), ({"a": [(1.0, 400.0)]}, 8)])
     assert flat["a"] == pytest.approx((400.0, 400.0, 1.0))
-    shrinking = memory_growth({"a": [(1.0, 380.0)]}, {"a": [(1.0, 400.0)]}, frames=16, before_frames=8)
-    assert shrinking["a"] == pytest.approx((380.0, 380.0, 1.0))  # a lower peak of the longer run is noise
-    with pytest.raises(ValueError, match="different"):
-        memory_growth({}, {}, frames=8, before_frames=8)
+    shrinking = memory_growth([({"a": [(1.0, 380.0)]}, 16), ({"a": [(1.0, 400.0)]}, 8)])
+    assert shrinking["a"] == pytest.approx((390.0, 390.0, 1.0))  # a lower peak of the longer run is noise: the mean
+    with pytest.raises(ValueError, match="two different frame counts"):
+        memory_growth([({}, 8), ({}, 8)])
+
+
+def test_memory_growth_through_several_runs_is_the_least_squares_line():
+    # 32, 64, 128 frames on 200 + 0.5 * frames, with +-4 MB of noise of zero sum and zero slope:
+    # the fitted line is the exact one (residuals orthogonal to [1, frames])
+    frames = np.array([32, 64, 128])
+    noise = np.array([4.0, -6.0, 2.0])  # sum 0 and sum(noise * frames) = 128 - 384 + 256 = 0
+    runs = [({"a": [(1.0, 200 + 0.5 * n + e)]}, int(n)) for n, e in zip(frames, noise)]
+    low, high, ratio = memory_growth(runs)["a"]
+    assert low == pytest.approx(250.0) and high == pytest.approx(700.0) and ratio == pytest.approx(700 / 250)
+    assert growth_table(memory_growth(runs))[1].split() == ["a", "250", "700", "2.80"]
+
+
+def test_read_runs_orders_the_runs_longest_first(tmp_path):
+    for name, rss in (("short", 100.0), ("long", 120.0)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "arrival.tsv").write_text("s\th:m:s\tmax_rss\tcpu_time\n1.0\t0:00:01\t%s\t0.5\n" % rss)
+    runs = read_runs([tmp_path / "short", tmp_path / "long"], [8, 16])
+    assert [n for _, n in runs] == [16, 8] and runs[0][0]["arrival"][0][1] == 120.0
+    with pytest.raises(ValueError, match="one frame count per run"):
+        read_runs([tmp_path / "short"], [8, 16])
 
 
 def test_scale_targets_are_the_ratios_of_one_run():
