@@ -31,8 +31,8 @@ def add_parser(subparsers, name):
     parser = subparsers.add_parser(name, help="rays of a light field")
     parser.add_argument("--capture", required=True, help="capture folder with capture.json")
     parser.add_argument("--sweeps", nargs="+", required=True, help="<screen>_<h|v>.nc of lightfield-shadow-times")
-    parser.add_argument("--anchor", choices=ANCHORS, default="near",
-                        help="screen whose pixels carry the rays (default near)")
+    parser.add_argument("--anchor", choices=ANCHORS, default="far",
+                        help="screen whose pixels carry the rays (default far)")
     parser.add_argument("--out", required=True, help="output rays netCDF")
     return parser
 

@@ -237,17 +237,18 @@ def screen_maps(sweeps, description):
     return maps
 
 
-def rays_from_sweeps(sweeps, description, *, anchor="near", mask_std_scale=0.05):
+def rays_from_sweeps(sweeps, description, *, anchor="far", mask_std_scale=0.05):
     """The rays dataset of a capture: its two nearest screens' :func:`screen_maps` joined.
 
     The rays go through the anchor pixels' mask points on the description's mask plane
     (``mask.position_mm``), from each pixel's flux centroid (the camera's
     ``sensor.footprint_variance_px2``; 1/12, a box pixel, where the description has none).
-    Anchored on the near screen by default: through the mask point both anchors' direction
-    errors are the mask error over the mask-to-anchor distance (the far one's half as large),
-    but the near screen's rings are the less sharp, so its pixels' flux centroids (first order
-    in the footprint) and pixel-centre origins are the closer to the rays'
-    (docs/benchmarks.md "Light field: rays through the mask point").
+    Anchored on the far screen by default: through the mask point both anchors' direction
+    errors are the mask error over the mask-to-anchor distance (the far one's half as large).
+    The near screen's rings are the less sharp, so its pixels' flux centroids (first order in
+    the footprint) are the closer to the rays' when the camera's footprint is known, but its
+    renders beyond the far screen depend more on that footprint (docs/benchmarks.md
+    "Light field: rays through the mask point").
 
     Parameters
     ----------
