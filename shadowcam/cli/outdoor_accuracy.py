@@ -56,7 +56,7 @@ def run(args):
     params = parse_params(args.params, allowed={"condition"})
     manifest = load_manifest(args.manifest)
     report = outdoor_accuracy(
-        load_ground_truth(manifest), open_frames(args.frames), open_dataset(args.photometry),
+        load_ground_truth(manifest, frame_maps=False), open_frames(args.frames), open_dataset(args.photometry),
         open_dataset(args.edges), open_dataset(args.arrival), open_dataset(args.pushbroom),
         condition=accuracy_condition(manifest, params.get("condition")))
     report["dataset"] = manifest["name"]

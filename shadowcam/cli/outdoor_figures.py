@@ -50,7 +50,7 @@ def run(args):
     truth = None
     if args.manifest:
         manifest = load_manifest(args.manifest)
-        truth = load_ground_truth(manifest) if manifest.get("ground_truth") or manifest.get("synthetic") else None
+        truth = load_ground_truth(manifest, frame_maps=False) if manifest.get("ground_truth") or manifest.get("synthetic") else None
     write_outdoor_figures(args.outdir, frames=open_frames(args.frames), photometry=open_dataset(args.photometry),
                           edges=open_dataset(args.edges), arrival=open_dataset(args.arrival),
                           pushbroom=open_dataset(args.pushbroom), report=report, truth=truth)

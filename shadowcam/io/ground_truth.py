@@ -241,8 +241,15 @@ def mitsuba_lab_npz_to_dataset(arrays):
     return check_ground_truth(dataset)
 
 
-def _load_shadowcam_nc(path):
+def _per_pixel_frame(variable):
+    """Whether a ground-truth variable holds a map per frame (dims time, row and col)."""
+    return {"time", "row", "col"} <= set(variable.dims)
+
+
+def _load_shadowcam_nc(path, *, frame_maps=True):
     with xr.open_dataset(path, engine="h5netcdf") as source:
+        if not frame_maps:
+            source = source.drop_vars([name for name, v in source.data_vars.items() if _per_pixel_frame(v)])
         dataset = source.load()
     return dataset
 
@@ -257,8 +264,8 @@ def _load_mitsuba_outdoor_npz(path):
         return mitsuba_outdoor_npz_to_dataset({k: arrays[k] for k in arrays.files})
 
 
-def _load_shadowcam_outdoor_nc(path):
-    return _as_bool(_load_shadowcam_nc(path), _OUTDOOR_MASKS)
+def _load_shadowcam_outdoor_nc(path, *, frame_maps=True):
+    return _as_bool(_load_shadowcam_nc(path, frame_maps=frame_maps), _OUTDOOR_MASKS)
 
 
 #: ground_truth.format -> loader(path) -> Dataset
@@ -268,11 +275,13 @@ GT_FORMATS = {
     "shadowcam_outdoor_nc": _load_shadowcam_outdoor_nc,
     "mitsuba_outdoor_npz": _load_mitsuba_outdoor_npz,
 }
+#: formats whose loader leaves the per-frame maps unread when asked (``frame_maps=False``)
+_READS_SELECTIVELY = ("shadowcam_nc", "shadowcam_outdoor_nc")
 #: formats whose standard form is the outdoor one
 OUTDOOR_FORMATS = ("shadowcam_outdoor_nc", "mitsuba_outdoor_npz")
 
 
-def load_ground_truth(manifest):
+def load_ground_truth(manifest, *, frame_maps=True):
     """Return a manifest's ground truth as the standard GT Dataset.
 
     Parameters
@@ -280,6 +289,12 @@ def load_ground_truth(manifest):
     manifest : dict or str or Path
         From :func:`shadowcam.io.manifest.load_manifest`, or a manifest path. Its
         ``ground_truth`` entry names the format and the file (relative to root).
+    frame_maps : bool, keyword-only
+        Keep the variables that hold a map per frame (dims ``time``, ``row``, ``col``,
+        e.g. an outdoor render's ``lit_center``). False leaves them out, so that a step
+        that does not read them needs memory independent of the number of frames (they
+        are never read from a ``shadowcam_nc`` / ``shadowcam_outdoor_nc`` file; other
+        formats drop them after conversion).
 
     Returns
     -------
@@ -303,7 +318,12 @@ def load_ground_truth(manifest):
         raise ValueError(f"ground truth file {path} (manifest {manifest.get('manifest_path')}) does not exist")
     checksums = verify_checksums(manifest, ["ground_truth"]) if "ground_truth" in manifest.get("files", {}) else {}
     try:
-        dataset = GT_FORMATS[spec["format"]](path)
+        if spec["format"] in _READS_SELECTIVELY:
+            dataset = GT_FORMATS[spec["format"]](path, frame_maps=frame_maps)
+        else:
+            dataset = GT_FORMATS[spec["format"]](path)
+            if not frame_maps:
+                dataset = dataset.drop_vars([n for n, v in dataset.data_vars.items() if _per_pixel_frame(v)])
         (check_outdoor_ground_truth if spec["format"] in OUTDOOR_FORMATS else check_ground_truth)(dataset)
     except ValueError as exc:
         raise ValueError(f"ground truth {path} (format {spec['format']}): {exc}") from None

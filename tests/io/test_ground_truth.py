@@ -129,6 +129,25 @@ def test_outdoor_npz_and_netcdf_give_the_same_standard_form(tmp_path, write_mani
         mitsuba_outdoor_npz_to_dataset(broken)
 
 
+@pytest.mark.parametrize("fmt, name", [("shadowcam_outdoor_nc", "ground_truth.nc"), ("mitsuba_outdoor_npz", "gt.npz")])
+def test_ground_truth_without_its_per_frame_maps(tmp_path, write_manifest, fmt, name):
+    from shadowcam.io.ground_truth import mitsuba_outdoor_npz_to_dataset
+
+    full = mitsuba_outdoor_npz_to_dataset(_outdoor_arrays())
+    full["lit_center"] = (("time", "row", "col"), np.ones((3, 4, 5), np.float32))
+    if fmt == "mitsuba_outdoor_npz":
+        np.savez(tmp_path / name, **_outdoor_arrays())
+    else:
+        full.drop_attrs().to_netcdf(tmp_path / name, engine="h5netcdf")
+    manifest = _manifest(write_manifest, tmp_path, fmt, name)
+    lean = load_ground_truth(manifest, frame_maps=False)
+    kept = load_ground_truth(manifest)
+    assert "lit_center" not in lean and ("lit_center" in kept) == (fmt == "shadowcam_outdoor_nc")
+    assert "pb_edge_y" in lean and "times_s" in lean  # (time, col) and (time,) are not per-pixel-frame maps
+    for variable in ("shadow_class", "arrival_time_s", "pb_edge_y"):
+        np.testing.assert_array_equal(lean[variable].values, kept[variable].values)
+
+
 @pytest.mark.usefixtures("shared_data")  # the repository manifest reads the shared dev data
 def test_dev_ridge_ground_truth_counts():
     ds = load_ground_truth(REPO / "data_manifest" / "dev_ridge.yaml")
