@@ -381,7 +381,10 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     summary : DipSummary
         One sweep.
     saturated : (H, W) bool ndarray, optional
-        Pixels that reached the white level in any channel.
+        Pixels that reached the white level in any channel. Their dip is timed
+        from the samples below the clip (censoring keeps a symmetric dip's
+        centre); one that shows no dip is ``saturated`` rather than
+        ``never_shadowed``.
     site_level, site_colour : (H, W) ndarray, optional
         For demosaiced RAW: each pixel's lit level in its own CFA channel and
         that channel's index, used by the cast-shadow boundary test.
@@ -445,7 +448,11 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     reason[(reason == OK) & several] = SEVERAL_MINIMA
     reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
     if saturated is not None:
-        reason[(reason == OK) & saturated] = SATURATED
+        # a clipped channel censors the samples above the white level; the part of the dip
+        # below it is a monotone image of the symmetric dip, so a detected dip keeps its
+        # centre (its smaller depth widens the time's noise). A pixel that shows no dip at all
+        # may have it above the clip
+        reason[(reason == NEVER_SHADOWED) & saturated & ~deep_enough] = SATURATED
     # a non-finite sample in the window at a frame inside the sweep (slots outside the
     # sweep are NaN padding)
     frame = _window_times(summary)
