@@ -742,7 +742,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
     Returns
     -------
     results : dict of (H, W) ndarrays
-        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
+        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)``, ``saturated`` (bool)
+        and ``n_frames``.
     """
     lit_image = lit_colour(summary)
     classify_params = dict(classify_params or {})
@@ -755,6 +756,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
     results = shadow_times(summary, method=method, saturated=summary.saturated,
                            method_params=method_params, interval=interval, **classify_params)
     results["lit_image"] = lit_image
+    if summary.saturated is not None:
+        results["saturated"] = summary.saturated
     results["n_frames"] = summary.n_frames
     return results
 
@@ -769,6 +772,7 @@ _VARIABLE_ATTRS = {
     "lit_level": ("linear", "unshadowed level of the channel sum"),
     "noise": ("linear", "temporal noise standard deviation of the channel sum"),
     "lit_image": ("linear", "unshadowed colour per channel"),
+    "saturated": ("1", "a channel reached the white level: the unshadowed colour is a lower bound"),
     "interval_entry": ("frame", "time the smoothed signal falls below half the dip's depth (dip interval entry)"),
     "interval_exit": ("frame", "time the smoothed signal comes back above half the dip's depth (interval exit)"),
     "interval_entry_std": ("frame", "standard deviation of interval_entry (noise over the crossing's slope)"),

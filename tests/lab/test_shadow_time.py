@@ -105,6 +105,7 @@ def test_a_clipped_channel_keeps_the_dip_centre(wire_sweep, gain):
     result = run(frames)
     assert (frames[..., 0] >= 0.999).any(axis=0).mean() == 1.0  # the red channel clips everywhere
     assert (result["reason"] != SATURATED).all()  # every pixel's dip comes below the clip
+    assert result["saturated"].all() and not clean["saturated"].any()  # their colour is a lower bound
     err, coverage = abs_error(result, gt)
     err_clean, coverage_clean = abs_error(clean, gt)
     assert coverage >= coverage_clean - 0.01
