@@ -422,14 +422,18 @@ def camera_colours(shadow_time, *, reference=None, sweeps=("u", "v")):
     Returns
     -------
     (rows, cols, channel) float32 ndarray
+        NaN at the pixels the shadow-time dataset marks ``saturated`` in any of `sweeps`
+        (a clipped colour is a lower bound: those dual pixels are left uncovered).
     """
+    present = [s for s in sweeps if s in shadow_time["sweep"].values]
+    clipped = (shadow_time["saturated"].sel(sweep=present).any("sweep").transpose("row", "col").values
+               if "saturated" in shadow_time and present else False)
     if reference is not None:
         ref = np.asarray(reference, dtype=np.float32)
         check_array(ref, "reference", ndim=3)
-        return ref
+        return np.where(np.asarray(clipped)[..., None], np.float32(np.nan), ref)
     if "lit_image" not in shadow_time:
         raise ValueError("shadow_time: no 'lit_image' variable and no reference frame given")
-    present = [s for s in sweeps if s in shadow_time["sweep"].values]
     if not present:
         raise ValueError(f"shadow_time: none of the sweeps {list(sweeps)} is present")
     lit = shadow_time["lit_image"].sel(sweep=present).transpose("sweep", "row", "col", "channel")
@@ -437,7 +441,7 @@ def camera_colours(shadow_time, *, reference=None, sweeps=("u", "v")):
         stack = np.asarray(lit.values, dtype=np.float32)
         counts = np.sum(np.isfinite(stack), axis=0)
         mean = np.where(counts > 0, np.nansum(stack, axis=0) / np.maximum(counts, 1), np.nan)
-    return mean.astype(np.float32)
+    return np.where(np.asarray(clipped)[..., None], np.nan, mean).astype(np.float32)
 
 
 def dual_view_dataset(image, coverage, *, method, params=None, channels=("R", "G", "B")):

@@ -27,6 +27,7 @@ Targets (foundation issue) are checked and reported pass/fail.
 Offers
 ------
 ACCURACY_TARGETS : the targets and their thresholds.
+CONFIDENT_STD : time std (frames) above which a time is reported as uncertain.
 shadow_time_errors : error statistics of one sweep's shadow times.
 dual_coord_errors : error statistics of dual coordinates.
 dual_image_errors : gain-fitted relative RMSE of a dual view, masked and whole image.
@@ -71,7 +72,12 @@ def _stats(err):
     }
 
 
-def shadow_time_errors(estimate, truth, *, lit):
+#: a time whose standard deviation is above this (frames) is not confident (the scale of
+#: the shadow time's ``confidence``, exp(-std^2 / (2 * 0.25^2)))
+CONFIDENT_STD = 0.25
+
+
+def shadow_time_errors(estimate, truth, *, lit, time_std=None):
     """Error statistics of one sweep's shadow times.
 
     Parameters
@@ -82,13 +88,18 @@ def shadow_time_errors(estimate, truth, *, lit):
         GT shadow time (frames), NaN where not lit or not swept.
     lit : (rows, cols) bool ndarray, keyword-only
         GT: the pixel's point sees the light.
+    time_std : (rows, cols) ndarray, optional
+        The estimate's standard deviation (frames).
 
     Returns
     -------
     dict
         ``n_truth`` (lit pixels with a GT time), ``n_evaluated``, ``coverage``,
         ``median``, ``p95``, ``rmse``, ``max`` (absolute error, frames),
-        ``frac_gt_1_frame``, ``n_unlit``, ``false_time_rate``, ``mean_signed``.
+        ``frac_gt_1_frame``, ``n_unlit``, ``false_time_rate``, ``mean_signed``; with
+        `time_std` also ``n_uncertain`` (evaluated pixels whose std exceeds
+        :data:`CONFIDENT_STD`; they stay in every statistic above) and ``p95_confident``
+        (p95 over the other evaluated pixels).
     """
     estimate = np.asarray(estimate, dtype=np.float64)
     truth = np.asarray(truth, dtype=np.float64)
@@ -113,6 +124,13 @@ def shadow_time_errors(estimate, truth, *, lit):
         "n_unlit": n_unlit,
         "false_time_rate": float((has_est & ~lit).sum() / n_unlit) if n_unlit else 0.0,
     }
+    if time_std is not None:
+        std = np.asarray(time_std, dtype=np.float64)
+        if std.shape != truth.shape:
+            raise ValueError(f"time_std: shape {std.shape} differs from truth's {truth.shape}")
+        confident = ~(std[evaluated] > CONFIDENT_STD)
+        out["n_uncertain"] = int((~confident).sum())
+        out["p95_confident"] = _stats(np.abs(signed[confident]))["p95"]
     return out
 
 
@@ -446,8 +464,10 @@ def accuracy_report(shadow_time, ground_truth, *, dual_coords=None, dual_view=No
         if sweep not in names or f"t_{sweep}" not in ground_truth:
             continue
         est = shadow_time["shadow_time"].sel(sweep=sweep).transpose("row", "col").values
+        std = (shadow_time["time_std"].sel(sweep=sweep).transpose("row", "col").values
+               if "time_std" in shadow_time else None)
         report["shadow_time"][sweep] = shadow_time_errors(
-            est, ground_truth[f"t_{sweep}"].transpose("row", "col").values, lit=lit)
+            est, ground_truth[f"t_{sweep}"].transpose("row", "col").values, lit=lit, time_std=std)
     # without dual coordinates the dual view is taken to be on the reciprocal grid
     grid_map = np.eye(3) if dual_coords is None else _dual_grid_map(dual_coords, ground_truth)
     if dual_coords is not None:
@@ -540,6 +560,8 @@ TABLE_ROWS = {
         "mean_signed": ("shadow time mean signed error", "frame", 1.0),
         "false_time_rate": ("false times (unlit pixels given a time)", "%", 100.0),
         "n_evaluated": ("pixels evaluated (lit, timed)", "pixel", 1.0),
+        "n_uncertain": (f"pixels evaluated with time std > {CONFIDENT_STD:g} frame", "pixel", 1.0),
+        "p95_confident": (f"shadow time |error| p95, time std <= {CONFIDENT_STD:g} frame", "frame", 1.0),
     },
     "dual_coords": {
         "coverage": ("dual coordinates coverage", "%", 100.0),

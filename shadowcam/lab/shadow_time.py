@@ -15,6 +15,7 @@ SHADOW_TIME_METHODS : name -> timing function ``f(summary) -> (time, entry, exit
 REASONS : flag code -> meaning, for pixels without a reliable time.
 classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
+footprint_spread_std : time uncertainty of a footprint that sees two surfaces' shadow times.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 lit_colour : unshadowed colour per pixel from a summary with channel sums.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
@@ -381,7 +382,10 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     summary : DipSummary
         One sweep.
     saturated : (H, W) bool ndarray, optional
-        Pixels that reached the white level in any channel.
+        Pixels that reached the white level in any channel. Their dip is timed
+        from the samples below the clip (censoring keeps a symmetric dip's
+        centre); one that shows no dip is ``saturated`` rather than
+        ``never_shadowed``.
     site_level, site_colour : (H, W) ndarray, optional
         For demosaiced RAW: each pixel's lit level in its own CFA channel and
         that channel's index, used by the cast-shadow boundary test.
@@ -445,7 +449,11 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     reason[(reason == OK) & several] = SEVERAL_MINIMA
     reason[(reason == OK) & _wider_than_window(summary, depth, z * noise)] = WIDE_DIP
     if saturated is not None:
-        reason[(reason == OK) & saturated] = SATURATED
+        # a clipped channel censors the samples above the white level; the part of the dip
+        # below it is a monotone image of the symmetric dip, so a detected dip keeps its
+        # centre (its smaller depth widens the time's noise). A pixel that shows no dip at all
+        # may have it above the clip
+        reason[(reason == NEVER_SHADOWED) & saturated & ~deep_enough] = SATURATED
     # a non-finite sample in the window at a frame inside the sweep (slots outside the
     # sweep are NaN padding)
     frame = _window_times(summary)
@@ -474,8 +482,9 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
         The measured dip intervals (:func:`shadowcam.lab.dip_tracker.track_intervals`):
         a dip wider than the window is then timed at its interval's centre
         (``dip_at_sweep_end`` when the interval reaches the sweep's start or
-        end, ``invalid_input`` with a non-finite sample inside), and the
-        ``interval_*`` variables are returned.
+        end, ``invalid_input`` with a non-finite sample inside), the
+        ``interval_*`` variables are returned, and ``time_std`` adds the
+        footprint's excess span (:func:`footprint_spread_std`).
     **classify_params
         Options of :func:`classify_dips`.
 
@@ -497,6 +506,8 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
     time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
     if interval is not None:
         reason, time, entry, exit_, std, extra = _time_wide_dips(summary, interval, reason, time, entry, exit_, std)
+    if interval is not None:
+        std = np.hypot(std, footprint_spread_std(interval, reason == OK))
     last = summary.n_frames - 1
     outside = ~((time >= 0) & (time <= last))
     reason = reason.copy()
@@ -518,6 +529,39 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
         **({} if interval is None else {
             key: np.where(good, value, nan).astype(np.float32) for key, value in extra.items()}),
     }
+
+
+def footprint_spread_std(interval, timed):
+    """Time uncertainty of a pixel whose footprint sees more shadow times than one surface's.
+
+    A pixel's half-depth dip spans the times its footprint's points are shadowed; on one
+    surface a neighbour's footprint spans as long. A footprint that sees two surfaces (a
+    silhouette) or a surface and a cast shadow spans more, and its centroid is that of
+    whichever part is lit, while the pixel's centre sees one of the surfaces: its time is at
+    one end of the excess span, half of it from the centroid (standard deviation
+    ``excess / 2``).
+
+    Parameters
+    ----------
+    interval : DipInterval
+        Measured half-depth ``entry`` and ``exit`` per pixel, ``(H, W)`` each.
+    timed : (H, W) bool ndarray
+        Pixels with a time; the reference span is the median of the timed 8-neighbours'.
+
+    Returns
+    -------
+    (H, W) float64 ndarray
+        Frames; 0 where the dip spans no more than the reference (or none is known).
+    """
+    with np.errstate(invalid="ignore"):
+        width = np.where(timed, interval.exit - interval.entry, np.nan)
+    neighbours = np.stack([shifted(width, dr, dc, np.nan) for dr, dc in _shifts(1)])
+    known = np.isfinite(neighbours).any(axis=0)
+    reference = np.full(width.shape, np.nan)
+    reference[known] = np.nanmedian(neighbours[:, known], axis=0)
+    with np.errstate(invalid="ignore"):
+        excess = np.maximum(width - reference, 0.0)
+    return 0.5 * np.nan_to_num(excess, nan=0.0, posinf=0.0)
 
 
 def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
@@ -698,7 +742,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
     Returns
     -------
     results : dict of (H, W) ndarrays
-        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
+        As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)``, ``saturated`` (bool)
+        and ``n_frames``.
     """
     lit_image = lit_colour(summary)
     classify_params = dict(classify_params or {})
@@ -711,6 +756,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
     results = shadow_times(summary, method=method, saturated=summary.saturated,
                            method_params=method_params, interval=interval, **classify_params)
     results["lit_image"] = lit_image
+    if summary.saturated is not None:
+        results["saturated"] = summary.saturated
     results["n_frames"] = summary.n_frames
     return results
 
@@ -725,6 +772,7 @@ _VARIABLE_ATTRS = {
     "lit_level": ("linear", "unshadowed level of the channel sum"),
     "noise": ("linear", "temporal noise standard deviation of the channel sum"),
     "lit_image": ("linear", "unshadowed colour per channel"),
+    "saturated": ("1", "a channel reached the white level: the unshadowed colour is a lower bound"),
     "interval_entry": ("frame", "time the smoothed signal falls below half the dip's depth (dip interval entry)"),
     "interval_exit": ("frame", "time the smoothed signal comes back above half the dip's depth (interval exit)"),
     "interval_entry_std": ("frame", "standard deviation of interval_entry (noise over the crossing's slope)"),

@@ -154,6 +154,25 @@ def test_camera_colours_and_dataset():
     assert out["dual_view"].dtype == np.float32 and out.attrs["resampling"] == "mesh"
 
 
+def test_clipped_camera_colours_are_left_out():
+    # a pixel whose channel reached the white level in either sweep has a lower bound for a
+    # colour: NaN, so no dual pixel takes it, from the lit image or the reference alike
+    lit = np.full((2, 3, 4, 3), 0.5, np.float32)
+    saturated = np.zeros((2, 3, 4), bool)
+    saturated[0, 1, 2] = saturated[1, 2, 0] = True
+    ds = xr.Dataset({"lit_image": (("sweep", "row", "col", "channel"), lit),
+                     "saturated": (("sweep", "row", "col"), saturated)},
+                    coords={"sweep": ["u", "v"], "channel": ["R", "G", "B"]})
+    ref = np.full((3, 4, 3), 0.25, np.float32)
+    for col, value in ((camera_colours(ds), 0.5), (camera_colours(ds, reference=ref), 0.25)):
+        missing = np.isnan(col).all(axis=2)
+        assert missing[1, 2] and missing[2, 0] and missing.sum() == 2
+        np.testing.assert_array_equal(col[~missing], value)
+    image, coverage = resample_dual_view(camera_colours(ds), *np.meshgrid(np.arange(4.0), np.arange(3.0)),
+                                         shape=(3, 4), method="idw", k=1, radius=0.1)
+    assert coverage.sum() == 10 and not coverage[1, 2] and not coverage[2, 0]
+
+
 def test_mesh_warp_of_exact_gt_reproduces_reciprocal_render(shared_data):
     gt = np.load(shared_data / "lab-dev" / "dev_spheres" / "gt.npz")
     # README 1.7: camera and reciprocal radiance of a Lambertian point differ by

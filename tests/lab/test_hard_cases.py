@@ -89,10 +89,22 @@ def test_low_light_12bit_times_are_right_or_flagged(electrons, seed, method, dip
 
 @settings(max_examples=10, deadline=None)
 @given(level=st.floats(0.9995, 3.0), method=st.sampled_from(METHODS))
-def test_saturated_pixels_are_flagged_never_timed(level, method, dips):
+def test_saturated_pixels_are_timed_from_the_dip_below_the_clip(level, method, dips):
+    # the clipped pixels' lit level is `level` (white = 1); their dip's floor (0.1 of it)
+    # is below the clip, so the censored dip keeps the unclipped pixels' time
     frames = dips(30, 14.3, shape=(4, 4))
     frames[:, :, :2] = np.minimum(frames[:, :, :2] * level / LEVEL, 1.0)  # clipped at white
     result = run(frames, method=method)
+    check_invariants(result, 30)
+    assert (result["reason"] == OK).all()
+    t = result["shadow_time"]
+    assert np.abs(t[:, :2] - t[:, 2:].mean()).max() < 0.02
+
+
+def test_a_pixel_flat_at_the_clip_is_saturated(dips):
+    frames = dips(30, 14.3, shape=(4, 4))
+    frames[:, :, :2] = 1.0  # white in every frame: a dip, if any, is above the clip
+    result = run(frames)
     check_invariants(result, 30)
     assert (result["reason"][:, :2] == SATURATED).all()
     assert (result["reason"][:, 2:] == OK).all()

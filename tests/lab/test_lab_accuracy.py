@@ -262,3 +262,19 @@ def test_accuracy_table_has_the_interval_and_viewpoint_rows():
     assert table["dual view coverage of what the camera sees, viewpoint entry"]["value"] == "80"
     assert table["dual pixels in the GT valid mask, viewpoint entry"]["value"] == "300"
     assert table["dual view, viewpoint exit"]["value"] == "skipped: no reciprocal render"
+
+
+def test_uncertain_times_are_counted_and_stay_in_the_score():
+    truth = np.arange(20, dtype=float).reshape(4, 5)
+    estimate = truth + 0.01
+    estimate[0, :2] += 2.0  # two wrong times that say so
+    std = np.full((4, 5), 0.05)
+    std[0, :2] = 1.0
+    lit = np.ones((4, 5), bool)
+    out = shadow_time_errors(estimate, truth, lit=lit, time_std=std)
+    assert out["n_evaluated"] == 20 and out["n_uncertain"] == 2
+    assert out["p95_confident"] == pytest.approx(0.01, abs=1e-9)
+    assert out["p95"] == pytest.approx(np.percentile(np.abs(estimate - truth), 95))
+    assert "n_uncertain" not in shadow_time_errors(estimate, truth, lit=lit)
+    with pytest.raises(ValueError, match="time_std"):
+        shadow_time_errors(estimate, truth, lit=lit, time_std=std[:2])

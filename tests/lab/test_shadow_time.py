@@ -84,7 +84,7 @@ def test_constant_pixels_are_flagged_without_warnings():
 
 def test_saturated_and_invalid_pixels_say_why(wire_sweep):
     frames, gt = wire_sweep(shape=(16, 16), n_frames=30, px_per_frame=1.0)
-    frames[:, 0:3, 0:3, 0] = 1.0  # clipped red channel
+    frames[:, 0:3, 0:3, :] = 1.0  # every channel clipped in every frame: any dip is above the clip
     frames[12, 10, 10, :] = np.nan  # corrupt sample inside the dip window
     frames[:, 5, 5] *= np.linspace(1, 1.001, 30)[:, None]
     result = run(frames)
@@ -93,6 +93,24 @@ def test_saturated_and_invalid_pixels_say_why(wire_sweep):
     if abs(dip_frame - 12) <= 4:
         assert result["reason"][10, 10] == INVALID_INPUT
     assert np.isnan(result["shadow_time"][result["reason"] != OK]).all()
+
+
+@pytest.mark.parametrize("gain", [1.5, 3.0])
+def test_a_clipped_channel_keeps_the_dip_centre(wire_sweep, gain):
+    # the red channel's lit level is `gain` times the white level: its samples are censored
+    # except deep in the dip, a monotone image of the symmetric dip, so the centre is kept
+    frames, gt = wire_sweep(shape=(24, 24), n_frames=40, px_per_frame=1.0)
+    clean = run(frames)
+    frames[..., 0] = np.minimum(frames[..., 0] * gain / frames[..., 0].max(axis=0), 1.0)
+    result = run(frames)
+    assert (frames[..., 0] >= 0.999).any(axis=0).mean() == 1.0  # the red channel clips everywhere
+    assert (result["reason"] != SATURATED).all()  # every pixel's dip comes below the clip
+    assert result["saturated"].all() and not clean["saturated"].any()  # their colour is a lower bound
+    err, coverage = abs_error(result, gt)
+    err_clean, coverage_clean = abs_error(clean, gt)
+    assert coverage >= coverage_clean - 0.01
+    # exact truth; the clean sweep's p95 is the scale (sub-tenth frame)
+    assert np.percentile(err, 95) <= max(0.1, 1.1 * np.percentile(err_clean, 95))
 
 
 def test_two_minima_are_flagged(wire_sweep):
@@ -272,3 +290,49 @@ def test_pure_noise_gets_no_time_with_the_interval_pass(wire_sweep):
     after = _interval_times(frames, method="edge_fit")
     # classify_dips' default false_alarm is 1e-2 per pixel on its own
     assert np.mean(after["reason"] == OK) < 0.02
+
+
+def test_footprint_spread_std_is_the_excess_span_over_the_neighbours():
+    from types import SimpleNamespace
+
+    from shadowcam.lab.shadow_time import footprint_spread_std
+
+    entry = np.full((5, 6), 10.0)
+    exit_ = entry + 3.0
+    exit_[2, 3] = 16.0  # spans 6 frames against its neighbours' 3
+    timed = np.ones((5, 6), bool)
+    timed[0, 0] = False
+    exit_[0, 0] = 40.0  # untimed: neither a std nor a reference
+    std = footprint_spread_std(SimpleNamespace(entry=entry, exit=exit_), timed)
+    assert std[2, 3] == pytest.approx(1.5, rel=1e-12)
+    others = np.ones_like(timed)
+    others[2, 3] = False
+    assert (std[others] == 0.0).all()
+
+
+def test_a_footprint_on_two_surfaces_says_its_time_is_uncertain(wire_sweep):
+    # column 20's footprint sees two surfaces, each half of it: the near one shadowed at the
+    # left neighbours' times, the far one 2.5 frames later. The pixel centre's time is one of
+    # the two (here the near one's); the dip's centroid lies between them, so the pixel must
+    # carry a std that covers its error, while its one-surface neighbours stay confident
+    import xarray as xr
+
+    from shadowcam.lab.shadow_time import shadow_time_of_stores
+
+    rows, cols = np.mgrid[0:12, 0:32]
+    near = 10.0 + 0.5 * cols + 0.1 * rows
+    options = dict(n_frames=48, shape=(12, 32), width=2.0, ramp=1.0)
+    frames, _ = wire_sweep(centres=[near, near + 2.5], depth=[0.5, 0.5], **options)
+    frames[:, :, :20] = wire_sweep(centres=near, **options)[0][:, :, :20]  # the near surface only
+    frames[:, :, 21:] = wire_sweep(centres=near + 2.5, **options)[0][:, :, 21:]  # the far one
+    gt = np.where(cols <= 20, near, near + 2.5)
+    store = xr.Dataset({"image": (("time", "row", "col", "channel"), frames)})
+    result = shadow_time_of_stores({"u": store}, half_window=4)
+    t = result["shadow_time"].sel(sweep="u").values
+    std = result["time_std"].sel(sweep="u").values
+    inner = slice(1, 11)
+    err = np.abs(t - gt)[inner, 20]
+    assert np.isfinite(err).all() and (err > 1.0).all()  # the centroid is between the two times
+    assert (std[inner, 20] >= 0.5 * err).all()
+    assert (std[inner, 4:17] < 0.25).all()  # one surface, the same shape of dip as its neighbours
+

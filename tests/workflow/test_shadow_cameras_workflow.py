@@ -64,7 +64,13 @@ def test_every_shadow_camera_runs_from_its_manifest_to_accuracy(camera_run):
             {n: s.n_frames for n, s in planned.sweeps.items()}, ds
         report = json.loads((results / "accuracy.json").read_text())
         for sweep in ("u", "v"):
-            assert report["shadow_time"][sweep]["coverage"] >= 0.95, (ds, sweep)
+            stats = report["shadow_time"][sweep]
+            # measured 0.974 (glass v) to 0.999 (orthographic v); the rest of the lit pixels
+            # are cast-shadow boundary pixels (low_contrast), several_minima and wide dips
+            assert stats["coverage"] >= 0.97, (ds, sweep)
+            # the silhouette pixels' times say they are uncertain; they stay in the p95
+            assert 0 <= stats["n_uncertain"] < stats["n_evaluated"], (ds, sweep)
+            assert stats["p95_confident"] <= stats["p95"], (ds, sweep)
             assert {"shadow_time_p95_frames", "shadow_time_coverage"} <= {
                 t["target"] for t in report["targets"] if t["sweep"] == sweep}
         assert math.isfinite(report["dual_coords"]["rmse"]), ds
