@@ -24,7 +24,7 @@ import numpy as np
 from shadowcam.io.cfa import site_constants
 from shadowcam.io.decode import read_frame
 from shadowcam.io.raw_mosaic import is_raw, read_mosaic
-from shadowcam.lab.dip_tracker import DipTracker, merge_partials
+from shadowcam.lab.dip_tracker import DipTracker, merge_partials, track_intervals, without_interval
 from shadowcam.io.mosaic_reader import MosaicReader
 from shadowcam.lab.dip_kernels import SUM_SCALE, quantise_sum
 from shadowcam.lab.mosaic_signal import bilinear_channels, mosaic_signal
@@ -155,6 +155,20 @@ def _track_owned(paths, owned, half_window, block_frames, saturation_level):
     return tracker.partial(), frames.sums()
 
 
+def _signal_blocks(paths, block_frames):
+    """The sweep's tracked signal read again in blocks of `block_frames` (the interval's second pass).
+
+    A generator: nothing is read unless it is iterated.
+    """
+    frames = (_MosaicFrames if is_raw(paths[0]) else _DecodedFrames)(paths, 0, (0, 0), np.inf)
+    buffer = np.empty((block_frames,) + frames.frame_shape, np.float32)
+    for start in range(0, len(paths), block_frames):
+        stop = min(start + block_frames, len(paths))
+        for index in range(start, stop):
+            frames.read_into(paths[index], index, buffer[index - start])
+        yield buffer[:stop - start]
+
+
 def _mosaic_colour(summary, chunk_sums):
     """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place).
 
@@ -235,9 +249,20 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
     dict
         As :func:`shadowcam.lab.shadow_time.sweep_shadow_times`; the CFA pattern of
         RAW frames is read from the first file.
+
+    Notes
+    -----
+    The dip interval (a dip wider than the tracker's window, as the workflow's
+    shadow-time step measures it) comes from each pixel's stored window where
+    its crossings lie inside it; only if some pixel's do not are the files
+    read a second time (in this process) for those pixels
+    (:func:`shadowcam.lab.dip_tracker.track_intervals`).
     """
+    paths = [os.fspath(p) for p in paths]
     summary = track_files(paths, half_window=half_window, workers=workers,
                           block_frames=block_frames)
+    interval = track_intervals(_signal_blocks(paths, int(block_frames)), summary)
+    summary, interval = without_interval(summary, interval)
     cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, interval=interval,
                                 method_params=method_params, classify_params=classify_params)
