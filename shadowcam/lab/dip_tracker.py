@@ -734,22 +734,28 @@ def window_intervals(summary, threshold):
     return partial, resolved.reshape(shape)
 
 
-def track_intervals(blocks, summary, *, threshold=None):
+def track_intervals(blocks, summary, *, threshold=None, measure=None):
     """The dip interval of every pixel of `summary`: from its window, else by a second pass over the frames.
 
     Pixels whose crossings lie in the stored window (:func:`window_intervals`)
-    need no frame; only if some pixel is left are `blocks` iterated (a lazy
-    iterable, e.g. a generator reading the frames, then costs nothing) and
-    that pixel measured by an :class:`IntervalTracker`. The result equals the
-    tracker's over all pixels bit for bit.
+    need no frame; only if some pixel is left are the frames read again
+    (`blocks` iterated: a lazy iterable, e.g. a generator reading the frames,
+    then costs nothing) and that pixel measured by an :class:`IntervalTracker`.
+    The result equals the tracker's over all pixels bit for bit.
 
     Parameters
     ----------
     blocks : iterable of (T, H, W[, C]) ndarray
-        The same frames as fed to the :class:`DipTracker`, in time order.
+        The same frames as fed to the :class:`DipTracker`, in time order
+        (unused with `measure`).
     summary : DipSummary
     threshold : (H, W) ndarray, optional
         Default :func:`half_depth`.
+    measure : callable, optional
+        ``measure(centre_frame, threshold)`` -> the :class:`IntervalPartial` of
+        every time chunk of an :class:`IntervalTracker` with these arguments
+        (``threshold`` NaN for the pixels already measured), e.g. chunks
+        tracked in parallel; replaces the pass over `blocks`.
 
     Returns
     -------
@@ -757,18 +763,22 @@ def track_intervals(blocks, summary, *, threshold=None):
     """
     threshold = half_depth(summary) if threshold is None else np.asarray(threshold, np.float64)
     partial, resolved = window_intervals(summary, threshold)
-    if not resolved.all():
-        tracker = IntervalTracker(summary.minimum_frame, np.where(resolved, np.nan, threshold),
-                                  half_window=summary.half_window, n_frames=summary.n_frames)
+    interval = merge_intervals([partial], n_frames=summary.n_frames, threshold=threshold)
+    if resolved.all():
+        return interval
+    left = np.where(resolved, np.nan, threshold)
+    if measure is None:
+        tracker = IntervalTracker(summary.minimum_frame, left, half_window=summary.half_window,
+                                  n_frames=summary.n_frames)
         for block in blocks:
             tracker.update(block)
-        rest = tracker.partial()
-        for f in fields(IntervalPartial):
-            if f.name not in ("start", "stop"):
-                mine = getattr(partial, f.name)
-                keep = resolved.reshape(resolved.shape + (1,) * (mine.ndim - 2))
-                setattr(partial, f.name, np.where(keep, mine, getattr(rest, f.name)))
-    return merge_intervals([partial], n_frames=summary.n_frames, threshold=threshold)
+        parts = [tracker.partial()]
+    else:
+        parts = measure(summary.minimum_frame, left)
+    rest = merge_intervals(parts, n_frames=summary.n_frames, threshold=threshold)
+    # merge_intervals works pixel by pixel: each pixel's result from its own partial
+    return DipInterval(**{f.name: np.where(resolved, getattr(interval, f.name), getattr(rest, f.name))
+                          for f in fields(DipInterval)})
 
 
 def _ramp_deficit(level, minimum, crossing, slope, first, last):
