@@ -537,8 +537,8 @@ def format_report(figures):
         lines.append(f"  {reader + ' floor':19s} {f[reader + '_floor_s']:8.1f} s  "
                      f"{f[reader + '_floor_mpfs']:8.1f} M pixel-frames/s   ({note})")
     lines += [
-        f"  ratio to decode floor (direct)  {f['ratio_to_direct_floor']:.2f}   (target >= 0.8: the decode the pipeline uses)",
-        f"  ratio to decode floor (rawpy)   {f['ratio_to_decode_floor']:.2f}",
+        f"  ratio to decode floor (direct)  {f['ratio_to_direct_floor']:.3f}   (target >= 0.8: the decode the pipeline uses)",
+        f"  ratio to decode floor (rawpy)   {f['ratio_to_decode_floor']:.3f}",
         "",
     ]
     g = f["stages"]
