@@ -3,8 +3,10 @@
 # `make bench-outdoor` reruns the outdoor pipeline on dev_ridge and prints per-stage
 # wall time / peak memory and the arrival-time accuracy (ours and the naive baseline);
 # `make bench-outdoor-size` the same stages at a camera's size (24 MP by default), extrapolated.
-# `make bench` prints the speed benchmark (not part of the tests; ~10 min per compression,
-# renders its DNG input once into results/bench/dng-<compression> and reuses it).
+# `make bench` prints the speed benchmark: DNG -> shadow-time map against the pipeline's own
+# mosaic reader and against rawpy, and CPU ns per pixel-frame of each stage (not part of the
+# tests; ~10-15 min per compression, renders its DNG input once into
+# results/bench/dng-<compression> and reuses it).
 # `make shell` opens a shell inside .venv (`shadowcam`, `snakemake` on PATH; `exit` leaves it);
 # `make shell CMD='...'` runs one command in it.
 # Every target installs the package (editable, with test and SLURM-executor extras) into .venv first.

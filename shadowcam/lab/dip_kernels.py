@@ -27,6 +27,7 @@ finish_centres : test the last centres of a sequence that ended.
 window_sums : the exact sums of stored windows (to take the dip out of the running sums).
 select_dips : the deepest and second dip of each pixel among candidate lists (merging chunks).
 interval_block : compare smoothed frames with a threshold around each pixel's deepest minimum (the dip's interval).
+interval_from_window : the same for pixels whose crossings lie in their stored window (no pass over the frames).
 """
 
 import numba as nb
@@ -583,3 +584,84 @@ def interval_block(ext, ext_first, j_from, j_to, start, stop, end, centre_frame,
                     after_sums[p, 2] += np.int64(hi * 256.0)
                     after_sums[p, 3] += np.int64(lo * 2.0**40)
             previous[p] = s
+
+
+@nb.njit(cache=True, inline="always")
+def _window_smooth(window, p, j, lo, end):
+    """Smoothed value of frame `j` from pixel `p`'s window ``(K, P)`` (frame ``lo + k`` in row k), as :func:`interval_block`."""
+    mid = window[j - lo, p]
+    prev = window[j - 1 - lo, p] if j >= 1 else mid
+    nxt = window[j + 1 - lo, p] if j + 1 < end else mid
+    s = mid * _HALF
+    s += _QUARTER * prev
+    s += _QUARTER * nxt
+    return s
+
+
+@nb.njit(cache=True, parallel=True)
+def interval_from_window(window, centre_frame, threshold, end, before_frame, before_values, after_frame,
+                         after_values, resolved):
+    """What :func:`interval_block` over a whole sweep finds, for pixels whose crossings lie in their window.
+
+    `window` ``(K, P)`` float32 holds each pixel's raw signal of frames
+    ``centre - h .. centre + h`` (``K = 2h + 1``; NaN outside ``[0, end)``),
+    `centre_frame` ``(P,)`` its deepest minimum (negative: no dip), `threshold`
+    ``(P,)`` float32. A frame's smoothed value needs its neighbours inside the
+    window (or outside the sweep), so frames ``centre - h + 1 .. centre + h - 1``
+    (and the sweep's first / last frame) are known. A pixel is resolved when
+    its window has no non-finite sample inside the sweep and, on each side of
+    the centre, a known frame at or above the threshold is met before an
+    unknown one (or the sweep's end): then no frame beyond the window can
+    change the crossings, the invalid counts are 0 and nothing lies inside the
+    interval beyond the window. Resolved pixels get the crossing frames and
+    values (the arrays' other pixels are left as they are); pixels without a
+    dip are resolved with nothing found.
+    """
+    n_k, n_p = window.shape
+    h = (n_k - 1) // 2
+    for p in nb.prange(n_p):
+        c = centre_frame[p]
+        if c < 0:
+            resolved[p] = True
+            continue
+        lo = c - h
+        clean = True
+        for k in range(n_k):
+            f = lo + k
+            if 0 <= f < end and not window[k, p] - window[k, p] == 0:
+                clean = False
+        if not clean:
+            resolved[p] = False
+            continue
+        theta = threshold[p]
+        done_before = c == 0  # nothing before the sweep's first frame
+        for j in range(c - 1, max(0, lo) - 1, -1):
+            if j >= 1 and j - 1 < lo:
+                break  # its previous frame is outside the window
+            s = _window_smooth(window, p, j, lo, end)
+            if not s - s == 0:
+                break
+            if s >= theta:
+                before_frame[p] = j
+                before_values[p, 0] = s
+                before_values[p, 1] = _window_smooth(window, p, j + 1, lo, end)
+                done_before = True
+                break
+            if j == 0:
+                done_before = True  # the sweep starts inside the dip: nothing before
+        done_after = c + 1 >= end  # the sweep ends at the centre
+        for j in range(c + 1, min(end, c + h + 1)):
+            if j + 1 < end and j + 1 > c + h:
+                break  # its next frame is outside the window
+            s = _window_smooth(window, p, j, lo, end)
+            if not s - s == 0:
+                break
+            if s >= theta:
+                after_frame[p] = j
+                after_values[p, 0] = _window_smooth(window, p, j - 1, lo, end)
+                after_values[p, 1] = s
+                done_after = True
+                break
+            if j == end - 1:
+                done_after = True  # the sweep ends inside the dip
+        resolved[p] = done_before and done_after

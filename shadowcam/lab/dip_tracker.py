@@ -38,7 +38,8 @@ DipInterval : entry, exit and their slopes per pixel; ``at(fraction)`` across th
 IntervalPartial, merge_intervals : the interval of a sweep from its time chunks.
 half_depth : the default crossing level.
 without_interval : the summary's lit statistics without the whole dip, and the crossings at its half depth.
-track_intervals : the interval pass over a sweep's frames.
+window_intervals : the interval of the pixels whose crossings lie in their stored window.
+track_intervals : the interval of every pixel: from the window, else a pass over the sweep's frames.
 """
 
 from dataclasses import dataclass, fields
@@ -696,27 +697,88 @@ def merge_intervals(partials, *, n_frames, threshold):
                        beyond_square=sums[..., 2] / 256.0 + sums[..., 3] / 2.0**40)
 
 
-def track_intervals(blocks, summary, *, threshold=None):
-    """Second pass over a sweep's frames: the dip interval of every pixel of `summary`.
+def window_intervals(summary, threshold):
+    """The whole-sweep :class:`IntervalPartial` of the pixels whose crossings lie in their window.
+
+    Parameters
+    ----------
+    summary : DipSummary
+    threshold : (H, W) array_like
+
+    Returns
+    -------
+    partial : IntervalPartial
+        Over ``[0, summary.n_frames)``; equal to the interval pass's for the
+        resolved pixels (see :func:`shadowcam.lab.dip_kernels.interval_from_window`).
+    resolved : (H, W) bool ndarray
+        Pixels that need no pass over the frames.
+    """
+    threshold = np.asarray(threshold, np.float64)
+    shape = summary.minimum_frame.shape
+    if threshold.shape != shape:
+        raise ValueError(f"threshold must have the summary's shape {shape}, got {threshold.shape}")
+    p = summary.minimum_frame.size
+    centre = np.where(np.isfinite(threshold), summary.minimum_frame, -1).astype(np.int64).ravel()
+    before_frame, after_frame = np.full(p, -1, np.int64), np.full(p, -1, np.int64)
+    before_values, after_values = np.full((p, 2), np.nan, np.float32), np.full((p, 2), np.nan, np.float32)
+    resolved = np.zeros(p, bool)
+    _k.interval_from_window(np.ascontiguousarray(summary.window, np.float32).reshape(summary.window.shape[0], -1),
+                            centre, threshold.astype(np.float32).ravel(), int(summary.n_frames),
+                            before_frame, before_values, after_frame, after_values, resolved)
+    zeros = np.zeros(shape, np.int64)
+    partial = IntervalPartial(start=0, stop=int(summary.n_frames), before_frame=before_frame.reshape(shape),
+                              before_values=before_values.reshape(shape + (2,)), before_invalid=zeros,
+                              after_frame=after_frame.reshape(shape), after_values=after_values.reshape(shape + (2,)),
+                              after_invalid=zeros.copy(), before_sums=np.zeros(shape + (4,), np.int64),
+                              after_sums=np.zeros(shape + (4,), np.int64))
+    return partial, resolved.reshape(shape)
+
+
+def track_intervals(blocks, summary, *, threshold=None, measure=None):
+    """The dip interval of every pixel of `summary`: from its window, else by a second pass over the frames.
+
+    Pixels whose crossings lie in the stored window (:func:`window_intervals`)
+    need no frame; only if some pixel is left are the frames read again
+    (`blocks` iterated: a lazy iterable, e.g. a generator reading the frames,
+    then costs nothing) and that pixel measured by an :class:`IntervalTracker`.
+    The result equals the tracker's over all pixels bit for bit.
 
     Parameters
     ----------
     blocks : iterable of (T, H, W[, C]) ndarray
-        The same frames as fed to the :class:`DipTracker`, in time order.
+        The same frames as fed to the :class:`DipTracker`, in time order
+        (unused with `measure`).
     summary : DipSummary
     threshold : (H, W) ndarray, optional
         Default :func:`half_depth`.
+    measure : callable, optional
+        ``measure(centre_frame, threshold)`` -> the :class:`IntervalPartial` of
+        every time chunk of an :class:`IntervalTracker` with these arguments
+        (``threshold`` NaN for the pixels already measured), e.g. chunks
+        tracked in parallel; replaces the pass over `blocks`.
 
     Returns
     -------
     DipInterval
     """
-    threshold = half_depth(summary) if threshold is None else threshold
-    tracker = IntervalTracker(summary.minimum_frame, threshold, half_window=summary.half_window,
-                              n_frames=summary.n_frames)
-    for block in blocks:
-        tracker.update(block)
-    return tracker.result()
+    threshold = half_depth(summary) if threshold is None else np.asarray(threshold, np.float64)
+    partial, resolved = window_intervals(summary, threshold)
+    interval = merge_intervals([partial], n_frames=summary.n_frames, threshold=threshold)
+    if resolved.all():
+        return interval
+    left = np.where(resolved, np.nan, threshold)
+    if measure is None:
+        tracker = IntervalTracker(summary.minimum_frame, left, half_window=summary.half_window,
+                                  n_frames=summary.n_frames)
+        for block in blocks:
+            tracker.update(block)
+        parts = [tracker.partial()]
+    else:
+        parts = measure(summary.minimum_frame, left)
+    rest = merge_intervals(parts, n_frames=summary.n_frames, threshold=threshold)
+    # merge_intervals works pixel by pixel: each pixel's result from its own partial
+    return DipInterval(**{f.name: np.where(resolved, getattr(interval, f.name), getattr(rest, f.name))
+                          for f in fields(DipInterval)})
 
 
 def _ramp_deficit(level, minimum, crossing, slope, first, last):

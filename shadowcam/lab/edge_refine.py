@@ -136,6 +136,7 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
                 normal[:] = 0.0
                 rhs[:] = 0.0
                 s_w = s_k = s_tt = 0.0
+                n_fit = 6 if it == iterations else 3  # the quadratic only with the last weights
                 for dr in range(-radius, radius + 1):
                     rr = row + dr
                     for dc in range(-radius, radius + 1):
@@ -151,9 +152,9 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
                         if not wgt > 0 or not np.isfinite(wgt):
                             continue
                         _basis(dr, dc, basis)
-                        for i in range(6):
+                        for i in range(n_fit):
                             rhs[i] += wgt * basis[i] * t_n
-                            for j in range(6):
+                            for j in range(n_fit):
                                 normal[i, j] += wgt * basis[i] * basis[j]
                         s_w += wgt
                         s_k += kernel

@@ -24,7 +24,7 @@ import numpy as np
 from shadowcam.io.cfa import site_constants
 from shadowcam.io.decode import read_frame
 from shadowcam.io.raw_mosaic import is_raw, read_mosaic
-from shadowcam.lab.dip_tracker import DipTracker, merge_partials
+from shadowcam.lab.dip_tracker import DipTracker, IntervalTracker, merge_partials, track_intervals, without_interval
 from shadowcam.io.mosaic_reader import MosaicReader
 from shadowcam.lab.dip_kernels import SUM_SCALE, quantise_sum
 from shadowcam.lab.mosaic_signal import bilinear_channels, mosaic_signal
@@ -117,27 +117,41 @@ class _DecodedFrames:
         return None
 
 
-def _track_chunk(paths, owned, half_window, block_frames, saturation_level, threads):
-    """Decode the padded frames of one owned chunk; return its DipPartial (and RAW sums).
-
-    RAW files are tracked from their mosaic (one signal plane per frame, see
-    :mod:`shadowcam.lab.mosaic_signal`); the partial then comes with the chunk's
-    per-site sums and clipped-pixel mask, else with None. `threads`: numba
-    threads meanwhile (None: unchanged).
-    """
+def _in_threads(threads, function, *args):
+    """``function(*args)`` with `threads` numba threads meanwhile (None: unchanged)."""
     if threads is None:
-        return _track_owned(paths, owned, half_window, block_frames, saturation_level)
+        return function(*args)
     import numba
 
     previous = numba.get_num_threads()
     numba.set_num_threads(threads)
     try:
-        return _track_owned(paths, owned, half_window, block_frames, saturation_level)
+        return function(*args)
     finally:
         numba.set_num_threads(previous)
 
 
+def _in_chunks(function, paths, workers, *args):
+    """``function(paths, owned, *args)`` for each time chunk, one per process.
+
+    This process takes the first chunk itself (one process fewer to start,
+    one result fewer to send back); each uses one numba thread.
+    """
+    chunks = chunk_bounds(len(paths), int(workers))
+    if len(chunks) == 1:
+        return [function(paths, chunks[0], *args)]
+    with ProcessPoolExecutor(len(chunks) - 1, mp_context=_CONTEXT) as pool:
+        futures = [pool.submit(_in_threads, 1, function, paths, owned, *args) for owned in chunks[1:]]
+        return [_in_threads(1, function, paths, chunks[0], *args)] + [f.result() for f in futures]
+
+
 def _track_owned(paths, owned, half_window, block_frames, saturation_level):
+    """Decode the padded frames of one owned chunk; return its DipPartial (and RAW sums).
+
+    RAW files are tracked from their mosaic (one signal plane per frame, see
+    :mod:`shadowcam.lab.mosaic_signal`); the partial then comes with the chunk's
+    per-site sums and clipped-pixel mask, else with None.
+    """
     start, stop = owned
     pad = DipTracker.padding(half_window)
     first, last = max(0, start - pad), min(len(paths), stop + pad)
@@ -153,6 +167,30 @@ def _track_owned(paths, owned, half_window, block_frames, saturation_level):
             tracker.update(buffer[:len(block)], first_index=block[0])
             block = []
     return tracker.partial(), frames.sums()
+
+
+def _signal_blocks(paths, block_frames, first=0, last=None):
+    """Frames ``first .. last - 1`` of the sweep's tracked signal read again, in blocks of `block_frames`.
+
+    A generator: nothing is read unless it is iterated.
+    """
+    last = len(paths) if last is None else last
+    frames = (_MosaicFrames if is_raw(paths[first]) else _DecodedFrames)(paths, first, (0, 0), np.inf)
+    buffer = np.empty((block_frames,) + frames.frame_shape, np.float32)
+    for start in range(first, last, block_frames):
+        stop = min(start + block_frames, last)
+        for index in range(start, stop):
+            frames.read_into(paths[index], index, buffer[index - start])
+        yield buffer[:stop - start]
+
+
+def _interval_owned(paths, owned, centre_frame, threshold, half_window, block_frames):
+    """The IntervalPartial of one owned chunk, its padded frames read again."""
+    tracker = IntervalTracker(centre_frame, threshold, half_window=half_window, n_frames=len(paths), owned=owned)
+    first = max(0, owned[0] - IntervalTracker.PAD)
+    for block in _signal_blocks(paths, block_frames, first, min(len(paths), owned[1] + IntervalTracker.PAD)):
+        tracker.update(block)
+    return tracker.partial()
 
 
 def _mosaic_colour(summary, chunk_sums):
@@ -201,16 +239,7 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
         raise ValueError("paths is empty: give the frame files of the sweep")
     if int(workers) < 1 or int(block_frames) < 1:
         raise ValueError(f"workers and block_frames must be >= 1, got {workers!r}, {block_frames!r}")
-    chunks = chunk_bounds(len(paths), int(workers))
-    args = (half_window, int(block_frames), saturation_level)
-    if len(chunks) == 1:
-        results = [_track_chunk(paths, chunks[0], *args, None)]
-    else:
-        # this process tracks the first chunk itself: one process fewer to start, one
-        # partial fewer to send back
-        with ProcessPoolExecutor(len(chunks) - 1, mp_context=_CONTEXT) as pool:
-            futures = [pool.submit(_track_chunk, paths, owned, *args, 1) for owned in chunks[1:]]
-            results = [_track_chunk(paths, chunks[0], *args, 1)] + [f.result() for f in futures]
+    results = _in_chunks(_track_owned, paths, workers, half_window, int(block_frames), saturation_level)
     summary = merge_partials([partial for partial, _ in results], n_frames=len(paths))
     if results[0][1] is None:
         return summary
@@ -235,9 +264,21 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
     dict
         As :func:`shadowcam.lab.shadow_time.sweep_shadow_times`; the CFA pattern of
         RAW frames is read from the first file.
+
+    Notes
+    -----
+    The dip interval (a dip wider than the tracker's window, as the workflow's
+    shadow-time step measures it) comes from each pixel's stored window where
+    its crossings lie inside it; only if some pixel's do not are the files
+    read a second time for those pixels (in time chunks, as the tracking)
+    (:func:`shadowcam.lab.dip_tracker.track_intervals`).
     """
+    paths = [os.fspath(p) for p in paths]
     summary = track_files(paths, half_window=half_window, workers=workers,
                           block_frames=block_frames)
+    interval = track_intervals(None, summary, measure=lambda centre, threshold: _in_chunks(
+        _interval_owned, paths, workers, centre, threshold, summary.half_window, int(block_frames)))
+    summary, interval = without_interval(summary, interval)
     cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, interval=interval,
                                 method_params=method_params, classify_params=classify_params)

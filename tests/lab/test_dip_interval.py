@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from shadowcam.lab.dip_tracker import (DipTracker, IntervalTracker, merge_intervals, track_intervals)
+from shadowcam.lab.dip_tracker import (DipTracker, IntervalTracker, half_depth, merge_intervals, track_intervals,
+                                        window_intervals)
 
 
 def trapezoid(n_frames, *, entry, plateau, ramp, depth=0.8, level=1.0, floor=0.0):
@@ -215,3 +216,81 @@ def test_wide_dip_lit_level_leaves_out_the_penumbra_ramps(plateau, ramp, phase, 
     first, summary, interval, entry, exit_ = _tracked_trapezoid(plateau, ramp, phase, floor)
     assert abs(1.0 + floor - summary.lit_level[0, 0]) <= 0.01 * 0.8
     np.testing.assert_allclose([interval.entry[0, 0], interval.exit[0, 0]], [entry, exit_], atol=0.1)
+
+
+def full_pass(frames, summary, threshold):
+    """The interval pass over every frame for every pixel (the reference)."""
+    tracker = IntervalTracker(summary.minimum_frame, threshold, half_window=summary.half_window,
+                              n_frames=summary.n_frames)
+    tracker.update(frames)
+    return tracker.result()
+
+
+_INTERVAL_FIELDS = ("entry", "exit", "entry_slope", "exit_slope", "invalid", "entry_open", "exit_open",
+                    "threshold", "beyond_count", "beyond_sum", "beyond_square")
+
+
+@settings(max_examples=40, deadline=None)
+@given(n=st.integers(3, 60), half_window=st.integers(1, 5), seed=st.integers(0, 2**16),
+       nan_rate=st.sampled_from([0.0, 0.0, 0.02]))
+def test_window_and_second_pass_equal_the_full_pass_bit_for_bit(n, half_window, seed, nan_rate):
+    # dips of every width from none to wider than the window, anywhere (also cut by the sweep's
+    # ends), with noise and the odd non-finite sample
+    rng = np.random.default_rng(seed)
+    shape = (6, 9)
+    t = np.arange(n)[:, None, None]
+    centre = rng.uniform(-3, n + 3, shape)
+    width = rng.choice([0.0, 0.5, 1.5, 3.0, 8.0, 30.0], shape)
+    depth = rng.uniform(0, 1, shape)
+    frames = 1.0 - depth * (np.abs(t - centre) < width / 2) + rng.normal(0, 0.05, (n,) + shape)
+    frames = frames.astype(np.float32)
+    frames[rng.random(frames.shape) < nan_rate] = np.nan
+    tracker = DipTracker(shape, half_window=half_window)
+    tracker.update(frames)
+    summary = tracker.result()
+    reference = full_pass(frames, summary, half_depth(summary))
+    interval = track_intervals(iter([frames]), summary)
+    for name in _INTERVAL_FIELDS:
+        np.testing.assert_array_equal(getattr(interval, name), getattr(reference, name), err_msg=name)
+
+
+def test_dips_inside_the_window_need_no_second_pass():
+    # a 2-frame dip under a 4-frame half window, noise free, away from the sweep's ends: every
+    # crossing lies in the stored window, so the frames are not read again
+    n, shape = 80, (5, 7)
+    centre = 20 + np.arange(35).reshape(shape)
+    frames = np.ones((n,) + shape, np.float32)
+    for offset in (0, 1):
+        np.put_along_axis(frames, (centre + offset)[None], 0.2, axis=0)
+    tracker = DipTracker(shape, half_window=4)
+    tracker.update(frames)
+    summary = tracker.result()
+    partial, resolved = window_intervals(summary, half_depth(summary))
+    assert resolved.all()
+
+    def unread():
+        raise AssertionError("the frames were read again")
+        yield
+
+    interval = track_intervals(unread(), summary)
+    reference = full_pass(frames, summary, half_depth(summary))
+    for name in _INTERVAL_FIELDS:
+        np.testing.assert_array_equal(getattr(interval, name), getattr(reference, name), err_msg=name)
+    # smoothed [1, 2, 1] / 4 of a 2-frame dip of depth 0.8: 1, 0.8, 0.4, 0.4, 0.8, 1 around it;
+    # lit level 1, smoothed minimum 0.4: half depth 0.7 is crossed a quarter of the way from
+    # the 0.8 frame to the 0.4 frame (float32 threshold)
+    np.testing.assert_allclose(interval.entry, centre - 0.75, atol=1e-6)
+    np.testing.assert_allclose(interval.exit, centre + 1.75, atol=1e-6)
+
+
+def test_a_dip_wider_than_the_window_is_left_to_the_second_pass():
+    n = 120
+    signal, entry, exit_ = trapezoid(n, entry=40.0, plateau=30, ramp=4)
+    frames = signal.astype(np.float32)[:, None, None]
+    tracker = DipTracker((1, 1), half_window=4)
+    tracker.update(frames)
+    summary = tracker.result()
+    _, resolved = window_intervals(summary, half_depth(summary))
+    assert not resolved.any()
+    with pytest.raises(ValueError, match="threshold must have the summary's shape"):
+        window_intervals(summary, np.zeros((2, 2)))

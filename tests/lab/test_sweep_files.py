@@ -7,7 +7,10 @@ import pytest
 
 from shadowcam.lab.accuracy import shadow_time_errors
 from shadowcam.evaluate.speed_benchmark import WireScene, write_sweep_dngs
-from shadowcam.lab.dip_tracker import DipSummary
+from shadowcam.io.mosaic_reader import MosaicReader
+from shadowcam.lab.dip_tracker import DipSummary, half_depth, track_intervals, window_intervals, without_interval
+from shadowcam.lab.mosaic_signal import mosaic_signal
+from shadowcam.lab.shadow_time import summary_shadow_times
 from shadowcam.lab.sweep_files import chunk_bounds, sweep_shadow_times_from_files, track_files
 
 # the library's WireScene, not the wire_sweep fixture: write_sweep_dngs renders its DNG files from it
@@ -54,3 +57,31 @@ def test_rendered_frames_are_darkest_at_the_true_time():
     darkest = frames.argmin(axis=0)
     inside = np.isfinite(truth) & (truth > 2) & (truth < SCENE.n_frames - 3)
     assert np.abs(darkest - truth)[inside].max() <= 1.0
+
+
+def test_a_shadow_wider_than_the_window_is_timed_from_a_second_read_of_the_files(tmp_path):
+    # a 14-frame-wide shadow (the tracker's window is 9 frames): the crossings lie beyond the
+    # window, so the files are read again for the interval, as the workflow's step measures it
+    scene = WireScene(height=24, width_px=40, n_frames=60, px_per_frame=1.5, width=14.0, t0=4.0, seed=5)
+    paths = write_sweep_dngs(scene, tmp_path, workers=1)
+    result = sweep_shadow_times_from_files(paths, workers=2, block_frames=7)
+
+    summary = track_files(paths, workers=1)
+    reader = MosaicReader(paths[0])
+    planes = []
+    for path in paths:
+        mosaic, levels = reader.read(path)
+        planes.append(mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
+                                    white=levels["white_sites"])[0])
+    _, resolved = window_intervals(summary, half_depth(summary))
+    assert resolved.mean() < 0.5
+    summary, interval = without_interval(summary, track_intervals([np.stack(planes)], summary))
+    reference = summary_shadow_times(summary, interval=interval, cfa_pattern=levels["cfa_pattern"])
+    for name in ("shadow_time", "time_std", "reason", "entry_time", "exit_time"):
+        np.testing.assert_array_equal(result[name], reference[name], err_msg=name)
+    truth = scene.truth()
+    inside = (truth > 7 + 2) & (truth < scene.n_frames - 1 - 7 - 2)  # the whole dip in the sweep
+    errors = shadow_time_errors(result["shadow_time"], truth, lit=inside)
+    # the interval's centre: half-depth crossings of hard edges under 14-bit noise
+    assert errors["coverage"] > 0.95
+    assert errors["p95"] < 0.3
