@@ -3,7 +3,7 @@ import pytest
 
 from shadowcam.lightfield import accuracy, hdr, rays, screen
 from shadowcam.lightfield.render import irradiance_on_plane, splat_polygons
-from shadowcam.synthetic.lightfield.capture import LightFieldCapture, sweep_frames
+from shadowcam.synthetic.lightfield.capture import FOOTPRINT_VARIANCE_PX2, LightFieldCapture, sweep_frames
 
 
 def test_splat_polygons_gives_exact_area_shares():
@@ -33,15 +33,21 @@ def captured_rays():
         xy, area = screen.screen_coordinates(capture.homography(s), capture.shape)
         maps.append(rays.screen_mask_map(found["x"], found["y"], xy=xy, area=area,
                                          position_mm=capture.positions_mm[s]))
-    return capture, maps, rays.rays_dataset(maps[0], maps[1])
+    # as the workflow builds them: anchored on the far screen, through each pixel's mask point,
+    # from its flux centroid under the renderer's pixel footprint
+    return capture, maps, rays.rays_dataset(maps[0], maps[1], anchor="far", mask_position_mm=capture.source.z_mask,
+                                            footprint_variance=FOOTPRINT_VARIANCE_PX2)
 
 
+# between the screens and 50 % beyond the far one, at the camera's own pitch and twice it:
+# measured 0.46 / 0.37 (1 x) and 0.15 / 0.28 (2 x) on this noisy capture (docs/benchmarks.md)
+@pytest.mark.parametrize("factor", [1, 2])
 @pytest.mark.parametrize("target_mm, screen", [(350.0, 0), (675.0, 1)])
-def test_rendered_screen_beats_the_naive_baseline_by_half(captured_rays, target_mm, screen):
+def test_rendered_screen_beats_the_naive_baseline_by_half(captured_rays, target_mm, screen, factor):
     capture, maps, ray_set = captured_rays
     near_pitch = capture.homography(0)[0, 1]
-    pitch = 2 * near_pitch * target_mm / capture.positions_mm[0]
-    shape = (capture.shape[0] // 2,) * 2
+    pitch = factor * near_pitch * target_mm / capture.positions_mm[0]
+    shape = (capture.shape[0] // factor,) * 2
     truth = capture.source.irradiance(centre=(0, 0, target_mm), shape=shape, pixel_size=pitch)
     rendered = irradiance_on_plane(ray_set, centre=(0, 0, target_mm), shape=shape, pixel_size=pitch).values
     baseline = accuracy.naive_baseline(maps[screen]["irradiance"], maps[screen]["xy"],
@@ -85,5 +91,5 @@ def test_far_field_of_the_capture_at_its_resolution(captured_rays):
     estimate = far_field_grid(ray_set["direction"].values, ray_set["flux"].values, resolution_deg=resolution)
     truth = capture.source.far_field_grid(resolution_deg=resolution, size=estimate.shape[0]).values
     assert np.isclose(np.nansum(estimate.values), truth.sum(), rtol=0.005)  # the rays' flux
-    # regression bound of the measured median error (docs/benchmarks.md; the 5 % target is not met)
-    assert accuracy.far_field_error(estimate.values, truth) < 0.10
+    # the 5 % target at the capture's own resolution: measured 1.25 % (docs/benchmarks.md)
+    assert accuracy.far_field_error(estimate.values, truth) <= 0.05
