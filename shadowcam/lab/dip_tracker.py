@@ -40,7 +40,6 @@ half_depth : the default crossing level.
 without_interval : the summary's lit statistics without the whole dip, and the crossings at its half depth.
 window_intervals : the interval of the pixels whose crossings lie in their stored window.
 track_intervals : the interval of every pixel: from the window, else a pass over the sweep's frames.
-raw_floor : each dip's floor from the raw samples of its window.
 """
 
 from dataclasses import dataclass, fields
@@ -628,22 +627,6 @@ class IntervalTracker:
 def half_depth(summary):
     """Threshold halfway between each pixel's lit level and its smoothed minimum, ``(H, W)``."""
     return 0.5 * (summary.lit_level + summary.minimum_value.astype(np.float64))
-
-
-def raw_floor(summary):
-    """Each dip's floor from the raw samples of its window, ``(H, W)`` float64.
-
-    The tracker's [1, 2, 1] smoothing lifts a floor shorter than its kernel: the
-    smoothed minimum lies above the umbra. The floor is the mean of the window's
-    raw samples at or below the smoothed minimum (a weighted mean of three raw
-    samples, so at least one of them is; on a plateau, its lower samples).
-    NaN where the pixel has no dip.
-    """
-    window = summary.window.astype(np.float64)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        low = window <= summary.minimum_value.astype(np.float64)[None]
-        floor = np.where(low, window, 0.0).sum(axis=0) / low.sum(axis=0)
-    return np.where(low.any(axis=0), floor, np.nan)
 
 
 def merge_intervals(partials, *, n_frames, threshold):

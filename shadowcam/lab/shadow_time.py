@@ -34,7 +34,7 @@ from scipy.special import ndtri
 from shadowcam._shared.progress import Progress
 from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
 from shadowcam._shared.validation import check_in_interval, check_positive
-from shadowcam.lab.dip_tracker import DipTracker, raw_floor
+from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
 
 log = logging.getLogger(__name__)
@@ -576,12 +576,6 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     with np.errstate(invalid="ignore", divide="ignore"):
         entry_std = sigma / interval.entry_slope
         exit_std = sigma / interval.exit_slope
-        # the reported crossings are at half the depth down to the raw floor (the smoothed
-        # minimum of an umbra shorter than the kernel lies above it), each moved along its
-        # slope (the smoothed signal of a straight penumbra is the penumbra)
-        shift = 0.5 * (raw_floor(summary) - summary.minimum_value)
-        interval_entry = np.where(np.isfinite(shift), interval.entry - shift / interval.entry_slope, interval.entry)
-        interval_exit = np.where(np.isfinite(shift), interval.exit + shift / interval.exit_slope, interval.exit)
     # the half-depth interval reaches the window's first or last frame: the window truncates
     # the dip (window methods are biased toward its centre), the interval does not. A dip
     # flagged wide whose interval fits the window is dark at the window's edge for another
@@ -607,10 +601,10 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     reason[broken] = INVALID_INPUT  # a non-finite sample inside, or next to a crossing
     reason[timed] = OK
     time = np.where(timed, centre, time)
-    entry = np.where(timed, interval_entry, entry)
-    exit_ = np.where(timed, interval_exit, exit_)
+    entry = np.where(timed, interval.entry, entry)
+    exit_ = np.where(timed, interval.exit, exit_)
     std = np.where(timed, 0.5 * np.hypot(entry_std, exit_std), std)
-    extra = {"interval_entry": interval_entry, "interval_exit": interval_exit,
+    extra = {"interval_entry": interval.entry, "interval_exit": interval.exit,
              "interval_entry_std": entry_std, "interval_exit_std": exit_std}
     return reason, time, entry, exit_, std, extra
 

@@ -294,27 +294,3 @@ def test_a_dip_wider_than_the_window_is_left_to_the_second_pass():
     assert not resolved.any()
     with pytest.raises(ValueError, match="threshold must have the summary's shape"):
         window_intervals(summary, np.zeros((2, 2)))
-
-
-@settings(max_examples=40, deadline=None)
-@given(plateau=st.integers(0, 60), ramp=st.integers(2, 8), phase=st.floats(0, 1), floor=st.floats(0, 1))
-def test_raw_floor_is_the_umbra_however_short(plateau, ramp, phase, floor):
-    from shadowcam.lab.dip_tracker import raw_floor
-
-    n = plateau + 2 * ramp + 60
-    signal, _, _ = trapezoid(n, entry=30 + ramp / 2 + phase, plateau=plateau, ramp=ramp, depth=0.8, floor=floor)
-    umbra = floor + 1.0 - 0.8
-    frames = signal.astype(np.float32)[:, None, None]
-    tracker = DipTracker((1, 1), half_window=4)
-    tracker.update(frames)
-    summary = tracker.result()
-    on_umbra = np.isclose(signal, umbra, atol=1e-9).any()
-    if on_umbra:
-        # a frame of the sweep lies on the umbra: the floor is it, to float32 rounding
-        np.testing.assert_allclose(raw_floor(summary)[0, 0], umbra, atol=1e-6)
-    # never above the smoothed minimum, never below the lowest raw sample
-    assert raw_floor(summary)[0, 0] <= summary.minimum_value[0, 0] + 1e-7
-    assert raw_floor(summary)[0, 0] >= signal.astype(np.float32).min() - 1e-7
-    if plateau == 0 and on_umbra:
-        # an umbra shorter than the kernel: the smoothed minimum lies above it
-        assert summary.minimum_value[0, 0] > umbra + 0.8 / ramp / 8
