@@ -13,6 +13,7 @@ Offers
 ------
 SHADOW_TIME_METHODS : name -> timing function ``f(summary) -> (time, entry, exit, time_std)``.
 REASONS : flag code -> meaning, for pixels without a reliable time.
+TIMED : the codes of the pixels with a time.
 classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 footprint_spread_std : time uncertainty of a footprint that sees two surfaces' shadow times.
@@ -49,8 +50,13 @@ REASONS = {
     5: "invalid_input",
     6: "wide_dip",
     7: "dip_at_sweep_end",
+    8: "dip_at_sweep_end_timed",
 }
-OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP, DIP_AT_SWEEP_END = range(8)
+(OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP, DIP_AT_SWEEP_END,
+ DIP_AT_SWEEP_END_TIMED) = range(9)
+#: codes of the pixels with a time: a reliable one, and one from a dip's one edge and its
+#: neighbours' shadow width (its uncertainty in ``time_std``)
+TIMED = (OK, DIP_AT_SWEEP_END_TIMED)
 
 #: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
 _SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
@@ -512,7 +518,7 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
     outside = ~((time >= 0) & (time <= last))
     reason = reason.copy()
     reason[(reason == OK) & outside] = NEVER_SHADOWED
-    good = reason == OK
+    good = np.isin(reason, TIMED)
     std = np.where(good, std, np.nan)
     confidence = np.where(good, np.exp(-0.5 * (std / 0.25) ** 2), 0.0)
     nan = np.float32(np.nan)
@@ -576,6 +582,7 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     with np.errstate(invalid="ignore", divide="ignore"):
         entry_std = sigma / interval.entry_slope
         exit_std = sigma / interval.exit_slope
+    interval_entry, interval_exit = interval.entry, interval.exit
     # the half-depth interval reaches the window's first or last frame: the window truncates
     # the dip (window methods are biased toward its centre), the interval does not. A dip
     # flagged wide whose interval fits the window is dark at the window's edge for another
@@ -601,12 +608,61 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     reason[broken] = INVALID_INPUT  # a non-finite sample inside, or next to a crossing
     reason[timed] = OK
     time = np.where(timed, centre, time)
-    entry = np.where(timed, interval.entry, entry)
-    exit_ = np.where(timed, interval.exit, exit_)
+    entry = np.where(timed, interval_entry, entry)
+    exit_ = np.where(timed, interval_exit, exit_)
     std = np.where(timed, 0.5 * np.hypot(entry_std, exit_std), std)
-    extra = {"interval_entry": interval.entry, "interval_exit": interval.exit,
+    # a dip cut by the sweep's start or end, timed from its one crossing and the shadow's
+    # half-depth width: the wire's width over its step (the same for every point a planar
+    # sweep shadows), measured as the uncut neighbours' mean width, their spread the width's
+    # uncertainty
+    uncut = (reason == OK) & ~opened & np.isfinite(interval_entry) & np.isfinite(interval_exit)
+    width, width_std = _local_width(interval_exit - interval_entry, uncut)
+    with np.errstate(invalid="ignore"):
+        cut_centre = np.where(interval.exit_open, interval_entry + 0.5 * width, interval_exit - 0.5 * width)
+        cut = (at_end & (interval.entry_open != interval.exit_open) & (interval.invalid == 0)
+               & np.isfinite(cut_centre) & (cut_centre >= 0) & (cut_centre <= summary.n_frames - 1))
+    edge_std = np.where(interval.exit_open, entry_std, exit_std)
+    reason[cut] = DIP_AT_SWEEP_END_TIMED
+    time = np.where(cut, cut_centre, time)
+    interval_entry = np.where(cut & interval.entry_open, interval_exit - width, interval_entry)
+    interval_exit = np.where(cut & interval.exit_open, interval_entry + width, interval_exit)
+    entry_std = np.where(cut & interval.entry_open, np.hypot(edge_std, width_std), entry_std)
+    exit_std = np.where(cut & interval.exit_open, np.hypot(edge_std, width_std), exit_std)
+    entry = np.where(cut, interval_entry, entry)
+    exit_ = np.where(cut, interval_exit, exit_)
+    std = np.where(cut, np.hypot(edge_std, 0.5 * width_std), std)
+    extra = {"interval_entry": interval_entry, "interval_exit": interval_exit,
              "interval_entry_std": entry_std, "interval_exit_std": exit_std}
     return reason, time, entry, exit_, std, extra
+
+
+def _local_width(width, known, *, min_count=8):
+    """Mean and standard deviation of `width` over the nearest `known` pixels, ``(H, W)`` each.
+
+    Over the smallest square of side ``2 r + 1`` (``r`` = 1, 2, 4, ...) holding at
+    least `min_count` known pixels; NaN where the whole image holds fewer.
+    """
+    from scipy import ndimage
+
+    values = np.where(known, width, 0.0)
+    mean, spread = np.full(width.shape, np.nan), np.full(width.shape, np.nan)
+    left = np.ones(width.shape, bool)
+    radius = 1
+    while left.any():
+        size = 2 * radius + 1
+        count = np.rint(ndimage.uniform_filter(known.astype(np.float64), size, mode="constant") * size**2)
+        total = ndimage.uniform_filter(values, size, mode="constant") * size**2
+        square = ndimage.uniform_filter(values**2, size, mode="constant") * size**2
+        here = left & (count >= min_count)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m = total / count
+            v = np.maximum(square / count - m**2, 0.0) * count / np.maximum(count - 1, 1)
+        mean[here], spread[here] = m[here], np.sqrt(v[here])
+        left &= ~here
+        if size >= 2 * max(width.shape):
+            break
+        radius *= 2
+    return mean, spread
 
 
 def _masked_summary(summary, keep):
@@ -846,9 +902,9 @@ def check_timed(shadow_time, *, min_coverage=MIN_COVERAGE):
     """
     for sweep in shadow_time["sweep"].values:
         codes = np.bincount(shadow_time["reason"].sel(sweep=sweep).values.ravel(), minlength=len(REASONS))
-        counts = {REASONS[code]: int(codes[code]) for code in REASONS if code != OK}
+        counts = {REASONS[code]: int(codes[code]) for code in REASONS if code not in TIMED}
         worst = max(counts, key=counts.get)
-        check_coverage(codes[OK], codes.sum(), what=f"camera pixels timed in sweep {sweep}", reasons=counts,
+        check_coverage(int(codes[list(TIMED)].sum()), codes.sum(), what=f"camera pixels timed in sweep {sweep}", reasons=counts,
                        hint=_EMPTY_HINTS[worst], min_coverage=min_coverage)
 
 

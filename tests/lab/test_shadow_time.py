@@ -336,3 +336,48 @@ def test_a_footprint_on_two_surfaces_says_its_time_is_uncertain(wire_sweep):
     assert (std[inner, 20] >= 0.5 * err).all()
     assert (std[inner, 4:17] < 0.25).all()  # one surface, the same shape of dip as its neighbours
 
+
+
+@pytest.mark.parametrize("side", ["end", "start"])
+@pytest.mark.parametrize("noise", [0.0, 0.01])
+def test_a_dip_cut_by_the_sweep_is_timed_from_its_edge_and_the_neighbours_width(wire_sweep, side, noise):
+    # a 12-frame shadow with 3-frame penumbrae sweeping a plane: the pixels it passes last
+    # are still in it at the sweep's last frame; their one crossing and the width of the
+    # uncut pixels' dips give the time
+    from shadowcam.lab.shadow_time import DIP_AT_SWEEP_END_TIMED, OK, REASONS, TIMED
+
+    n, width = 60, 12.0
+    frames, gt = wire_sweep(n_frames=n, shape=(16, 40), width=width, ramp=3.0, px_per_frame=1.0,
+                            t0=20.0, tilt=0.25, level=1.0, noise=noise, seed=5)
+    if side == "start":  # the same sweep run backwards: the dip cut by the first frame
+        frames, gt = frames[::-1].copy(), n - 1 - gt
+    after = _interval_times(frames, method="edge_fit")
+    # the half-depth crossing on the cut side lies beyond the sweep, the centre inside it
+    beyond = (gt + width / 2 > n - 0.5) if side == "end" else (gt - width / 2 < -0.5)
+    cut = np.isfinite(gt) & beyond & (gt > 1.5) & (gt < n - 2.5)
+    assert cut.sum() >= 20
+    reason = after["reason"]
+    assert np.mean(reason[cut] == DIP_AT_SWEEP_END_TIMED) >= 0.95
+    timed = cut & (reason == DIP_AT_SWEEP_END_TIMED)
+    error = np.abs(after["shadow_time"] - gt)[timed]
+    # noise free: the half-depth width is the same for every pixel (12 frames) and the
+    # crossing exact to the pixel's sub-sampling
+    assert np.percentile(error, 95) <= (0.1 if noise == 0 else 0.2)
+    # never a confident wrong time: the stated uncertainty covers the error
+    assert np.all(error <= 3 * after["time_std"][timed] + 0.02)
+    # the cut side's crossing is the other one plus or minus the width
+    span = after["interval_exit"] - after["interval_entry"]
+    np.testing.assert_allclose(span[timed], width, atol=0.3)
+    # the uncut pixels keep their reliable time
+    assert np.mean(reason[np.isfinite(gt) & ~cut & (np.abs(gt - n / 2) < 10)] == OK) >= 0.98
+    assert REASONS[DIP_AT_SWEEP_END_TIMED] == "dip_at_sweep_end_timed" and DIP_AT_SWEEP_END_TIMED in TIMED
+
+
+def test_a_cut_dip_without_uncut_neighbours_stays_untimed(wire_sweep):
+    from shadowcam.lab.shadow_time import DIP_AT_SWEEP_END
+
+    # every pixel's dip reaches the sweep's end: no width to borrow
+    frames, _ = wire_sweep(n_frames=40, shape=(8, 8), centres=36.0, width=12.0, ramp=3.0, level=1.0)
+    after = _interval_times(frames, method="edge_fit")
+    assert np.all(after["reason"] == DIP_AT_SWEEP_END)
+    assert np.all(np.isnan(after["shadow_time"]))
