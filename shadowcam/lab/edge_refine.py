@@ -55,8 +55,8 @@ def shifted(array, dr, dc, fill):
 def _solve(work, n, m):
     """Solve, in place, the leading ``n x n`` block of `work` for its ``m`` right-hand columns.
 
-    `work` is ``(N, N + m)``: the matrix in its first ``n`` columns, the
-    right-hand sides in columns ``N .. N + m - 1`` (Gauss-Jordan, partial
+    `work` is ``(N, N + m)`` with ``N >= n``: the matrix in its first ``n``
+    columns, the right-hand sides in columns ``N .. N + m - 1`` (Gauss-Jordan, partial
     pivoting). Each right-hand column sees the same operations as if it were
     solved alone. On return ``work[i, N + k] / work[i, i]`` is solution ``k``'s
     ``i``-th unknown. Returns False when a pivot is negligible against the
@@ -125,7 +125,8 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
 
     A pixel's usable neighbours (finite time, positive inverse variance) are
     gathered once; each pass then only evaluates the range kernel and adds
-    to the normal equations, and the solves work in preallocated buffers. Rows run in parallel (``prange``).
+    to the normal equations (the plane's in scalars), and the solves work in
+    preallocated buffers. Rows run in parallel (``prange``).
 
     Returns, each ``(H, W)`` float64, NaN where the pixel has no time or no
     plane: the plane's value ``a`` at the pixel and its variance under the

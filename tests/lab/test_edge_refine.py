@@ -126,7 +126,8 @@ def _reference_fit(times, inv_var, row, col, *, radius=3, range_sigma=0.5, itera
     for dr in range(-radius, radius + 1):
         for dc in range(-radius, radius + 1):
             rr, cc = row + dr, col + dc
-            if (dr or dc) and 0 <= rr < h and 0 <= cc < w and np.isfinite(times[rr, cc]) and inv_var[rr, cc] > 0:
+            inside = (dr or dc) and 0 <= rr < h and 0 <= cc < w
+            if inside and np.isfinite(times[rr, cc]) and inv_var[rr, cc] > 0:
                 design.append([1.0, dr, dc, dr * dr, dr * dc, dc * dc])
                 offsets.append(times[rr, cc] - own)
                 weights.append(inv_var[rr, cc])
