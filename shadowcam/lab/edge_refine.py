@@ -51,53 +51,69 @@ def shifted(array, dr, dc, fill):
     return out
 
 
-@nb.njit(cache=True)
-def _solve(normal, rhs, n):
-    """Solve the leading ``n x n`` block of `normal` for `rhs` (Gauss-Jordan, partial pivoting).
+@nb.njit(cache=True, nogil=True)
+def _solve(work, n, m):
+    """Solve, in place, the leading ``n x n`` block of `work` for its ``m`` right-hand columns.
 
-    Returns ``(x, ok)``; ``ok`` is False when a pivot is negligible against the
+    `work` is ``(N, N + m)`` with ``N >= n``: the matrix in its first ``n``
+    columns, the right-hand sides in columns ``N .. N + m - 1`` (Gauss-Jordan, partial
+    pivoting). Each right-hand column sees the same operations as if it were
+    solved alone. On return ``work[i, N + k] / work[i, i]`` is solution ``k``'s
+    ``i``-th unknown. Returns False when a pivot is negligible against the
     matrix's scale (too few or collinear neighbours).
     """
-    a = np.empty((n, n + 1))
-    for i in range(n):
-        for j in range(n):
-            a[i, j] = normal[i, j]
-        a[i, n] = rhs[i]
+    first = work.shape[0]
     scale = 0.0
     for i in range(n):
-        scale = max(scale, abs(a[i, i]))
+        scale = max(scale, abs(work[i, i]))
     for col in range(n):
         pivot = col
         for i in range(col + 1, n):
-            if abs(a[i, col]) > abs(a[pivot, col]):
+            if abs(work[i, col]) > abs(work[pivot, col]):
                 pivot = i
-        if not abs(a[pivot, col]) > 1e-9 * scale:
-            return np.zeros(n), False
-        for j in range(n + 1):
-            a[col, j], a[pivot, j] = a[pivot, j], a[col, j]
+        if not abs(work[pivot, col]) > 1e-9 * scale:
+            return False
+        if pivot != col:
+            for j in range(n):
+                work[col, j], work[pivot, j] = work[pivot, j], work[col, j]
+            for k in range(m):
+                work[col, first + k], work[pivot, first + k] = work[pivot, first + k], work[col, first + k]
         for i in range(n):
             if i != col:
-                f = a[i, col] / a[col, col]
-                for j in range(col, n + 1):
-                    a[i, j] -= f * a[col, j]
-    x = np.empty(n)
+                f = work[i, col] / work[col, col]
+                for j in range(col, n):
+                    work[i, j] -= f * work[col, j]
+                for k in range(m):
+                    work[i, first + k] -= f * work[col, first + k]
+    return True
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _load(normal, rhs, n, work):
+    """`work` = ``[normal | rhs | e0]`` over the leading ``n x n`` block (see :func:`_solve`)."""
+    first = work.shape[0]
     for i in range(n):
-        x[i] = a[i, n] / a[i, i]
-    return x, True
+        for j in range(n):
+            work[i, j] = normal[i, j]
+        work[i, first] = rhs[i]
+        work[i, first + 1] = 1.0 if i == 0 else 0.0
 
 
-@nb.njit(cache=True)
-def _basis(dr, dc, out):
-    """Quadratic basis ``1, dr, dc, dr^2, dr dc, dc^2`` (the plane is its first three)."""
-    out[0] = 1.0
-    out[1] = dr
-    out[2] = dc
-    out[3] = dr * dr
-    out[4] = dr * dc
-    out[5] = dc * dc
+@nb.njit(cache=True, nogil=True, inline="always")
+def _accumulate(normal, rhs, n_fit, wgt, basis, t_n):
+    """Add one neighbour of weight `wgt` to the leading ``n_fit`` normal equations.
+
+    Entries are ``(wgt * basis_i) * basis_j`` and ``(wgt * basis_i) * t_n``
+    for the basis ``1, dr, dc, dr^2, dr dc, dc^2`` (the plane is its first three).
+    """
+    for i in range(n_fit):
+        wb = wgt * basis[i]
+        rhs[i] += wb * t_n
+        for j in range(n_fit):
+            normal[i, j] += wb * basis[j]
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True, nogil=True, parallel=True)
 def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
     """Per pixel: the neighbours' IRLS plane and its variances (see :func:`refine_times`).
 
@@ -106,6 +122,11 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
     and a Gaussian range kernel on their residual from the previous plane
     (first pass: the flat plane through the pixel's own time). With the last
     pass's weights, a local quadratic is fitted too.
+
+    A pixel's usable neighbours (finite time, positive inverse variance) are
+    gathered once; each pass then only evaluates the range kernel and adds
+    to the normal equations (the plane's in scalars), and the solves work in
+    preallocated buffers. Rows run in parallel (``prange``).
 
     Returns, each ``(H, W)`` float64, NaN where the pixel has no time or no
     plane: the plane's value ``a`` at the pixel and its variance under the
@@ -121,83 +142,132 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
     phi_out = np.full((h, w), np.nan)
     quad_out = np.full((h, w), np.nan)
     quad_var_out = np.full((h, w), np.nan)
+    size = (2 * radius + 1) ** 2
     for row in nb.prange(h):
-        basis = np.empty(6)
         normal = np.empty((6, 6))
         rhs = np.empty(6)
+        basis = np.empty(6)
+        work = np.empty((6, 8))
+        n_dr = np.empty(size)
+        n_dc = np.empty(size)
+        n_t = np.empty(size)
+        n_iv = np.empty(size)
+        r_lo = max(row - radius, 0) - row
+        r_hi = min(row + radius, h - 1) - row
         for col in range(w):
             own = t64[row, col]
             if not np.isfinite(own):
                 continue
-            coef = np.zeros(3)  # plane relative to the pixel's own time
+            count = 0
+            for dr in range(r_lo, r_hi + 1):
+                rr = row + dr
+                for dc in range(max(col - radius, 0) - col, min(col + radius, w - 1) - col + 1):
+                    if dr == 0 and dc == 0:
+                        continue
+                    cc = col + dc
+                    t_n = t64[rr, cc] - own
+                    iv = inv_var[rr, cc]
+                    if not np.isfinite(t_n) or not iv > 0:
+                        continue
+                    n_dr[count] = dr
+                    n_dc[count] = dc
+                    n_t[count] = t_n
+                    n_iv[count] = iv
+                    count += 1
+            c0 = c1 = c2 = 0.0  # plane relative to the pixel's own time
+            a3_0 = 0.0
             ok = False
             s_w = s_k = s_tt = 0.0
             for it in range(iterations + 1):
-                normal[:] = 0.0
-                rhs[:] = 0.0
+                last = it == iterations  # the quadratic only with the last weights
                 s_w = s_k = s_tt = 0.0
-                n_fit = 6 if it == iterations else 3  # the quadratic only with the last weights
-                for dr in range(-radius, radius + 1):
-                    rr = row + dr
-                    for dc in range(-radius, radius + 1):
-                        cc = col + dc
-                        if (dr == 0 and dc == 0) or rr < 0 or rr >= h or cc < 0 or cc >= w:
-                            continue
-                        t_n = t64[rr, cc] - own
-                        if not np.isfinite(t_n) or not inv_var[rr, cc] > 0:
-                            continue
-                        residual = (t_n - coef[0] - coef[1] * dr - coef[2] * dc) / range_sigma
-                        kernel = np.exp(-0.5 * residual**2)
-                        wgt = inv_var[rr, cc] * kernel
-                        if not wgt > 0 or not np.isfinite(wgt):
-                            continue
-                        _basis(dr, dc, basis)
-                        for i in range(n_fit):
-                            rhs[i] += wgt * basis[i] * t_n
-                            for j in range(n_fit):
-                                normal[i, j] += wgt * basis[i] * basis[j]
-                        s_w += wgt
+                n01 = n02 = n11 = n12 = n21 = n22 = r0 = r1 = r2 = 0.0
+                if last:
+                    normal[:] = 0.0
+                    rhs[:] = 0.0
+                for k in range(count):
+                    dr = n_dr[k]
+                    dc = n_dc[k]
+                    t_n = n_t[k]
+                    residual = (t_n - c0 - c1 * dr - c2 * dc) / range_sigma
+                    kernel = np.exp(-0.5 * residual**2)
+                    wgt = n_iv[k] * kernel
+                    if not wgt > 0 or not np.isfinite(wgt):
+                        continue
+                    s_w += wgt
+                    if last:
+                        basis[0] = 1.0
+                        basis[1] = dr
+                        basis[2] = dc
+                        basis[3] = dr * dr
+                        basis[4] = dr * dc
+                        basis[5] = dc * dc
+                        _accumulate(normal, rhs, 6, wgt, basis, t_n)
                         s_k += kernel
                         s_tt += wgt * t_n * t_n
+                    else:  # the plane's 3 x 3 system, as _accumulate would add it
+                        w_r = wgt * dr
+                        w_c = wgt * dc
+                        n01 += wgt * dr
+                        n02 += wgt * dc
+                        n11 += w_r * dr
+                        n12 += w_r * dc
+                        n21 += w_c * dr
+                        n22 += w_c * dc
+                        r0 += wgt * t_n
+                        r1 += w_r * t_n
+                        r2 += w_c * t_n
+                if not last:
+                    normal[0, 0] = s_w
+                    normal[0, 1] = normal[1, 0] = n01
+                    normal[0, 2] = normal[2, 0] = n02
+                    normal[1, 1] = n11
+                    normal[1, 2] = n12
+                    normal[2, 1] = n21
+                    normal[2, 2] = n22
+                    rhs[0] = r0
+                    rhs[1] = r1
+                    rhs[2] = r2
                 if s_w == 0.0:
                     ok = False
                     break
-                coef3, ok = _solve(normal, rhs, 3)
+                _load(normal, rhs, 3, work)
+                ok = _solve(work, 3, 2 if last else 1)
                 if not ok:  # too few or collinear neighbours: the weighted mean
-                    coef[0] = rhs[0] / s_w
-                    coef[1] = 0.0
-                    coef[2] = 0.0
-                elif it < iterations:
-                    coef[:] = coef3
+                    c0 = rhs[0] / s_w
+                    c1 = 0.0
+                    c2 = 0.0
+                else:
+                    a3_0 = work[0, 6] / work[0, 0]
+                    if it < iterations:
+                        c0 = a3_0
+                        c1 = work[1, 6] / work[1, 1]
+                        c2 = work[2, 6] / work[2, 2]
             if s_w == 0.0:
                 continue
-            e0 = np.zeros(6)
-            e0[0] = 1.0
             if ok:
-                inverse, _ = _solve(normal, e0, 3)
-                variance = inverse[0]
-                a = coef3[0]
+                variance = work[0, 7] / work[0, 0]
+                a = a3_0
             else:
                 variance = 1.0 / s_w
-                a = coef[0]
+                a = c0
             phi = np.nan
             a_quad = np.nan
             var_quad = np.nan
             df_quad = s_k - 6.0
             if ok and df_quad > 1.0:
-                coef6, ok6 = _solve(normal, rhs, 6)
-                inverse6, _ = _solve(normal, e0, 6)
-                if ok6:
+                _load(normal, rhs, 6, work)
+                if _solve(work, 6, 2):
                     q_quad = s_tt
                     for i in range(6):
-                        q_quad -= coef6[i] * rhs[i]
+                        q_quad -= (work[i, 6] / work[i, i]) * rhs[i]
                     # the range kernel keeps Gaussian residuals of variance s2 as if their
                     # variance were s2 h2 / (s2 + h2) (h = range_sigma): undo that shrinkage
                     shrunk = max(q_quad, 0.0) / df_quad * (s_k / s_w)
                     h2 = range_sigma**2
                     phi = shrunk * h2 / (h2 - shrunk) / (s_k / s_w) if shrunk < h2 else np.inf
-                    a_quad = own + coef6[0]
-                    var_quad = inverse6[0]
+                    a_quad = own + work[0, 6] / work[0, 0]
+                    var_quad = work[0, 7] / work[0, 0]
             plane_out[row, col] = own + a
             var_out[row, col] = variance
             phi_out[row, col] = phi

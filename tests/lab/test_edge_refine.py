@@ -116,3 +116,61 @@ def test_dispersion_is_the_median_of_the_finite_fits():
     assert dispersion(np.array([[0.25, np.inf], [0.5, np.nan]])) == 0.375
     assert dispersion(np.full((2, 2), np.nan)) == 1.0
     assert dispersion(np.array([[np.inf, np.inf], [np.nan, np.nan]])) == 1.0
+
+
+def _reference_fit(times, inv_var, row, col, *, radius=3, range_sigma=0.5, iterations=3):
+    """One pixel's IRLS plane and quadratic by numpy least squares (the kernel's stated model)."""
+    h, w = times.shape
+    own = times[row, col]
+    design, offsets, weights = [], [], []
+    for dr in range(-radius, radius + 1):
+        for dc in range(-radius, radius + 1):
+            rr, cc = row + dr, col + dc
+            inside = (dr or dc) and 0 <= rr < h and 0 <= cc < w
+            if inside and np.isfinite(times[rr, cc]) and inv_var[rr, cc] > 0:
+                design.append([1.0, dr, dc, dr * dr, dr * dc, dc * dc])
+                offsets.append(times[rr, cc] - own)
+                weights.append(inv_var[rr, cc])
+    x, t, iv = np.array(design), np.array(offsets), np.array(weights)
+    coef = np.zeros(3)
+    for _ in range(iterations + 1):
+        kernel = np.exp(-0.5 * ((t - x[:, :3] @ coef) / range_sigma) ** 2)
+        wgt = iv * kernel
+        plane = np.linalg.solve(x[:, :3].T @ (wgt[:, None] * x[:, :3]), x[:, :3].T @ (wgt * t))
+        coef = plane
+    normal3 = x[:, :3].T @ (wgt[:, None] * x[:, :3])
+    normal6 = x.T @ (wgt[:, None] * x)
+    plane_fit = (own + plane[0], np.linalg.inv(normal3)[0, 0])
+    if kernel.sum() - 6.0 <= 1.0:  # too little weight left for the quadratic's dispersion
+        return plane_fit + (np.nan, np.nan, np.nan)
+    quad = np.linalg.solve(normal6, x.T @ (wgt * t))
+    chi2 = np.sum(wgt * (t - x @ quad) ** 2)
+    ratio = kernel.sum() / wgt.sum()
+    shrunk = chi2 / (kernel.sum() - 6.0) * ratio
+    phi = shrunk * range_sigma**2 / (range_sigma**2 - shrunk) / ratio if shrunk < range_sigma**2 else np.inf
+    return plane_fit + (phi, own + quad[0], np.linalg.inv(normal6)[0, 0])
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_kernel_solves_the_stated_normal_equations(seed):
+    # curved noisy map with a 4-frame step, missing pixels and unequal variances: every
+    # pixel's five outputs against numpy least squares on its own neighbours (borders included)
+    from shadowcam.lab.edge_refine import _robust_plane_fit
+
+    rng = np.random.default_rng(seed)
+    rows, cols = np.mgrid[0:14, 0:17].astype(float)
+    times = 2.0 + 0.45 * cols - 0.2 * rows + 0.01 * (cols - 8) ** 2 + rng.normal(0, 0.15, cols.shape)
+    times[:, 9:] += 4.0
+    times[rng.random(times.shape) < 0.08] = np.nan
+    inv_var = np.where(np.isfinite(times), 1.0 / rng.uniform(0.1, 0.3, times.shape) ** 2, 0.0)
+    got = _robust_plane_fit(times, inv_var, 3, 0.5, 3)
+    for row, col in zip(*np.nonzero(np.isfinite(times))):
+        want = _reference_fit(times, inv_var, row, col)
+        for name, value, expected in zip(("plane", "plane_var", "phi", "quad", "quad_var"),
+                                          [g[row, col] for g in got], want):
+            # times to 1e-9 frame; variances and the dispersion relative to their size
+            if not np.isfinite(expected):
+                assert value == expected or np.isnan(value) and np.isnan(expected), (name, row, col, value)
+                continue
+            tol = 1e-9 if name in ("plane", "quad") else 1e-9 * abs(expected)
+            assert abs(value - expected) <= tol, (name, row, col, value, expected)
