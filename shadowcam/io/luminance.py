@@ -64,12 +64,12 @@ def _reflect(i, n):
     return i
 
 
-@nb.njit(cache=True, parallel=True)
+@nb.njit(cache=True)
 def _luminance_kernel(mosaic, scale, channel_of_site, black, span, out):
     """Mean of the normalised bilinear R, G, B of ``mosaic * scale`` (OpenCV's rounding) into `out`."""
     rows, cols = mosaic.shape
     three = np.float32(3.0)
-    for r in nb.prange(rows):
+    for r in range(rows):
         values = np.zeros(3, dtype=np.int64)
         for c in range(cols):
             own = channel_of_site[r & 1, c & 1]
