@@ -64,37 +64,50 @@ def _reflect(i, n):
     return i
 
 
+@nb.njit(cache=True, inline="always")
+def _pixel(mosaic, r, up, down, c, left, right, own, other, scale, black, span):
+    """Normalised channel mean at (r, c): `own` its site's channel, `other` its row neighbours' (G sites)."""
+    centre = np.int32(mosaic[r, c]) * scale
+    if own != 1:  # R or B site: G from the 4 neighbours, the other from the 4 diagonals
+        cross = (np.int32(mosaic[up, c]) + np.int32(mosaic[down, c]) + np.int32(mosaic[r, left])
+                 + np.int32(mosaic[r, right])) * scale
+        diagonal = (np.int32(mosaic[up, left]) + np.int32(mosaic[up, right]) + np.int32(mosaic[down, left])
+                    + np.int32(mosaic[down, right])) * scale
+        v_own, v_green, v_other = centre, (cross + 2) >> 2, (diagonal + 2) >> 2
+        if own == 0:
+            red, green, blue = v_own, v_green, v_other
+        else:
+            red, green, blue = v_other, v_green, v_own
+    else:  # G site: the row neighbours' channel and the column neighbours' channel
+        horizontal = ((np.int32(mosaic[r, left]) + np.int32(mosaic[r, right])) * scale + 1) >> 1
+        vertical = ((np.int32(mosaic[up, c]) + np.int32(mosaic[down, c])) * scale + 1) >> 1
+        green = centre
+        if other == 0:
+            red, blue = horizontal, vertical
+        else:
+            red, blue = vertical, horizontal
+    total = (np.float32(red) - black[0]) / span[0]
+    total += (np.float32(green) - black[1]) / span[1]
+    total += (np.float32(blue) - black[2]) / span[2]
+    return total / np.float32(3.0)
+
+
 @nb.njit(cache=True)
 def _luminance_kernel(mosaic, scale, channel_of_site, black, span, out):
     """Mean of the normalised bilinear R, G, B of ``mosaic * scale`` (OpenCV's rounding) into `out`."""
     rows, cols = mosaic.shape
-    three = np.float32(3.0)
+    scale = np.int32(scale)
     for r in range(rows):
-        values = np.zeros(3, dtype=np.int64)
-        for c in range(cols):
-            own = channel_of_site[r & 1, c & 1]
-            up, down = _reflect(r - 1, rows), _reflect(r + 1, rows)
-            left, right = _reflect(c - 1, cols), _reflect(c + 1, cols)
-            centre = np.int64(mosaic[r, c]) * scale
-            cross = (np.int64(mosaic[up, c]) + np.int64(mosaic[down, c]) + np.int64(mosaic[r, left])
-                     + np.int64(mosaic[r, right])) * scale
-            diagonal = (np.int64(mosaic[up, left]) + np.int64(mosaic[up, right]) + np.int64(mosaic[down, left])
-                        + np.int64(mosaic[down, right])) * scale
-            if own != 1:  # R or B site: G from the 4 neighbours, the other from the 4 diagonals
-                values[own] = centre
-                values[1] = (cross + 2) >> 2
-                values[2 - own] = (diagonal + 2) >> 2
-            else:  # G site: the row neighbours' channel and the column neighbours' channel
-                values[1] = centre
-                row_channel = channel_of_site[r & 1, (c + 1) & 1]
-                horizontal = (np.int64(mosaic[r, left]) + np.int64(mosaic[r, right])) * scale
-                vertical = (np.int64(mosaic[up, c]) + np.int64(mosaic[down, c])) * scale
-                values[row_channel] = (horizontal + 1) >> 1
-                values[2 - row_channel] = (vertical + 1) >> 1
-            total = (np.float32(values[0]) - black[0]) / span[0]
-            total += (np.float32(values[1]) - black[1]) / span[1]
-            total += (np.float32(values[2]) - black[2]) / span[2]
-            out[r, c] = total / three
+        up, down = _reflect(r - 1, rows), _reflect(r + 1, rows)
+        for parity in range(2):  # the columns of one site type: no branch on the site in the loop
+            own = channel_of_site[r & 1, parity]
+            other = channel_of_site[r & 1, 1 - parity]
+            for c in range(1 + (1 - parity), cols - 1, 2):
+                out[r, c] = _pixel(mosaic, r, up, down, c, c - 1, c + 1, own, other, scale, black, span)
+        for c in (0, cols - 1):  # the mirrored border columns
+            own, other = channel_of_site[r & 1, c & 1], channel_of_site[r & 1, (c + 1) & 1]
+            out[r, c] = _pixel(mosaic, r, up, down, c, _reflect(c - 1, cols), _reflect(c + 1, cols), own, other,
+                               scale, black, span)
 
 
 def mosaic_luminance(mosaic, *, cfa_pattern, black_sites, white_sites):
