@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Outdoor first pass against the decode, per added frame, at a camera's size (one process).
 
-    .venv/bin/python scripts/benchmark_outdoor_pass1.py [--size 6000x4000] [--frames 8] [--dir /tmp/...]
+    .venv/bin/python scripts/benchmark_outdoor_pass1.py [--size 6000x4000] [--frames 8] [--dir /tmp/...] [--source results/synthetic_ridge/capture/frames]
 
 Makes ````frames`` 14-bit lossless-JPEG RGGB DNGs of the given size from the rendered
 ``synthetic_ridge`` capture (its first frames' decodes resized, each moved by a known
@@ -39,13 +39,15 @@ def _timed(function, *args, **kwargs):
     return out, cpu1 - cpu, wall1 - wall
 
 
-def _make_dngs(folder, size, count):
+def _make_dngs(folder, size, count, source):
     from shadowcam.io.decode import read_frame
     from shadowcam.io.raw_writer import write_dng
     from shadowcam.outdoor.translation import translate
 
     cols, rows = size
-    source = sorted(Path("/work/main/results/synthetic_ridge/capture/frames").glob("*.dng"))
+    frames = sorted(Path(source).glob("*.dng"))
+    if not frames:
+        raise SystemExit(f"no DNG frames in {source}: run the workflow on synthetic_ridge first, or give --source")
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(1)
     paths = []
@@ -54,7 +56,7 @@ def _make_dngs(folder, size, count):
         paths.append(path)
         if path.exists():
             continue
-        image = cv2.resize(read_frame(source[k % len(source)]), (cols, rows), interpolation=cv2.INTER_CUBIC)
+        image = cv2.resize(read_frame(frames[k % len(frames)]), (cols, rows), interpolation=cv2.INTER_CUBIC)
         shift = rng.uniform(-2, 2, size=2) if k else np.zeros(2)
         image = np.stack([translate(image[..., c], shift, method="opencv_cubic") for c in range(3)], axis=-1)
         mosaic = np.empty((rows, cols), np.float32)
@@ -86,10 +88,12 @@ def main():
     parser.add_argument("--size", default="6000x4000", help="COLSxROWS")
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--dir", type=Path, default=Path("/tmp/shadowcam-bench-pass1"))
+    parser.add_argument("--source", type=Path, default=Path("results/synthetic_ridge/capture/frames"),
+                        help="rendered DNG frames the benchmark's frames are made from")
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     n = args.frames
-    paths = _make_dngs(args.dir / f"dng-{args.size}", size, n)
+    paths = _make_dngs(args.dir / f"dng-{args.size}", size, n, args.source)
     reader = MosaicReader(paths[0])
     decode = []
     for path in paths[1:]:

@@ -23,9 +23,7 @@ mosaic_luminance : the luminance of a mosaic's bilinear demosaic, without the co
 import numba as nb
 import numpy as np
 
-from shadowcam.io.cfa import demosaic_scaled, site_map
-
-_CHANNEL_OF_LETTER = {"R": 0, "G": 1, "B": 2}
+from shadowcam.io.cfa import _CHANNEL_OF_LETTER, site_map
 
 
 def channel_mean(image):
