@@ -11,7 +11,9 @@ lossless-JPEG RAW files) with the per-frame levels ``black_sites`` and
 the lazy ``image`` above, demosaiced on indexing
 (:func:`shadowcam.io.decode.mosaic_image`: the values a float store of the
 same frames holds, bit for bit), reading only the window of the mosaic the
-index needs. Other frames (TIFF, PNG, EXR ...) are stored as the float32
+index needs, and adds the lazy ``luminance (time, row, col)``, the mean of
+those channels computed from the mosaic without the colour image
+(:func:`shadowcam.io.luminance.mosaic_luminance`, equal bit for bit). Other frames (TIFF, PNG, EXR ...) are stored as the float32
 ``image`` itself, compressed with zstd level 1. A reference store holds
 ``image (row, col, channel)`` (the mean of the reference frames). Stores are written to a hidden
 temporary directory beside the store and renamed when complete
@@ -35,6 +37,8 @@ write_reference : decode and average reference frame(s) into a reference store.
 open_frames : open a store lazily (xarray, no dask).
 iter_frame_chunks : yield (start, (T_chunk, H, W, C) float32 block) in time order (optionally a frame range).
 iter_store_frames : yield the (H, W, C) float32 frames one at a time (logging progress).
+iter_store_luminance : yield the frames' (H, W) float32 luminance one at a time (a mosaic store's
+    straight from the mosaic, without the colour image).
 """
 
 import glob
@@ -54,6 +58,7 @@ from zarr.codecs import BloscCodec, ZstdCodec
 from shadowcam._shared.atomic import atomic_directory
 from shadowcam._shared.progress import Progress
 from shadowcam.io.decode import iter_frames, iter_mosaics, mosaic_image
+from shadowcam.io.luminance import channel_mean, mosaic_luminance
 from shadowcam.io.raw_mosaic import is_raw
 
 log = logging.getLogger(__name__)
@@ -412,7 +417,12 @@ def open_frames(path):
     chunks = (mosaic.encoding["chunks"][0],) + image.shape[1:]
     variable = xr.Variable(("time", "row", "col", "channel"), indexing.LazilyIndexedArray(image),
                            attrs=_image_attrs(), encoding={"chunks": chunks})
-    return dataset.drop_vars(["mosaic", "black_sites", "white_sites"]).assign(image=variable)
+    luminance = _MosaicImage(mosaic.variable, dataset["black_sites"].values, dataset["white_sites"].values,
+                             dataset.attrs["cfa_pattern"], luminance=True)
+    luminance = xr.Variable(("time", "row", "col"), indexing.LazilyIndexedArray(luminance),
+                            attrs={"long_name": "luminance (mean of R, G, B)", "units": _image_attrs()["units"]},
+                            encoding={"chunks": chunks[:3]})
+    return dataset.drop_vars(["mosaic", "black_sites", "white_sites"]).assign(image=variable, luminance=luminance)
 
 
 def _local_index(index, origin):
@@ -429,12 +439,15 @@ class _MosaicImage(BackendArray):
     An index reads the mosaic window of the indexed rows and cols, widened by
     :data:`_WINDOW_MARGIN` pixels and started on even rows and cols (the CFA
     phase), demosaics it (:func:`shadowcam.io.decode.mosaic_image`) and crops it:
-    the values of the whole frame's decode, bit for bit.
+    the values of the whole frame's decode, bit for bit. With ``luminance=True``
+    it is ``luminance (time, row, col)``, the mean of those channels computed
+    from the mosaic directly (:func:`shadowcam.io.luminance.mosaic_luminance`, equal bit for bit).
     """
 
-    def __init__(self, mosaic, black_sites, white_sites, cfa_pattern):
+    def __init__(self, mosaic, black_sites, white_sites, cfa_pattern, *, luminance=False):
         self._mosaic, self._black, self._white, self._pattern = mosaic, black_sites, white_sites, cfa_pattern
-        self.shape = tuple(mosaic.shape) + (len(CHANNELS),)
+        self._luminance = luminance
+        self.shape = tuple(mosaic.shape) + (() if luminance else (len(CHANNELS),))
         self.dtype = np.dtype(np.float32)
 
     def __getitem__(self, key):
@@ -442,9 +455,8 @@ class _MosaicImage(BackendArray):
 
     def _getitem(self, key):
         picks = [np.arange(n)[k] for n, k in zip(self.shape, key)]
-        out_shape = tuple(p.shape for p in picks)
-        times, rows, cols, channels = (np.atleast_1d(p) for p in picks)
-        out_shape = sum(out_shape, ())
+        out_shape = sum((p.shape for p in picks), ())
+        times, rows, cols, channels = (np.atleast_1d(p) for p in picks + [np.zeros(1, int)] * self._luminance)
         if min(times.size, rows.size, cols.size, channels.size) == 0:
             return np.empty(out_shape, dtype=np.float32)
         height, width = self.shape[1:3]
@@ -455,16 +467,24 @@ class _MosaicImage(BackendArray):
         local_rows, local_cols = _local_index(rows, r0), _local_index(cols, c0)
         whole = (isinstance(local_rows, slice) and isinstance(local_cols, slice)
                  and local_rows == slice(0, r1 - r0, 1) and local_cols == slice(0, c1 - c0, 1)
-                 and channels.size == len(CHANNELS) and np.array_equal(channels, np.arange(len(CHANNELS))))
+                 and (self._luminance or (channels.size == len(CHANNELS)
+                                          and np.array_equal(channels, np.arange(len(CHANNELS))))))
+        convert = mosaic_luminance if self._luminance else mosaic_image
         out = None
         for k, t in enumerate(times):
-            image = mosaic_image(mosaics[t - t0], cfa_pattern=self._pattern, black_sites=self._black[t],
-                                 white_sites=self._white[t])
+            image = convert(mosaics[t - t0], cfa_pattern=self._pattern, black_sites=self._black[t],
+                            white_sites=self._white[t])
             if whole and times.size == 1:
                 return image.reshape(out_shape)
             if out is None:
-                out = np.empty((times.size, rows.size, cols.size, channels.size), dtype=np.float32)
-            out[k] = image if whole else image[local_rows][:, local_cols][:, :, channels]
+                out = np.empty((times.size, rows.size, cols.size) + (() if self._luminance else (channels.size,)),
+                               dtype=np.float32)
+            if whole:
+                out[k] = image
+            elif self._luminance:
+                out[k] = image[local_rows][:, local_cols]
+            else:
+                out[k] = image[local_rows][:, local_cols][:, :, channels]
         return out.reshape(out_shape)
 
 
@@ -515,6 +535,30 @@ def iter_store_frames(dataset, *, what="read frames"):
     """
     progress = Progress(max(dataset.sizes["time"], 1), what)
     for start, block in iter_frame_chunks(dataset):
+        for offset, frame in enumerate(block):
+            yield frame
+            progress.update(start + offset + 1)
+
+
+def iter_store_luminance(dataset, *, what="read luminance"):
+    """Yield the ``(H, W)`` float32 luminance (mean of R, G, B) of `dataset`'s frames one at a time.
+
+    A mosaic store's ``luminance`` is read one time chunk at a time, straight
+    from the mosaic (no colour image); other stores' colour frames are read
+    (:func:`iter_store_frames`) and averaged over their channels. Either way
+    the values are ``channel_mean`` of the frames :func:`iter_store_frames`
+    yields, bit for bit. Logs the progress of the pass, naming it `what`.
+    """
+    if "luminance" not in dataset:
+        for frame in iter_store_frames(dataset, what=what):
+            yield channel_mean(frame)
+        return
+    luminance = dataset["luminance"]
+    chunk_frames = int(luminance.encoding["chunks"][0])
+    n = luminance.sizes["time"]
+    progress = Progress(max(n, 1), what)
+    for start in range(0, n, chunk_frames):
+        block = luminance.isel(time=slice(start, min(start + chunk_frames, n))).values
         for offset, frame in enumerate(block):
             yield frame
             progress.update(start + offset + 1)

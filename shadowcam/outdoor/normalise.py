@@ -143,19 +143,30 @@ class SequenceNormaliser:
         return previous
 
     def update(self, frame):
-        """Process the next frame ``(H, W, C)`` (frame 0 sets the reference)."""
+        """Process the next frame.
+
+        Parameters
+        ----------
+        frame : (H, W, C) or (H, W) ndarray
+            The frame in colour, or (after frame 0, which sets the reference and
+            its sky mask from colour) its luminance
+            (:func:`shadowcam.outdoor.photometric.luminance`): the pass uses
+            nothing else of the later frames, so a reader that gives the
+            luminance directly (:func:`shadowcam.io.frame_store.iter_store_luminance`)
+            saves the colour image.
+        """
         frame = np.asarray(frame, dtype=np.float32)
-        check_array(frame, "frame", ndim=3)
         k = self._k
+        check_array(frame, "frame", ndim=3 if k == 0 else (2, 3))
         if k == 0:
             self._start(frame)
             shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
             kept = int(self._small_lit.sum())
         else:
-            if frame.shape != self.reference.shape:
+            if frame.shape[:2] != self.reference.shape[:2] or frame.shape[2:] not in ((), self.reference.shape[2:]):
                 raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
             last_shift, last_gain, last_sky = self._last
-            raw = luminance(frame)
+            raw = luminance(frame) if frame.ndim == 3 else frame
             factor, ref = self.factor, self._small_reference
             small = block_mean(raw, factor)
             rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
@@ -306,7 +317,8 @@ def normalise_frames(frames, **options):
     Parameters
     ----------
     frames : iterable of (H, W, C) ndarray
-        In time order (e.g. flattened :func:`shadowcam.io.frame_store.iter_frame_chunks`).
+        In time order (e.g. flattened :func:`shadowcam.io.frame_store.iter_frame_chunks`);
+        frames after the first may be given as their ``(H, W)`` luminance.
     **options
         Keyword options of :class:`SequenceNormaliser`.
 
@@ -331,8 +343,9 @@ def normalise_part(frames, *, start, stop, reference=None, overlap=2, **options)
 
     Parameters
     ----------
-    frames : iterable of (H, W, C) ndarray
-        Frames ``max(0, start - overlap) .. stop - 1`` in time order
+    frames : iterable of (H, W, C) or (H, W) ndarray
+        Frames ``max(0, start - overlap) .. stop - 1`` in time order, in colour
+        or as luminance (frame 0 in colour)
         (:func:`part_frames` gives the range).
     start, stop : int
         Frames recorded by this part.

@@ -17,7 +17,7 @@ lit, 0 where shadowed and the lit fraction of the footprint in between.
 
 Offers
 ------
-luminance : mean of the colour channels, float32.
+luminance : mean of the colour channels, float32 (:func:`shadowcam.io.luminance.channel_mean`).
 exposure_gains : per-frame gain relative to the first frame from exposure times.
 lit_at_start : split the first frame into lit and shadowed pixels (Otsu on log Y).
 estimate_gain : robust gain of a frame relative to the reference on given pixels.
@@ -27,32 +27,11 @@ coverage : per-pixel lit fraction of a frame from its lit and shadow levels.
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_positive, check_same_shape
+from shadowcam.io.luminance import channel_mean
 
 
-def luminance(image):
-    """Return the mean over the last (channel) axis.
-
-    Parameters
-    ----------
-    image : (..., C) ndarray
-        Linear colour image(s).
-
-    Returns
-    -------
-    (...) float32 ndarray
-    """
-    image = np.asarray(image)
-    if image.ndim < 3:
-        raise ValueError(f"image must have a trailing channel axis (H, W, C); got shape {image.shape}")
-    if image.dtype != np.float32:
-        return image.mean(axis=-1, dtype=np.float32)
-    # channel by channel in place: the same sums and division as ``mean`` (bit for bit)
-    # at a third of the time of a reduction over a short last axis
-    out = image[..., 0].copy()
-    for channel in range(1, image.shape[-1]):
-        out += image[..., channel]
-    out /= np.float32(image.shape[-1])
-    return out
+#: the pipeline's luminance: mean of the linear colour channels (float32)
+luminance = channel_mean
 
 
 def exposure_gains(exposure_s):

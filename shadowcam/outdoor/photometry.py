@@ -17,7 +17,7 @@ import numpy as np
 
 from shadowcam.io.datasets import merge_input_checksums
 from shadowcam.io.decode import read_frame
-from shadowcam.io.frame_store import iter_store_frames
+from shadowcam.io.frame_store import iter_store_luminance
 from shadowcam.io.manifest import verify_checksums
 from shadowcam.outdoor.datasets import (
     photometry_dataset, photometry_part_arrays, photometry_part_dataset,
@@ -81,6 +81,14 @@ def sweep_sky_mask(frames, manifest, *, sky_params=None):
     return np.asarray(mask, dtype=bool), source
 
 
+def _pass_frames(frames, first, stop, *, what):
+    """Frames ``first .. stop - 1`` as the pass reads them: frame 0 in colour, the others' luminance."""
+    if first == 0:
+        yield np.asarray(frames["image"].isel(time=0).values, dtype=np.float32)
+        first = 1
+    yield from iter_store_luminance(frames.isel(time=slice(first, stop)), what=what)
+
+
 def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_metadata=True, part=None,
                            **options):
     """Run the first outdoor pass over a frame store.
@@ -120,7 +128,8 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
                         registration_margin=options.get("registration_margin", 6))
     time_s = frames["time_s"].values
     if part is None:
-        result = normalise_frames(iter_store_frames(frames, what="registration and gains"), **pass_options)
+        result = normalise_frames(_pass_frames(frames, 0, frames.sizes["time"], what="registration and gains"),
+                                  **pass_options)
         return photometry_dataset(result, time_s, exposure_gain=exposure, sky_source=sky_source)
     start, stop = part
     if not 0 <= start < stop <= frames.sizes["time"]:
@@ -128,7 +137,7 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
     overlap = int(options.get("overlap", 2))
     first, _ = part_frames(start, stop, overlap=overlap)
     reference = frames["image"].isel(time=0).values
-    stream = iter_store_frames(frames.isel(time=slice(first, stop)), what=f"registration and gains {start}:{stop}")
+    stream = _pass_frames(frames, first, stop, what=f"registration and gains {start}:{stop}")
     result = normalise_part(stream, start=start, stop=stop, reference=reference, overlap=overlap, **pass_options)
     return photometry_part_dataset(result, time_s[start:stop], sky_source=sky_source,
                                    exposure_gain=None if exposure is None else exposure[start:stop])

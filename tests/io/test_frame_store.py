@@ -200,3 +200,23 @@ def test_any_window_of_a_mosaic_store_is_the_window_of_the_whole_decode(raw_swee
         np.testing.assert_array_equal(got, decoded[key])
 
     check()
+
+
+def test_luminance_of_a_mosaic_store_is_the_channel_mean_of_its_frames(raw_sweep, make_frames, tmp_path):
+    from shadowcam.io.frame_store import iter_store_frames, iter_store_luminance
+    from shadowcam.io.luminance import channel_mean
+
+    _, decoded, store = raw_sweep
+    frames = open_frames(store)
+    want = channel_mean(decoded)
+    assert frames["luminance"].dims == ("time", "row", "col")
+    np.testing.assert_array_equal(np.stack(list(iter_store_luminance(frames))), want)  # chunks of 2
+    np.testing.assert_array_equal(np.stack(list(iter_store_luminance(frames.isel(time=slice(1, 4))))), want[1:4])
+    np.testing.assert_array_equal(frames["luminance"][2:4, 5:17, 3:9].values, want[2:4, 5:17, 3:9])
+    np.testing.assert_array_equal(frames["luminance"][1, 7, ::3].values, want[1, 7, ::3])
+    # a float store has no luminance variable: the frames are averaged as they are read
+    paths, _ = make_frames(tmp_path / "float", 3)
+    floats = open_frames(write_frames(paths, tmp_path / "float.zarr", times_s=np.arange(3.0)))
+    assert "luminance" not in floats
+    np.testing.assert_array_equal(np.stack(list(iter_store_luminance(floats))),
+                                  np.stack([channel_mean(f) for f in iter_store_frames(floats)]))

@@ -160,3 +160,18 @@ def test_soft_shadow_edge_is_measured_whatever_its_width(make_timelapse, factor)
     np.testing.assert_allclose(result["shift"], 0, atol=0.01)  # pixels; the true shift is 0
     with pytest.raises(ValueError, match="registration_margin"):
         normalise_frames(iter(frames), registration_margin=0)
+
+
+def test_later_frames_as_luminance_give_the_colour_pass_bit_for_bit(make_timelapse):
+    from shadowcam.outdoor.photometric import luminance
+
+    frames = make_timelapse(seed=2, **NUISANCES)["frames"][:8]
+    colour = normalise_frames(iter(frames))
+    lumas = normalise_frames([frames[0]] + [luminance(f) for f in frames[1:]])
+    for key, value in colour.items():
+        np.testing.assert_array_equal(lumas[key], value)
+    part = normalise_part([luminance(f) for f in frames[2:8]], start=4, stop=8, reference=frames[0])
+    np.testing.assert_array_equal(part["shift"], normalise_part(frames[2:8], start=4, stop=8,
+                                                                reference=frames[0])["shift"])
+    with pytest.raises(ValueError, match="frame must have 3 dimension"):
+        normalise_frames([luminance(frames[0])] + list(frames[1:3]))  # the first frame sets the sky mask: colour

@@ -1,0 +1,127 @@
+#!/usr/bin/env python
+"""Outdoor first pass against the decode, per added frame, at a camera's size (one process).
+
+    .venv/bin/python scripts/benchmark_outdoor_pass1.py [--size 6000x4000] [--frames 8] [--dir /tmp/...] [--source results/synthetic_ridge/capture/frames]
+
+Makes ````frames`` 14-bit lossless-JPEG RGGB DNGs of the given size from the rendered
+``synthetic_ridge`` capture (its first frames' decodes resized, each moved by a known
+sub-pixel shake, re-mosaiced), then measures, in this one process, the CPU seconds per frame (medians over the frames, so
+that the per-job fixed costs and the other users' load spikes drop out):
+
+* decode-only: the direct mosaic read of a frame (:class:`shadowcam.io.mosaic_reader.MosaicReader`),
+* pass 1 as the workflow runs it (frames after the first read from the store as luminance,
+  straight from the mosaic: :func:`shadowcam.io.frame_store.iter_store_luminance`), from one
+  frame handed to the pass to the next,
+* the same reading every frame in colour (demosaic, then luminance), interleaved with it,
+
+and prints the ratios to the decode. The pass's results of both reads are compared bit for bit.
+"""
+
+import argparse
+import itertools
+import resource
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+
+def _clock():
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime, time.perf_counter()
+
+
+def _timed(function, *args, **kwargs):
+    cpu, wall = _clock()
+    out = function(*args, **kwargs)
+    cpu1, wall1 = _clock()
+    return out, cpu1 - cpu, wall1 - wall
+
+
+def _make_dngs(folder, size, count, source):
+    from shadowcam.io.decode import read_frame
+    from shadowcam.io.raw_writer import write_dng
+    from shadowcam.outdoor.translation import translate
+
+    cols, rows = size
+    frames = sorted(Path(source).glob("*.dng"))
+    if not frames:
+        raise SystemExit(f"no DNG frames in {source}: run the workflow on synthetic_ridge first, or give --source")
+    folder.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(1)
+    paths = []
+    for k in range(count):
+        path = folder / f"{k:04d}.dng"
+        paths.append(path)
+        if path.exists():
+            continue
+        image = cv2.resize(read_frame(frames[k % len(frames)]), (cols, rows), interpolation=cv2.INTER_CUBIC)
+        shift = rng.uniform(-2, 2, size=2) if k else np.zeros(2)
+        image = np.stack([translate(image[..., c], shift, method="opencv_cubic") for c in range(3)], axis=-1)
+        mosaic = np.empty((rows, cols), np.float32)
+        mosaic[0::2, 0::2], mosaic[0::2, 1::2] = image[0::2, 0::2, 0], image[0::2, 1::2, 1]
+        mosaic[1::2, 0::2], mosaic[1::2, 1::2] = image[1::2, 0::2, 1], image[1::2, 1::2, 2]
+        dn = np.clip(np.nan_to_num(mosaic), 0, 1) * (16383 - 512) + 512
+        write_dng(path, np.rint(dn).astype(np.uint16), bit_depth=14, black_level=512, exposure_time=0.01,
+                  compression="ljpeg")
+    return paths
+
+
+def _per_frame(stream, cpu):
+    """Yield the items of `stream`, appending to `cpu` the CPU seconds from each item handed out to the next."""
+    last = None
+    for item in stream:
+        now = _clock()[0]
+        if last is not None:
+            cpu.append(now - last)  # the pass's work on the previous item and the read of this one
+        last = now
+        yield item
+
+
+def main():
+    from shadowcam.io.frame_store import iter_store_frames, iter_store_luminance, open_frames, write_frames
+    from shadowcam.io.mosaic_reader import MosaicReader
+    from shadowcam.outdoor.normalise import normalise_frames
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--size", default="6000x4000", help="COLSxROWS")
+    parser.add_argument("--frames", type=int, default=8)
+    parser.add_argument("--dir", type=Path, default=Path("/tmp/shadowcam-bench-pass1"))
+    parser.add_argument("--source", type=Path, default=Path("results/synthetic_ridge/capture/frames"),
+                        help="rendered DNG frames the benchmark's frames are made from")
+    args = parser.parse_args()
+    size = tuple(int(v) for v in args.size.split("x"))
+    n = args.frames
+    paths = _make_dngs(args.dir / f"dng-{args.size}", size, n, args.source)
+    reader = MosaicReader(paths[0])
+    decode = []
+    for path in paths[1:]:
+        _, cpu, _ = _timed(reader.read, path)
+        decode.append(cpu)
+    store, store_cpu, _ = _timed(write_frames, paths, args.dir / f"store{n}.zarr", times_s=np.arange(float(n)),
+                                 chunk_frames=1)
+    frames = open_frames(store)
+    first = frames["image"].isel(time=0).values
+    runs = {}
+    for name in ("luminance", "colour", "luminance", "colour"):  # interleaved: the load changes
+        later = frames.isel(time=slice(1, n))
+        stream = iter_store_luminance(later) if name == "luminance" else iter_store_frames(later)
+        cpu = []
+        result = normalise_frames(itertools.chain([first], _per_frame(stream, cpu)))
+        runs.setdefault(name, []).extend(cpu[1:])  # frame 1's time includes the reference's set-up
+        runs.setdefault(name + " result", result)
+    same = all(np.array_equal(runs["luminance result"][k], runs["colour result"][k]) for k in runs["colour result"])
+    per_decode = float(np.median(decode))
+    print(f"size {args.size}, {n} frames, RAW {sum(p.stat().st_size for p in paths) / n / 1e6:.1f} MB/frame; "
+          f"results of the two reads bit for bit equal: {same}")
+    print(f"decode-only (direct mosaic read) {per_decode:.3f} s CPU per frame (median of {len(decode)}); "
+          f"the whole store write {store_cpu / n:.3f} s CPU per frame")
+    for name in ("luminance", "colour"):
+        per = float(np.median(runs[name]))
+        print(f"pass 1 reading {name}: {per:.3f} s CPU per frame (median of {len(runs[name])}: read + pass) "
+              f"-> {per / per_decode:.2f} x decode")
+
+
+if __name__ == "__main__":
+    main()
