@@ -512,7 +512,6 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
     time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
     if interval is not None:
         reason, time, entry, exit_, std, extra = _time_wide_dips(summary, interval, reason, time, entry, exit_, std)
-    if interval is not None:
         std = np.hypot(std, footprint_spread_std(interval, reason == OK))
     last = summary.n_frames - 1
     outside = ~((time >= 0) & (time <= last))
