@@ -4,10 +4,10 @@ Each screen position has a horizontal sweep (a vertical wire moving along the ma
 x) and a vertical one (a horizontal wire moving along y). Their shadow times at a
 camera pixel, turned into mask positions ``x_mask = start + step * time``, name the
 mask point the pixel's light passed through (paper VI, Fig. 17). A ray's origin is a pixel of
-the anchor screen (the far one in :func:`rays_dataset`, the near one in the stages); its flux
-is the anchor screen's irradiance times the pixel's screen area. Its direction, given the mask plane's position (the default of the
-stages), is the line from the pixel's mask point on the mask plane to the pixel's flux
-centroid on the anchor screen: the wire blocks exactly the light through that mask point,
+the anchor screen (the far one by default); its flux is the anchor screen's irradiance times
+the pixel's screen area. Its direction, given the mask plane's position (as the stages give
+it), is the line from the pixel's mask point on the mask plane to the pixel's flux centroid
+on the anchor screen: the wire blocks exactly the light through that mask point,
 and the anchor's mask error then tilts the ray by itself over the mask-to-anchor distance.
 Without it, the ray goes to the other screen's point with the pixel's mask coordinates
 (interpolated over that screen's mask coordinates, Clough-Tocher C1 cubic on their Delaunay
