@@ -82,20 +82,27 @@ def _render(scene, radius_frames):
     return scene, capture.frames("u"), capture.ground_truth
 
 
-@pytest.mark.parametrize("radius_frames", [4, 8])
-def test_wide_area_light_shadow_is_timed_like_a_thin_one(area_scene, radius_frames):
-    # a wire whose shadow is 8 / 16 frames wide at half depth, penumbrae of about 3 frames
-    # each side, noise free
-    from shadowcam.lab.shadow_time import OK
-
+def _render_with_interval_truth(area_scene, radius_frames):
+    """Render sweep u; its half-blocked entry / exit (40, 40) and the lit pixels whose whole
+    penumbra lies inside the sweep."""
     scene, frames, gt = _render(area_scene, radius_frames)
     points = gt["P"].values.reshape(-1, 3)
     entry, exit_ = (t.reshape(40, 40) for t in area_light_times(points, scene.sweeps["u"], scene.mask,
                                                                  scene.light, fraction=0.5))
     first, last = (t.reshape(40, 40) for t in area_light_times(points, scene.sweeps["u"], scene.mask,
                                                                scene.light, fraction=0.0))
+    inside = gt["lit"].values.astype(bool) & (first > 1) & (last < 62)
+    return frames, entry, exit_, inside
+
+
+@pytest.mark.parametrize("radius_frames", [4, 8])
+def test_wide_area_light_shadow_is_timed_like_a_thin_one(area_scene, radius_frames):
+    # a wire whose shadow is 8 / 16 frames wide at half depth, penumbrae of about 3 frames
+    # each side, noise free
+    from shadowcam.lab.shadow_time import OK
+
+    frames, entry, exit_, lit = _render_with_interval_truth(area_scene, radius_frames)
     assert np.nanmedian(exit_ - entry) >= 2 * radius_frames - 0.5
-    lit = gt["lit"].values.astype(bool) & (first > 1) & (last < 62)
     thin_scene, thin_frames, _ = _render(replace(area_scene, light=PointLight(area_scene.light.position,
                                                                              area_scene.light.intensity)), 1)
     thin = _timed(thin_frames, interval=False)
@@ -126,13 +133,7 @@ def test_area_light_dip_hides_the_light_for_the_wires_width(area_scene, radius_f
     # the half-blocked entry and exit of a centrally symmetric source, whether or not the dip
     # has an umbra (the 8-frame one has none). Measured p95 0.026 / 0.030 frame (the 2 x 2
     # sub-samples of a footprint against the truth at its centre)
-    scene, frames, gt = _render(area_scene, radius_frames)
-    points = gt["P"].values.reshape(-1, 3)
-    entry, exit_ = (t.reshape(40, 40) for t in area_light_times(points, scene.sweeps["u"], scene.mask,
-                                                                 scene.light, fraction=0.5))
-    first, last = (t.reshape(40, 40) for t in area_light_times(points, scene.sweeps["u"], scene.mask,
-                                                               scene.light, fraction=0.0))
-    inside = gt["lit"].values.astype(bool) & (first > 1) & (last < 62)
+    frames, entry, exit_, inside = _render_with_interval_truth(area_scene, radius_frames)
     signal = np.asarray(frames, np.float64)
     signal = signal.sum(axis=-1) if signal.ndim == 4 else signal
     lit = signal.max(axis=0)  # a frame with the whole source in view
