@@ -76,7 +76,7 @@ demo: $(STAMP)
 	@echo "HTML report:  $(CURDIR)/results/report.html"
 
 test: $(STAMP)
-	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/pytest -q --durations=15
+	PATH="$(CURDIR)/$(BIN):$$PATH" $(BIN)/pytest -q -n 2 --dist loadfile --durations=15
 
 bench-outdoor: $(STAMP)
 	rm -rf results/$(OUTDOOR) benchmarks/$(OUTDOOR)

@@ -21,14 +21,13 @@ import yaml
 DS = "synthetic_tiny"
 DATASETS = f"datasets=[{DS}]"
 FRAMES = 24  # frames per sweep of synthetic_tiny = dual grid size
-DAG_SECONDS = 120
 BIN = Path(sys.executable).parent  # this environment's shadowcam and snakemake
 pytestmark = pytest.mark.slow  # runs the whole DAG
 
 
 @pytest.fixture(scope="module")
 def run(tmp_path_factory, workflow_copy, snakemake):
-    """Scratch working directory after running the whole DAG; and its wall time (s)."""
+    """Scratch working directory after running the whole DAG (its wall time is printed)."""
     workdir = workflow_copy(tmp_path_factory.mktemp("workflow"))
     start = time.perf_counter()
     result = snakemake(["--cores", "2", "--config", DATASETS], workdir)
@@ -38,7 +37,8 @@ def run(tmp_path_factory, workflow_copy, snakemake):
         for p in sorted((workdir / "logs").rglob("*.log"))
     ) if (workdir / "logs").exists() else ""
     assert result.returncode == 0, result.stdout[-4000:] + logs
-    return workdir, seconds
+    print(f"\n{DS} whole DAG: {seconds:.0f} s")
+    return workdir
 
 
 @pytest.fixture(scope="module")
@@ -46,13 +46,13 @@ def truth(run):
     from shadowcam.io.ground_truth import load_ground_truth
     from shadowcam.io.manifest import load_manifest
 
-    workdir, _ = run
+    workdir = run
     manifest = load_manifest(workdir / "results" / DS / "capture" / "capture.json")
     return load_ground_truth(manifest).load()
 
 
 def open_nc(run, name):
-    workdir, _ = run
+    workdir = run
     with xr.open_dataset(workdir / "results" / DS / name, engine="h5netcdf") as ds:
         return ds.load()
 
@@ -64,11 +64,6 @@ def planned_jobs(snakemake, workdir, *extra):
     stats = result.stdout.split("Job stats:")[-1] if "Job stats:" in result.stdout else ""
     return {m[1]: int(m[2]) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", stats, re.M)
             if m[1] not in ("total",)}
-
-
-def test_dag_runs_in_time(run):
-    _, seconds = run
-    assert seconds < DAG_SECONDS, f"whole DAG took {seconds:.0f} s"
 
 
 def test_shadow_times_match_ground_truth(run, truth):
@@ -107,7 +102,7 @@ def test_dual_axes_follow_the_sweeps(run, truth):
 def test_uniform_dual_coords_are_the_exact_frame_coordinates(run, truth, tmp_path):
     """The renderer moves the wire one dual pixel per frame, so on the uniform grid the
     dual coordinates are the exact shadow times t_u, t_v (sub-frame)."""
-    workdir, _ = run
+    workdir = run
     out = tmp_path / "dual_coords_uniform.nc"
     result = subprocess.run(
         [str(BIN / "shadowcam"), "dual-coords", "--model", "uniform",
@@ -138,7 +133,7 @@ def test_dual_view_covers_what_the_camera_sees(run, truth):
 
 
 def test_accuracy_and_figures_written(run):
-    workdir, _ = run
+    workdir = run
     out = workdir / "results" / DS
     json.loads((out / "accuracy.json").read_text())
     assert (out / "accuracy.csv").read_text().count("\n") >= 2
@@ -151,7 +146,7 @@ def test_accuracy_and_figures_written(run):
 
 
 def test_report_shows_every_figure(run, snakemake):
-    workdir, _ = run
+    workdir = run
     result = snakemake(["--cores", "1", "--config", DATASETS, "--report", "report.html"],
                        workdir)
     assert result.returncode == 0, result.stdout[-3000:]
@@ -169,7 +164,7 @@ def test_report_shows_every_figure(run, snakemake):
 
 
 def test_run_and_report_say_only_what_is_the_users_business(run, snakemake):
-    workdir, _ = run
+    workdir = run
     for log in (workdir / "logs" / DS).glob("*.log"):
         assert "Warning" not in log.read_text(), log  # e.g. zarr on Snakemake's .snakemake_timestamp
     result = snakemake(["--profile", "profiles/local", "--config", DATASETS, "--report", "quiet.html"], workdir)
@@ -178,7 +173,7 @@ def test_run_and_report_say_only_what_is_the_users_business(run, snakemake):
 
 
 def test_nothing_to_do_after_a_run(run, snakemake):
-    workdir, _ = run
+    workdir = run
     assert planned_jobs(snakemake, workdir) == {}
 
 
@@ -196,7 +191,7 @@ def test_nothing_to_do_after_a_run(run, snakemake):
     ],
 )
 def test_params_change_reruns_what_it_affects(run, section, change, rerun, snakemake):
-    workdir, _ = run
+    workdir = run
     config = yaml.safe_load((workdir / "config" / "config.yaml").read_text())
     config[section].update(change)
     changed = workdir / "config" / f"changed_{section}.yaml"
