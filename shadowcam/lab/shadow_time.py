@@ -338,10 +338,9 @@ def _partially_lit(detected, level, *, site_colour=None, site_image=None, resolu
     side: an undetected one, or one darker than `shadow_ratio` times the
     pixel's own level in that neighbour's colour (a cast shadow keeps only
     ambient light, an order of magnitude below direct light, while
-    neighbouring albedos of a texture rarely differ that much). A pixel whose
-    level in that colour is within `resolution` of the darkness test's bound
-    cannot tell a shadowed neighbour from a lit one and counts it as shadow
-    side. The lit fraction of a pixel beside the shadow side is its level over
+    neighbouring albedos of a texture rarely differ that much), within
+    `resolution`, the noise of the levels (a pixel too dim to tell a shadowed
+    neighbour from a lit one counts it as shadow side). The lit fraction of a pixel beside the shadow side is its level over
     the brightest detected neighbour of the same colour (within 1 pixel, or 2
     on a CFA's colour lattice); centre in shadow when it is under
     `min_lit_fraction` (1/2 for a straight boundary).
@@ -381,9 +380,8 @@ def _partially_lit(detected, level, *, site_colour=None, site_image=None, resolu
         if max(abs(dr), abs(dc)) > 1:
             continue
         own = np.take_along_axis(site_image, shifted(colour, dr, dc, 0)[..., None], axis=2)[..., 0]
-        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * own
-        unresolved = (1.0 - shadow_ratio) * own <= resolution
-        shadow_side |= darker | unresolved | ~shifted(detected, dr, dc, True)
+        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * own + resolution
+        shadow_side |= darker | ~shifted(detected, dr, dc, True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
     return detected & shadow_side & (fraction < min_lit_fraction)
