@@ -340,10 +340,11 @@ def _partially_lit(detected, level, *, site_colour=None, site_image=None, resolu
     ambient light, an order of magnitude below direct light, while
     neighbouring albedos of a texture rarely differ that much), within
     `resolution`, the noise of the levels (a pixel too dim to tell a shadowed
-    neighbour from a lit one counts it as shadow side). The lit fraction of a pixel beside the shadow side is its level over
-    the brightest detected neighbour of the same colour (within 1 pixel, or 2
-    on a CFA's colour lattice); centre in shadow when it is under
-    `min_lit_fraction` (1/2 for a straight boundary).
+    neighbour from a lit one counts it as shadow side). The lit fraction of a
+    pixel beside the shadow side is its level over the brightest detected
+    neighbour of the same colour (within 1 pixel, or 2 on a CFA's colour
+    lattice); its centre is in shadow when that is under `min_lit_fraction`
+    (1/2 for a straight boundary).
 
     Parameters
     ----------
@@ -432,8 +433,9 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     min_lit_fraction : float, optional
         Smallest lit fraction of a boundary pixel's footprint.
     shadow_ratio : float, optional
-        A same-colour neighbour darker than this fraction of a pixel's level
-        is taken as the shadowed side of a cast-shadow boundary.
+        A neighbour touching the pixel and darker than this fraction of the
+        pixel's level in the neighbour's colour (plus the lit level's noise) is
+        taken as the shadowed side of a cast-shadow boundary.
     noise_floor : float, optional
         Lower bound of the noise (signal units), for noise-free data.
     second_dip_ratio : float, optional
