@@ -328,32 +328,61 @@ def _supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, fram
     return candidate & (agree >= min_support) & (2 * agree >= total)
 
 
-def _partially_lit(detected, level, *, site_colour=None, min_lit_fraction=0.5,
-                   shadow_ratio=0.1):
+def _partially_lit(detected, level, *, site_colour=None, site_image=None, resolution=0.0,
+                   min_lit_fraction=0.5, shadow_ratio=0.1):
     """Detected pixels at a shadow boundary whose lit part is under `min_lit_fraction`.
 
     A pixel straddling the boundary of a cast (scene) shadow dips when the
-    mask passes, although its centre is in shadow. Its lit fraction is
-    estimated as its level over the brightest detected neighbour of the same
-    colour; only pixels beside the shadow side are tested: an undetected
-    neighbour, or a same-colour neighbour darker than `shadow_ratio` times
-    the pixel's level (a cast shadow keeps only ambient light, an order of
-    magnitude below direct light, while neighbouring albedos of a texture
-    rarely differ that much). For demosaiced RAW, `level` should be each
-    site's own measured channel and `site_colour` its CFA colour:
-    interpolated channels carry light from lit neighbours into shadowed
-    sites, so those are detected too and only the darkness test finds them.
+    mask passes, although its centre is in shadow. A boundary that crosses the
+    pixel's footprint leaves one of the eight pixels touching it on the shadow
+    side: an undetected one, or one darker than `shadow_ratio` times the
+    pixel's own level in that neighbour's colour (a cast shadow keeps only
+    ambient light, an order of magnitude below direct light, while
+    neighbouring albedos of a texture rarely differ that much), within
+    `resolution`, the noise of the levels (a pixel too dim to tell a shadowed
+    neighbour from a lit one counts it as shadow side). The lit fraction of a
+    pixel beside the shadow side is its level over the brightest detected
+    neighbour of the same colour (within 1 pixel, or 2 on a CFA's colour
+    lattice); its centre is in shadow when that is under `min_lit_fraction`
+    (1/2 for a straight boundary).
+
+    Parameters
+    ----------
+    detected : (H, W) bool ndarray
+        Pixels with a detected dip.
+    level : (H, W) ndarray
+        Lit level; for demosaiced RAW each site's own measured channel.
+    site_colour : (H, W) int ndarray, optional
+        CFA colour index of each site (demosaiced RAW).
+    site_image : (H, W, C) ndarray, optional
+        With `site_colour`: the lit colour of each pixel (its level in every channel).
+        Interpolated channels carry light from lit neighbours into shadowed sites, so
+        those are detected too and only the darkness test finds them.
+    resolution : float or (H, W) ndarray, optional
+        Noise of the pixel's lit level (signal units).
+    min_lit_fraction, shadow_ratio : float, optional
+        As :func:`classify_dips`.
+
+    Returns
+    -------
+    (H, W) bool ndarray
     """
-    same_colour_radius = 1 if site_colour is None else 2
-    colour = np.zeros(level.shape, np.int8) if site_colour is None else site_colour
+    if site_colour is None:
+        colour = np.zeros(level.shape, np.intp)
+        site_image = np.asarray(level)[..., None]
+    else:
+        colour = np.asarray(site_colour).astype(np.intp)
     lit_level = np.where(detected, level, 0.0)
     brightest = np.zeros_like(lit_level)
     shadow_side = np.zeros(detected.shape, bool)
-    for dr, dc in _shifts(same_colour_radius):
+    for dr, dc in _shifts(1 if site_colour is None else 2):
         same = shifted(colour, dr, dc, -1) == colour
         brightest = np.maximum(brightest, np.where(same, shifted(lit_level, dr, dc, 0.0), 0.0))
-        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * level
-        shadow_side |= (same & darker) | ~shifted(detected, dr, dc, True)
+        if max(abs(dr), abs(dc)) > 1:
+            continue
+        own = np.take_along_axis(site_image, shifted(colour, dr, dc, 0)[..., None], axis=2)[..., 0]
+        darker = shifted(level, dr, dc, np.inf) < shadow_ratio * own + resolution
+        shadow_side |= darker | ~shifted(detected, dr, dc, True)
     with np.errstate(invalid="ignore", divide="ignore"):
         fraction = level / brightest
     return detected & shadow_side & (fraction < min_lit_fraction)
@@ -404,8 +433,9 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     min_lit_fraction : float, optional
         Smallest lit fraction of a boundary pixel's footprint.
     shadow_ratio : float, optional
-        A same-colour neighbour darker than this fraction of a pixel's level
-        is taken as the shadowed side of a cast-shadow boundary.
+        A neighbour touching the pixel and darker than this fraction of the
+        pixel's level in the neighbour's colour (plus the lit level's noise) is
+        taken as the shadowed side of a cast-shadow boundary.
     noise_floor : float, optional
         Lower bound of the noise (signal units), for noise-free data.
     second_dip_ratio : float, optional
@@ -435,14 +465,18 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     strong = (contrast > z) & deep_enough
     weak = (contrast > z_weak) & deep_enough & ~strong
     detected = strong | _supported_by_neighbours(weak, strong, summary.minimum_frame)
-    significant_level = level > z * noise / np.sqrt(np.maximum(summary.lit_count, 1))
+    # the lit level's noise at the detection threshold
+    level_noise = z * noise / np.sqrt(np.maximum(summary.lit_count, 1))
+    significant_level = level > level_noise
 
     reason = np.zeros(level.shape, np.uint8)
     reason[~detected] = NEVER_SHADOWED
     reason[~significant_level] = LOW_CONTRAST
     boundary_level = level if site_level is None else site_level
     partial = _partially_lit(detected, boundary_level, site_colour=site_colour,
-                             min_lit_fraction=min_lit_fraction, shadow_ratio=shadow_ratio)
+                             site_image=None if site_colour is None else lit_colour(summary),
+                             resolution=level_noise, min_lit_fraction=min_lit_fraction,
+                             shadow_ratio=shadow_ratio)
     reason[partial] = LOW_CONTRAST
     several = detected & (second_depth >= second_dip_ratio * depth) & (
         second_depth / (noise * _SMOOTHED_NOISE) > z
