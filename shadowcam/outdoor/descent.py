@@ -183,8 +183,8 @@ def _half_level(buffer, time_s, centre, sigma, state, duration, *, shadow_ratio,
         t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
         levels = half_levels(values, t, shadow_ratio=shadow_ratio)
         probe = np.where(levels["lit_seen"], levels["half"], levels["lit"] - 0.5 * levels["contrast"])
-        with np.errstate(invalid="ignore"):
-            k = np.where(state[r, c] > STATE_CODE["short"], np.rint(0.25 * duration[r, c] / interval), 1)
+        with np.errstate(invalid="ignore"):  # a line over an eighth of the fitted duration each side
+            k = np.where(state[r, c] > STATE_CODE["short"], np.rint(0.125 * duration[r, c] / interval), 1)
         k = np.clip(np.nan_to_num(k, nan=1.0), 1, None).astype(np.int64)
         # a descent that does not start on its plateau: a wider line for its rate at the centre
         k = np.where(levels["lit_seen"], k, np.maximum(k, UNDER_WAY_WINDOW))

@@ -17,9 +17,10 @@ both are constants of the pixel.
   lit level times the capture's shadow-to-lit ratio (sky over sun irradiance; the albedo
   cancels in it), whose error moves the half level by only half its share of ``L``.
 * :func:`half_level_crossings`: the last downward crossing of the half level, refined by a
-  line over ``+-k`` samples around it (the caller's ``k``: a quarter of the ramp's duration,
-  over which the disc's law is nearly straight), with its standard error from the line's
-  residual.
+  line over ``+-k`` samples around it (the caller's ``k``: an eighth of the ramp's duration,
+  over which the disc's law keeps its centre rate to 3 %, ``sqrt(1 - u^2) >= 0.968`` for
+  ``|u| <= 1/4``, while the ramp's speed may differ between its halves), with its standard
+  error from the line's residual.
 
 Offers
 ------
