@@ -27,6 +27,7 @@ import xarray as xr
 from shadowcam.outdoor.accuracy import PRIMARY_DEFINITION, evaluate_arrivals, map_to_truth_camera
 from shadowcam.outdoor.arrival import arrival_map
 from shadowcam.outdoor.edges import track_edges
+from shadowcam.outdoor.half_level import half_level_crossings
 from shadowcam.outdoor.photometric import luminance
 from shadowcam.outdoor.photometry import photometry_from_frames
 from shadowcam.synthetic.outdoor.capture import render_outdoor_capture
@@ -40,22 +41,11 @@ LUMINANCE_NOISE = 0.68
 
 
 def half_level_crossing(fraction, times, *, pixels, half_window):
-    """Last downward crossing of 0.5 of ``(T, H, W)`` sun fractions, a line over +-k frames."""
+    """Last downward crossing of 0.5 of ``(T, H, W)`` sun fractions (:func:`half_level_crossings`)."""
     out = np.full(fraction.shape[1:], np.nan)
-    for r, c in zip(*np.nonzero(pixels)):
-        s = fraction[:, r, c]
-        above = s >= 0.5
-        idx = np.nonzero(above[:-1] & ~above[1:])[0]
-        if idx.size == 0:
-            continue
-        j = idx[-1]
-        a, b = max(0, j - half_window + 1), min(len(s), j + half_window + 1)
-        if b - a >= 3:
-            slope, offset = np.polyfit(times[a:b], s[a:b], 1)
-            if slope < 0:
-                out[r, c] = (0.5 - offset) / slope
-                continue
-        out[r, c] = times[j] + (s[j] - 0.5) / (s[j] - s[j + 1]) * (times[j + 1] - times[j])
+    series = fraction[:, pixels].T
+    out[pixels] = half_level_crossings(series, times, half_level=np.full(len(series), 0.5),
+                                       half_window=half_window)[0]
     return out
 
 
