@@ -254,7 +254,8 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
     check_same_shape({"arrival_s": arrival, "reason": reason, "ramp_centre_s": np.asarray(ramp_centre_s),
                       "ramp_state": state})
     final = (reason == REASON_CODE["edge_crossing"]) | (reason == REASON_CODE["coverage_crossing"])
-    fitted = final & np.isin(state, [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred")])
+    fitted = final & np.isin(state, [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred",
+                                                                             "half_level")])
     arrival[fitted] = np.asarray(ramp_centre_s, dtype=np.float64)[fitted]
     reason[fitted] = REASON_CODE["penumbra_fit"]
     for name, code in (("cut", "ramp_cut"), ("ambiguous", "ambiguous_ramp")):

@@ -80,6 +80,7 @@ def photometry_arrays(dataset):
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),
         "lit_level": dataset["lit_level"].values,
         "shadow_level": dataset["shadow_level"].values,
+        "shadow_ratio": dataset.attrs.get("shadow_ratio"),
     }
 
 

@@ -26,6 +26,16 @@ centre and lit level are fitted (``cut_centred``). Ramps whose centre is after t
 frame or that have no confident neighbours (``cut``) and uncertain fits that contradict the
 crossing (``ambiguous``) get no time.
 
+The law describes a straight skyline crossed at a constant speed; over a long penumbra the sun
+moves along a sloping, curved skyline and a pixel's footprint may be reached in steps. With
+the capture's shadow-to-lit ratio given (and the buffer keeping the exposure-normalised
+luminance), a ramp that spans several frames and starts on its lit plateau is timed by the
+crossing of its half level instead (:mod:`shadowcam.outdoor.half_level`, state
+``half_level``): no law, only the lit level and the shadow level (its own plateau after the
+ramp, or the lit level times the ratio). A ramp already under way at the start of its record
+that the law could not fit with certainty has no lit level: no time (``ambiguous``), and its
+level crossing, whose lit level is too low, does not stand in.
+
 Every step but the neighbours' duration and shadow level is per pixel; those read
 ``radius`` columns each side, within the halo of a column strip
 (:mod:`shadowcam.outdoor.strips`), and ``radius`` or ``cut_rows`` rows (a strip holds
@@ -41,14 +51,19 @@ fit_descents : per-pixel centre, duration, uncertainty and state of the final de
 import numpy as np
 
 from shadowcam._shared.validation import check_positive
+from shadowcam.outdoor.half_level import half_level_crossings, half_levels
 from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, neighbour_median
 
 #: ramp state code -> meaning
 RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: "cut", 5: "ambiguous",
-               6: "cut_centred"}
+               6: "cut_centred", 7: "half_level"}
 STATE_CODE = {name: code for code, name in RAMP_STATES.items()}
 #: pixels each side whose fitted durations steady a noisy ramp (:func:`fit_descents`)
 NEIGHBOUR_RADIUS = 3
+#: samples each side of the half level whose line gives the rate of a descent that does not start on its plateau
+UNDER_WAY_WINDOW = 3
+#: largest drop (share of the contrast) over the interval around a resolved ramp's centre: 4 / (pi 3)
+RESOLVED_STEP = 4.0 / (np.pi * 3)
 #: pixels fitted at once (bounds the (N, K) float64 series gathered from the buffer)
 _CHUNK = 4096
 
@@ -62,26 +77,39 @@ class DescentBuffer:
         ``(H, W)``.
     frames : int, keyword-only
         ``K``: frames kept per pixel (even; ``K // 2`` each side of the crossing).
+    luminance : bool, keyword-only
+        Also keep the exposure-normalised luminance of the same frames (``K`` more float16
+        values per pixel), whose levels give the half-level crossing
+        (:mod:`shadowcam.outdoor.half_level`).
     """
 
-    def __init__(self, shape, *, frames=128):
+    def __init__(self, shape, *, frames=128, luminance=False):
         shape = tuple(int(n) for n in shape)
         if int(frames) < 4:
             raise ValueError(f"frames must be >= 4; got {frames}")
         self.size = int(frames)
         self.values = np.full((self.size, *shape), np.nan, dtype=np.float16)
+        self.luminance = np.full((self.size, *shape), np.nan, dtype=np.float16) if luminance else None
         self.count = np.zeros(shape, dtype=np.int32)  # consecutive frames held (<= K)
         self.last = np.full(shape, -1, dtype=np.int32)  # frame index of the newest value held
         self.frozen = np.zeros(shape, dtype=bool)
         self._dark_frames = np.zeros(shape, dtype=np.int32)
         self._k = 0
 
-    def update(self, cover, *, dark):
-        """Add the next frame's coverage ``(H, W)``; `dark` ``(H, W)`` marks the pixels in a dark episode."""
+    def update(self, cover, *, dark, luminance=None):
+        """Add the next frame's coverage ``(H, W)``; `dark` ``(H, W)`` marks the pixels in a dark episode.
+
+        `luminance` ``(H, W)`` is the frame's exposure-normalised luminance (required when the
+        buffer keeps it).
+        """
         cover = np.asarray(cover)
         dark = np.asarray(dark, dtype=bool)
         if cover.shape != self.count.shape or dark.shape != self.count.shape:
             raise ValueError(f"cover {cover.shape} and dark {dark.shape} must have shape {self.count.shape}")
+        if (self.luminance is not None) != (luminance is not None):
+            raise ValueError("luminance must be given exactly when the buffer keeps it (DescentBuffer(luminance=True))")
+        if luminance is not None and np.shape(luminance) != self.count.shape:
+            raise ValueError(f"luminance {np.shape(luminance)} must have shape {self.count.shape}")
         k = self._k
         self._dark_frames = np.where(dark, self._dark_frames + 1, 0)
         restart = self.frozen & ~dark  # the episode ended: it was not the final one
@@ -89,13 +117,17 @@ class DescentBuffer:
         self.frozen &= dark
         write = ~self.frozen
         np.copyto(self.values[k % self.size], cover, where=write, casting="unsafe")
+        if luminance is not None:
+            np.copyto(self.luminance[k % self.size], luminance, where=write, casting="unsafe")
         self.count[write] = np.minimum(self.count[write] + 1, self.size)
         self.last[write] = k
         self.frozen |= dark & (self._dark_frames >= self.size // 2)
         self._k += 1
 
-    def series(self, rows, cols):
+    def series(self, rows, cols, *, record="coverage"):
         """The held values of pixels ``(rows, cols)`` in time order.
+
+        `record` is ``"coverage"`` or ``"luminance"`` (kept when the buffer was made with it).
 
         Returns
         -------
@@ -108,7 +140,10 @@ class DescentBuffer:
         last = self.last[rows, cols].astype(np.int64)[:, None]
         frame = last - (self.size - 1) + j[None, :]
         held = j[None, :] >= self.size - self.count[rows, cols][:, None]
-        values = self.values[np.mod(frame, self.size), rows[:, None], cols[:, None]].astype(np.float64)
+        if record not in ("coverage", "luminance") or (record == "luminance" and self.luminance is None):
+            raise ValueError(f"record must be 'coverage' or, kept with luminance=True, 'luminance'; got {record!r}")
+        source = self.values if record == "coverage" else self.luminance
+        values = source[np.mod(frame, self.size), rows[:, None], cols[:, None]].astype(np.float64)
         values[~held] = np.nan
         return values, np.where(held, frame, -1)
 
@@ -125,7 +160,55 @@ def _fit(buffer, rows, cols, time_s, centre, interval, duration=None, shadow=Non
     return {key: np.concatenate([o[key] for o in out]) for key in out[0]} if out else None
 
 
-def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS, cut_rows=0, speed_change=False):
+def _half_level(buffer, time_s, centre, sigma, state, duration, *, shadow_ratio, limit, interval):
+    """Time the ramps that span several frames and start on their lit plateau by their half level (in place).
+
+    A ramp the law found shorter than the sampling resolves (``short``) is taken too when the
+    two samples around its half-level crossing show that it is not: they drop by less than
+    the disc law's ``4 / (pi n)`` of the contrast over an interval at its centre, ``n`` the
+    law fit's ``min_samples`` (3). Such a ramp, or one the law could not fit with certainty
+    (``ambiguous``), that was already under way at the start of its record has no lit level
+    and no time (``ambiguous``; the returned mask keeps the level crossing from standing in).
+
+    Returns
+    -------
+    (H, W) bool ndarray
+        The ramps under way at the start of their record.
+    """
+    begun = np.zeros(state.shape, dtype=bool)
+    rows, cols = np.nonzero(state >= STATE_CODE["short"])
+    for a in range(0, rows.size, _CHUNK):
+        r, c = rows[a:a + _CHUNK], cols[a:a + _CHUNK]
+        values, frame = buffer.series(r, c, record="luminance")
+        t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
+        levels = half_levels(values, t, shadow_ratio=shadow_ratio)
+        probe = np.where(levels["lit_seen"], levels["half"], levels["lit"] - 0.5 * levels["contrast"])
+        with np.errstate(invalid="ignore"):  # a line over an eighth of the fitted duration each side
+            k = np.where(state[r, c] > STATE_CODE["short"], np.rint(0.125 * duration[r, c] / interval), 1)
+        k = np.clip(np.nan_to_num(k, nan=1.0), 1, None).astype(np.int64)
+        # a descent that does not start on its plateau: a wider line for its rate at the centre
+        k = np.where(levels["lit_seen"], k, np.maximum(k, UNDER_WAY_WINDOW))
+        crossing, error, step, rate = half_level_crossings(values, t, half_level=probe, half_window=k)
+        with np.errstate(invalid="ignore"):
+            long_ramp = step < RESOLVED_STEP * levels["contrast"]
+        resolved = (state[r, c] > STATE_CODE["short"]) | long_ramp
+        ok = levels["lit_seen"] & np.isfinite(crossing) & (error <= limit) & resolved
+        centre[r[ok], c[ok]], sigma[r[ok], c[ok]] = crossing[ok], error[ok]
+        state[r[ok], c[ok]] = STATE_CODE["half_level"]
+        # under way at the record's start: descending there, and the ramp's duration at its centre
+        # (the disc law's slope 4 / (pi D) of the contrast) reaches back to the start
+        with np.errstate(invalid="ignore", divide="ignore"):
+            reach = 4.0 / np.pi * levels["contrast"] / -rate
+            first = np.nanmin(t, axis=1)
+            under_way = (levels["under_way"] & long_ramp & (crossing - first <= reach)
+                         & np.isin(state[r, c], [STATE_CODE["short"], STATE_CODE["ambiguous"]]))
+        state[r[under_way], c[under_way]] = STATE_CODE["ambiguous"]
+        begun[r[under_way], c[under_way]] = True
+    return begun
+
+
+def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS, cut_rows=0, speed_change=False,
+                 shadow_ratio=None):
     """Fit the penumbra law to every pixel's final descent.
 
     Parameters
@@ -148,11 +231,18 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
     speed_change : bool, keyword-only
         Fit the ramps whose duration is free with an edge speed that changes linearly over
         the ramp (:func:`shadowcam.outdoor.penumbra.fit_ramps`).
+    shadow_ratio : float, optional, keyword-only
+        The capture's shadow-to-lit ratio (the first pass's). Given (with a buffer that keeps
+        the luminance), the ramps the law was fitted to (not ``short``) that start on their
+        lit plateau are timed by their half-level crossing instead
+        (:mod:`shadowcam.outdoor.half_level`; state ``half_level``), when its standard
+        error is at most `max_sigma` intervals.
 
     Returns
     -------
     dict of (H, W) ndarray
-        ``ramp_centre_s`` (NaN unless state fitted / neighbours_duration / cut_centred), ``ramp_duration_s``,
+        ``ramp_centre_s`` (NaN unless state fitted / neighbours_duration / cut_centred / half_level),
+        ``ramp_duration_s``,
         ``ramp_sigma_s`` (float32) and ``ramp_state`` (uint8, :data:`RAMP_STATES`).
     """
     crossing = np.asarray(crossing_s, dtype=np.float64)
@@ -223,12 +313,20 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
             duration[r[ok], c[ok]] = nbr_duration[known][ok]
             sigma[r[ok], c[ok]] = refit["sigma_s"][ok]
             state[r[ok], c[ok]] = STATE_CODE["cut_centred"]
+    # a ramp that starts on its lit plateau: the crossing of its half level needs no law
+    begun = None
+    if shadow_ratio is not None:
+        begun = _half_level(buffer, time_s, centre, sigma, state, duration, shadow_ratio=shadow_ratio, limit=limit,
+                            interval=interval)
     # an uncertain fit that does not contradict the level crossing (within two standard
-    # errors) leaves it standing; one that does gives no time
+    # errors) leaves it standing; one that does, or a ramp under way at its record's start
+    # (the crossing's lit level is then too low), gives no time
     with np.errstate(invalid="ignore"):
         agrees = (state == STATE_CODE["ambiguous"]) & (np.abs(centre - crossing) <= 2.0 * sigma)
+    if begun is not None:
+        agrees &= ~begun
     state[agrees] = STATE_CODE["short"]
-    keep = np.isin(state, [STATE_CODE["fitted"], STATE_CODE["neighbours_duration"], STATE_CODE["cut_centred"]])
+    keep = np.isin(state, [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred", "half_level")])
     out["ramp_centre_s"] = np.where(keep, centre, np.nan).astype(np.float32)
     out["ramp_duration_s"] = np.where(state > 0, duration, np.nan).astype(np.float32)
     out["ramp_sigma_s"] = np.where(state > 0, sigma, np.nan).astype(np.float32)

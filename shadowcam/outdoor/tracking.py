@@ -12,8 +12,8 @@ the column's most recent edge (tracking), and the dark episodes of every pixel a
 accumulated (:class:`shadowcam.outdoor.episodes.ShadowEpisodes`), with each pixel's final
 descent, whose penumbra ramp is fitted at the end (:mod:`shadowcam.outdoor.descent`). The lit level of each
 pixel follows slow shading changes (the sun moves) while the pixel is fully lit and well
-above the edge. Memory is a few ``(H, W)`` arrays, ``E`` episode slots and ``descent_frames``
-float16 values per pixel and the ``(T, W)`` edges.
+above the edge. Memory is a few ``(H, W)`` arrays, ``E`` episode slots and twice ``descent_frames``
+float16 values per pixel (coverage and luminance) and the ``(T, W)`` edges.
 
 Every step but the frame differencing's widening (``margin`` columns), the episodes'
 neighbour count (one pixel each side), the ramps' neighbours' duration (three pixels) and the
@@ -54,8 +54,10 @@ class EdgeTracker:
     ----------
     photometry : mapping
         ``shift (T, 2)``, ``gain_lit (T,)``, ``gain_sky (T,)``, ``sky``,
-        ``lit_at_start``, ``lit_level``, ``shadow_level`` ``(H, W)``
-        (the result of :func:`shadowcam.outdoor.normalise.normalise_frames`).
+        ``lit_at_start``, ``lit_level``, ``shadow_level`` ``(H, W)`` and, optionally,
+        ``shadow_ratio`` (the result of :func:`shadowcam.outdoor.normalise.normalise_frames`):
+        with it the final descents keep their exposure-normalised luminance too and the long
+        ramps are timed by their half-level crossing (:mod:`shadowcam.outdoor.half_level`).
     time_s : (T,) ndarray
         Frame times in seconds.
     half_window : int, optional
@@ -127,7 +129,9 @@ class EdgeTracker:
         self.band_count = np.zeros(n_frames, dtype=np.int64)
         self.valid_count = int(self.valid[self._counted].sum())
         self.episodes = ShadowEpisodes((height, width), eligible=self.lit_at_start & self.valid)
-        self.descent = DescentBuffer((height, width), frames=descent_frames)
+        ratio = photometry.get("shadow_ratio")
+        self.shadow_ratio = float(ratio) if ratio is not None and np.isfinite(ratio) else None
+        self.descent = DescentBuffer((height, width), frames=descent_frames, luminance=self.shadow_ratio is not None)
         self.max_sigma = float(max_sigma)
         self._previous = None
         self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
@@ -155,7 +159,8 @@ class EdgeTracker:
         found = np.isfinite(self.edge_row[k])
         self._last_edge[found] = self.edge_row[k][found]
         self.episodes.update(cover, self.time_s[k])
-        self.descent.update(cover, dark=self.episodes.dark & np.isfinite(self.episodes.start))
+        self.descent.update(cover, dark=self.episodes.dark & np.isfinite(self.episodes.start),
+                            luminance=None if self.shadow_ratio is None else shadow + cover * (self.lit_level - shadow))
         if self.lit_update > 0:
             with np.errstate(invalid="ignore"):
                 far = ~(self._centre > self.edge_row[k][None, :] - self.update_distance)
@@ -178,7 +183,7 @@ class EdgeTracker:
             "band_fraction": self.band_fraction,
             **episodes,
             **fit_descents(self.descent, episodes["coverage_arrival_s"], self.time_s, max_sigma=self.max_sigma,
-                           cut_rows=self._edge_width),
+                           cut_rows=self._edge_width, shadow_ratio=self.shadow_ratio),
         }
 
 

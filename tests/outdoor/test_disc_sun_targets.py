@@ -22,8 +22,9 @@ from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance,
 pytestmark = pytest.mark.slow
 
 
-def _disc_sun_accuracy(*, height, width, frames, cloud, seed=3):
-    scene = make_outdoor_scene(seed=seed, height=height, width=width)
+def _disc_sun_accuracy(*, height, width, frames, cloud, seed=3, elevations=(20.0, 1.5)):
+    scene = make_outdoor_scene(seed=seed, height=height, width=width, start_elevation_deg=elevations[0],
+                               end_elevation_deg=elevations[1])
     capture = render_outdoor_capture(scene, frames=frames, supersample=2, seed=seed,
                                      sun_diameter_deg=SUN_DIAMETER_DEG, cloud=cloud)
     truth = capture.ground_truth
@@ -58,3 +59,16 @@ def test_disc_sun_renders_meet_the_nuisance_targets(case):
     assert stats["coverage"] > 0.9
     failed = [t for t in report["targets"] if not t["pass"]]
     assert not failed, failed
+
+
+def test_long_penumbrae_at_a_photographers_cadence():
+    # the sun 8.0 -> 7.2 deg in 96 frames: each pixel's penumbra lasts ~55 intervals, most ramps
+    # begin before the first frame or end after the last; the nuisance targets are not met
+    # (docs/benchmarks.md, "Outdoor arrival from the half level"): bounds at the figures reached
+    # (0.96 / 13.8 / 13.7 %, coverage 77 %; before the half level 1.78 / 20.6 / 28.5 %, 80 %)
+    report, penumbra_intervals = _disc_sun_accuracy(height=128, width=192, frames=96, cloud=True,
+                                                    elevations=(8.0, 7.2))
+    assert penumbra_intervals > 40
+    stats = report["errors"]["combined"][PRIMARY_DEFINITION]
+    assert stats["median_abs"] <= 1.1 and stats["p95_abs"] <= 15.0 and stats["frac_over_5"] <= 0.15
+    assert stats["coverage"] >= 0.72

@@ -25,11 +25,12 @@ IMAGE_BYTES_PER_PIXEL = 2000
 #: (`make bench-outdoor-size`: benchmarks/bench<N>/<rule>.tsv max_rss at 24 MP; tracking
 #: and per-pixel steps: tracemalloc peaks per pixel, docs/benchmarks.md "Outdoor arrival",
 #: plus 30%; tracking also keeps each pixel's final descent, track_edges.descent_frames
-#: float16 values (128: 256 bytes per pixel), and fits it in batches of 4096 pixels)
+#: float16 values of coverage and as many of luminance (128: 512 bytes per pixel), and
+#: fits it in batches of 4096 pixels)
 OUTDOOR_MEM_MB = {
     "normalise": (400, 85),
-    "track": (500, 460),
-    "track_strip": (500, 460),
+    "track": (500, 800),
+    "track_strip": (500, 800),
     "per_pixel": (400, 110),
 }
 #: seconds per frame and megapixel of the outdoor steps on one core

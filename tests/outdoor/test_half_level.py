@@ -1,0 +1,136 @@
+"""The half-level crossing: the levels of a final descent, and the time half the sun's disc is hidden."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from shadowcam.outdoor.half_level import end_level, half_level_crossings, half_levels
+from shadowcam.outdoor.penumbra import visible_fraction
+from shadowcam.outdoor.photometric import luminance
+from shadowcam.synthetic.outdoor.render import (frame_radiance, make_outdoor_scene, sample_grid, sun_lit_fraction,
+                                                trace_samples)
+
+INTERVAL = 5.0
+TIMES = np.arange(128) * INTERVAL
+LIT, SHADOW = 0.45, 0.04
+
+
+def _descent(centre_s, first_s, second_s=None, *, times=TIMES):
+    """A disc ramp whose edge moves at one speed until half the disc is hidden and at another after.
+
+    ``first_s`` and ``second_s``: the durations of its halves (s); the constant-speed law has them equal.
+    """
+    second_s = first_s if second_s is None else second_s
+    dt = times - centre_s
+    u = np.where(dt < 0, dt / first_s, dt / np.asarray(second_s))
+    return SHADOW + (LIT - SHADOW) * visible_fraction(u)
+
+
+def test_end_level_tells_a_plateau_from_a_ramp_under_way():
+    rng = np.random.default_rng(0)
+    flat = 0.4 + rng.normal(0.0, 0.005, (200, 60))
+    level, plateau, _ = end_level(flat, TIMES[:60], side="start")
+    assert np.abs(level - 0.4).max() < 4 * 0.005 / np.sqrt(10)  # mean of the first 10 samples
+    assert 0.90 <= plateau.mean() <= 0.99  # a 2-standard-error test on a true plateau
+    # a ramp under way: the first 10 samples descend by 0.75 % of the level per interval (5 standard errors)
+    ramp = flat - 0.003 * np.arange(60)[None, :]
+    _, plateau, slope = end_level(ramp, TIMES[:60], side="start")
+    assert plateau.mean() < 0.05 and (slope < 0).all()
+    level, plateau, _ = end_level(ramp, TIMES[:60], side="end")
+    np.testing.assert_allclose(level, 0.4 - 0.003 * np.arange(50, 60).mean(), atol=4 * 0.005 / np.sqrt(10))
+
+
+@pytest.mark.parametrize(("first", "second"), [(19, 19), (38, 19), (10, 30), (4, 4)])
+def test_the_half_level_crossing_needs_no_law_of_the_ramp(first, second):
+    # the edge's speed changes between the halves of the ramp (the sun along a curved skyline);
+    # half the disc is hidden at the centre all the same
+    centre = np.array([52.3, 60.0, 67.8]) * INTERVAL
+    series = _descent(centre[:, None], first * INTERVAL, second * INTERVAL)
+    levels = half_levels(series, TIMES, shadow_ratio=0.5)  # both plateaus seen: the ratio is not used
+    assert levels["lit_seen"].all() and levels["own_shadow"].all()
+    np.testing.assert_allclose(levels["half"], 0.5 * (LIT + SHADOW), rtol=1e-12)
+    duration = first + second
+    k = max(1, round(duration / 8))
+    crossing, sigma, _, _ = half_level_crossings(series, TIMES, half_level=levels["half"], half_window=k)
+    # a line over +-k samples across a change of rate a -> b is off by (b - a) / (a + b) times
+    # the mean distance k / 2 of its samples from the centre: 0 for one speed
+    bound = 1.1 * abs(second - first) / duration * k / 2 + 0.02  # with 10 % for the law's curvature
+    assert np.abs(crossing - centre).max() / INTERVAL <= bound
+    # with k = 1 the crossing is between the two samples, with no standard error
+    assert np.isfinite(sigma).all() if k > 1 else np.isinf(sigma).all()
+
+
+def test_a_ramp_cut_by_the_end_takes_its_shadow_level_from_the_ratio():
+    centre = np.array([110.0, 114.5]) * INTERVAL  # 40-frame ramps: the record ends at 2/3 and 1/2 of them
+    series = _descent(centre[:, None], 20 * INTERVAL)
+    levels = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)
+    assert levels["lit_seen"].all() and not levels["own_shadow"].any()
+    np.testing.assert_allclose(levels["half"], 0.5 * (LIT + SHADOW), rtol=1e-12)
+    crossing, _, _, _ = half_level_crossings(series, TIMES, half_level=levels["half"], half_window=5)
+    np.testing.assert_allclose(crossing, centre, atol=0.02 * INTERVAL)
+    # a record ending before half the disc was hidden: no crossing, no time
+    early = _descent(130.0 * INTERVAL, 20 * INTERVAL)[None, :]
+    half = half_levels(early, TIMES, shadow_ratio=SHADOW / LIT)["half"]
+    crossing, _, _, _ = half_level_crossings(early, TIMES, half_level=half, half_window=5)
+    assert np.isnan(crossing).all()
+
+
+def test_a_ramp_under_way_at_the_start_has_no_half_level():
+    series = _descent(np.array([[8.0 * INTERVAL]]), 20 * INTERVAL)  # begun 12 frames before the record
+    levels = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)
+    assert not levels["lit_seen"][0] and levels["under_way"][0] and np.isnan(levels["half"][0])
+
+
+@settings(max_examples=25, deadline=None)
+@given(duration=st.integers(24, 60), phase=st.floats(0.0, 1.0), seed=st.integers(0, 2**16))
+def test_noisy_crossings_are_within_their_standard_errors(duration, phase, seed):
+    rng = np.random.default_rng(seed)
+    centre = (50.0 + phase) * INTERVAL
+    clean = _descent(centre, 0.5 * duration * INTERVAL)
+    series = clean[None, :] + rng.normal(0.0, 0.004, (400, TIMES.size))
+    levels = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)
+    k = max(1, round(duration / 8))
+    crossing, sigma, _, _ = half_level_crossings(series, TIMES, half_level=levels["half"], half_window=k)
+    ok = np.isfinite(crossing)
+    assert ok.mean() > 0.85  # a plateau test of 2 standard errors at each end misses ~5 % each
+    z = np.abs(crossing[ok] - centre) / sigma[ok]
+    # the line's standard error (k >= 3: 4 or more degrees of freedom; the levels' error is not in it)
+    assert np.mean(z <= 3.0) > 0.85
+
+
+def test_levels_against_the_renderers_exact_levels():
+    # a sunset at a photographer's cadence: penumbrae of tens of frames
+    rows, cols = 64, 96
+    scene = make_outdoor_scene(seed=3, height=rows, width=cols, start_elevation_deg=8.0, end_elevation_deg=7.2)
+    samples = trace_samples(scene, *sample_grid(rows, cols, 1))
+    times = np.linspace(0.0, scene.duration_s, 96)
+    ones = np.ones(len(samples.sky))
+    shown, lit, sky = [], [], []
+    for t in times:
+        frac = sun_lit_fraction(samples, scene.sun, t)
+        shown.append(luminance(frame_radiance(samples, scene, t, shape=(rows, cols), supersample=1, lit=frac)[0]))
+        lit.append(luminance(frame_radiance(samples, scene, t, shape=(rows, cols), supersample=1, lit=ones)[0]))
+        sky.append(luminance(frame_radiance(samples, scene, t, shape=(rows, cols), supersample=1, lit=0 * ones)[0]))
+    shown, lit, sky = (np.stack(a).reshape(times.size, -1).T for a in (shown, lit, sky))
+    # the photometry holds the lit level steady: the series over the pixel's own lit-level drift
+    drift = lit / lit[:, :1]
+    noise = np.random.default_rng(3).normal(0.0, 0.003, shown.shape) * lit[:, :1]  # a 14-bit capture's, about
+    y, exact_lit, exact_shadow = shown / drift + noise, lit[:, 0], sky / drift
+    with np.errstate(invalid="ignore", divide="ignore"):  # sky pixels: no sun term
+        fraction = (shown - sky) / (lit - sky)
+    # pixels whose whole penumbra is in the record, with the levels' samples (10) before and after it
+    descends = (fraction[:, :12] > 0.999).all(1) & (fraction[:, -12:] < 0.001).all(1) & (lit[:, 0] > 0)
+    assert descends.sum() >= 10
+    assert np.median(np.sum((fraction > 0.001) & (fraction < 0.999), axis=1)[descends]) > 10  # frames of penumbra
+    levels = half_levels(y[descends], times, shadow_ratio=0.1)
+    exact_half = 0.5 * (exact_lit[descends] + exact_shadow[descends, -1])
+    contrast = exact_lit[descends] - exact_shadow[descends, -1]
+    seen = levels["lit_seen"] & levels["own_shadow"]
+    assert seen.mean() > 0.8
+    assert np.abs(levels["half"] - exact_half)[seen].max() < 0.005 * contrast[seen].min()
+    # the crossing against the exact levels' crossing of half the disc hidden, per frame
+    interval = times[1] - times[0]
+    crossing, _, _, _ = half_level_crossings(y[descends], times, half_level=levels["half"], half_window=3)
+    truth, _, _, _ = half_level_crossings(fraction[descends], times, half_level=np.full(descends.sum(), 0.5), half_window=1)
+    assert np.abs(crossing - truth)[seen].max() / interval < 0.3
