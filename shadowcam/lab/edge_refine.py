@@ -27,6 +27,11 @@ variances, as for nested least squares), estimates the squared bias
 curvature on that scale), then clipped at 0. A clean centroid on a curved surface is kept; on
 a plane, or where the pixel's own estimate is noisy, the plane takes over.
 
+A pixel's dip is timed where the shadow line crosses its flux centroid, not its
+centre. Given each pixel's centroid shift (a camera fact: its footprint over the
+lit image), the times are first taken to the centres with the slopes of a first
+plane fit (:func:`centre_times`), and the refinement runs on the centred map.
+
 Offers
 ------
 refine_times : local robust plane fit of a time map, combined with the pixel's own time.
