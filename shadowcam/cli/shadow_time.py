@@ -20,7 +20,9 @@ run : compute and write the dataset.
 
 from shadowcam._shared.coverage import MIN_COVERAGE
 from shadowcam.cli.options import parse_params
+from shadowcam.io.capture_plan import footprint_variance
 from shadowcam.io.datasets import write_dataset
+from shadowcam.io.manifest import load_manifest
 from shadowcam.io.frame_store import open_frames
 from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, shadow_time_of_stores
 
@@ -33,6 +35,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--method", default="edge_fit", choices=sorted(SHADOW_TIME_METHODS),
                         help="how each pixel's sub-frame shadow time is found (default edge_fit)")
     parser.add_argument("--params", default="{}", help="JSON: half_window, method_params, classify_params, min_coverage")
+    parser.add_argument("--manifest", help="capture description: its sensor.footprint_variance_px2 (if any) "
+                        "is edge_fit's footprint_variance unless --params sets one")
     parser.add_argument("--partials", nargs="+", action="append", metavar="SWEEP FILE",
                         help="a sweep name and the partial files of all its time chunks (repeat per sweep); "
                              "default: stream the frames")
@@ -51,9 +55,14 @@ def run(args):
         raise ValueError(f"--partials must name each of the sweeps {sorted(args.sweeps)} once, each with "
                          f"its partial files; got {sorted(partials)}")
     stores = {sweep: open_frames(path) for path, sweep in zip(args.frames, args.sweeps)}
+    method_params = dict(params.get("method_params") or {})
+    if args.manifest and args.method == "edge_fit" and "footprint_variance" not in method_params:
+        declared = footprint_variance(load_manifest(args.manifest))
+        method_params.update({} if declared is None else {"footprint_variance": declared})
     dataset = shadow_time_of_stores(stores, method=args.method, partials=partials,
-                                    half_window=params.get("half_window", 4), method_params=params.get("method_params"),
+                                    half_window=params.get("half_window", 4), method_params=method_params,
                                     classify_params=params.get("classify_params"),
                                     min_coverage=params.get("min_coverage", MIN_COVERAGE))
-    write_dataset(dataset, args.out, config={"method": args.method, **params}, inputs=tuple(stores.values()),
+    write_dataset(dataset, args.out, config={"method": args.method, **params, "method_params": method_params},
+                  inputs=tuple(stores.values()),
                   step="shadow-time")

@@ -35,6 +35,7 @@ CapturePlan : the plan of one capture (frozen dataclass).
 LIGHTFIELD_SWEEPS : sweep suffix -> mask axis the wire moves along, of a light-field screen.
 lightfield_facts : the screens, sweeps and brackets of a ``kind: lightfield`` manifest.
 capture_plan : read a manifest into a :class:`CapturePlan`.
+footprint_variance : a lab capture's declared pixel footprint variance (``sensor.footprint_variance_px2``).
 """
 
 import inspect
@@ -620,3 +621,27 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         has_calibration=calibration,
         **facts,
     )
+
+
+def footprint_variance(manifest):
+    """A lab capture's pixel footprint variance, px^2 per axis, as its description declares it.
+
+    Parameters
+    ----------
+    manifest : dict
+        A loaded manifest (:func:`shadowcam.io.manifest.load_manifest`).
+
+    Returns
+    -------
+    float or None
+        ``sensor.footprint_variance_px2``; None where the description declares none (the
+        dips are then taken as timed at the pixel centres).
+    """
+    value = (manifest.get("sensor") or {}).get("footprint_variance_px2")
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value) or value < 0:
+        raise ValueError(f"manifest {manifest.get('manifest_path', '')}: key 'sensor.footprint_variance_px2' "
+                         f"must be a number >= 0 (px^2); got {value!r}: give the footprint's per-axis "
+                         "second moment (1/12 for a box pixel) or leave the key out")
+    return float(value)

@@ -27,9 +27,15 @@ variances, as for nested least squares), estimates the squared bias
 curvature on that scale), then clipped at 0. A clean centroid on a curved surface is kept; on
 a plane, or where the pixel's own estimate is noisy, the plane takes over.
 
+A pixel's dip is timed where the shadow line crosses its flux centroid, not its
+centre. Given each pixel's centroid shift (a camera fact: its footprint over the
+lit image), the times are first taken to the centres with the slopes of a first
+plane fit (:func:`centre_times`), and the refinement runs on the centred map.
+
 Offers
 ------
 refine_times : local robust plane fit of a time map, combined with the pixel's own time.
+centre_times : times at the pixel centres from times at the pixels' flux centroids.
 dispersion : common scale of the stated variances from the local quadratic fits.
 shifted : an image shifted by a neighbour offset, filled outside.
 """
@@ -130,7 +136,8 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
 
     Returns, each ``(H, W)`` float64, NaN where the pixel has no time or no
     plane: the plane's value ``a`` at the pixel and its variance under the
-    stated variances; the local dispersion (chi-square per degree of freedom
+    stated variances; its slopes ``b, c`` (frames per px along rows and
+    columns; NaN where the plane is undetermined) and their variances; the local dispersion (chi-square per degree of freedom
     about the quadratic, corrected for the range kernel's down-weighting of
     large residuals; inf where they exceed the kernel's scale), the quadratic's
     value at the pixel and its variance (NaN where the quadratic is
@@ -142,12 +149,14 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
     phi_out = np.full((h, w), np.nan)
     quad_out = np.full((h, w), np.nan)
     quad_var_out = np.full((h, w), np.nan)
+    slope_out = np.full((h, w, 2), np.nan)
+    slope_var_out = np.full((h, w, 2), np.nan)
     size = (2 * radius + 1) ** 2
     for row in nb.prange(h):
         normal = np.empty((6, 6))
         rhs = np.empty(6)
         basis = np.empty(6)
-        work = np.empty((6, 8))
+        work = np.empty((6, 10))
         n_dr = np.empty(size)
         n_dc = np.empty(size)
         n_t = np.empty(size)
@@ -232,7 +241,11 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
                     ok = False
                     break
                 _load(normal, rhs, 3, work)
-                ok = _solve(work, 3, 2 if last else 1)
+                if last:  # the slopes' variances: unit vectors e1, e2 as two more columns
+                    for i in range(3):
+                        work[i, 8] = 1.0 if i == 1 else 0.0
+                        work[i, 9] = 1.0 if i == 2 else 0.0
+                ok = _solve(work, 3, 4 if last else 1)
                 if not ok:  # too few or collinear neighbours: the weighted mean
                     c0 = rhs[0] / s_w
                     c1 = 0.0
@@ -248,6 +261,10 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
             if ok:
                 variance = work[0, 7] / work[0, 0]
                 a = a3_0
+                slope_out[row, col, 0] = work[1, 6] / work[1, 1]
+                slope_out[row, col, 1] = work[2, 6] / work[2, 2]
+                slope_var_out[row, col, 0] = work[1, 8] / work[1, 1]
+                slope_var_out[row, col, 1] = work[2, 9] / work[2, 2]
             else:
                 variance = 1.0 / s_w
                 a = c0
@@ -273,7 +290,7 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
             phi_out[row, col] = phi
             quad_out[row, col] = a_quad
             quad_var_out[row, col] = var_quad
-    return plane_out, var_out, phi_out, quad_out, quad_var_out
+    return plane_out, var_out, slope_out, slope_var_out, phi_out, quad_out, quad_var_out
 
 
 def _squared_bias(gap, gap_var, radius):
@@ -322,7 +339,66 @@ def dispersion(local_phi):
     return float(np.median(finite)) if finite.size else 1.0
 
 
-def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
+def _plane(t64, inv_var, radius, range_sigma, iterations):
+    """The neighbours' plane at each pixel, with its variance and slopes, the common scale applied.
+
+    Returns ``plane, plane_var, slope, slope_var, phi`` (see :func:`_robust_plane_fit`):
+    ``plane_var`` is ``phi * var(a) + tau**2`` and ``slope_var`` is ``phi * var(b, c)``.
+    """
+    plane, plane_var, slope, slope_var, local_phi, quad, quad_var = _robust_plane_fit(
+        t64, inv_var, int(radius), float(range_sigma), max(int(iterations), 1))
+    phi = dispersion(local_phi)
+    tau2 = _squared_bias(plane - quad, phi * (quad_var - plane_var), int(radius))
+    return plane, phi * plane_var + tau2, slope, phi * slope_var, phi
+
+
+def centre_times(time, time_std, slope, slope_var, centroid_shift, *, shift_std=None):
+    """Times at the pixel centres from times at the pixels' flux centroids.
+
+    A pixel's dip is centred on the time the shadow line crosses its flux centroid, at
+    `centroid_shift` from its centre (:func:`shadowcam._shared.flux_centroid.flux_centroid_shift`).
+    With the local time gradient ``g`` (frames per px), the centre's time is
+    ``t - g . shift`` to first order.
+
+    Parameters
+    ----------
+    time, time_std : (H, W) ndarray
+        Times at the flux centroids and their standard deviations, frames; NaN: no time.
+    slope, slope_var : (H, W, 2) ndarray
+        Time gradient along rows and columns (frames per px) and its variance; NaN: unknown
+        (the time is kept).
+    centroid_shift : (H, W, 2) ndarray
+        Flux centroid minus pixel centre, px.
+    shift_std : (H, W, 2) ndarray, optional
+        Standard deviation of `centroid_shift`, px (e.g. the part of a first-order shift
+        beyond the footprint).
+
+    Returns
+    -------
+    time : (H, W) float64 ndarray
+        Centre times.
+    time_std : (H, W) float64 ndarray
+        `time_std` with the correction's uncertainty added in quadrature:
+        ``sum(shift**2 slope_var + slope**2 shift_std**2)``.
+    """
+    time = np.asarray(time, dtype=np.float64)
+    check_array(time, "time", ndim=2)
+    shape = time.shape + (2,)
+    slope = check_array(slope, "slope", shape=shape, dtype_kind="f")
+    slope_var = check_array(slope_var, "slope_var", shape=shape, dtype_kind="f")
+    centroid_shift = check_array(centroid_shift, "centroid_shift", shape=shape, dtype_kind="iuf")
+    shift_std = np.zeros(shape) if shift_std is None else check_array(shift_std, "shift_std", shape=shape,
+                                                                      dtype_kind="iuf")
+    known = np.all(np.isfinite(slope) & np.isfinite(slope_var), axis=-1)
+    g = np.where(known[..., None], slope, 0.0)
+    gv = np.where(known[..., None], slope_var, 0.0)
+    correction = np.sum(g * centroid_shift, axis=-1)
+    extra = np.sum(centroid_shift**2 * gv + g**2 * shift_std**2, axis=-1)
+    return time - correction, np.sqrt(np.asarray(time_std, dtype=np.float64) ** 2 + extra)
+
+
+def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3, centroid_shift=None,
+                 shift_std=None):
     """Edge-aware local plane fit of a shadow-time map, combined with each pixel's own time.
 
     Parameters
@@ -342,6 +418,14 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         discontinuity) are ignored.
     iterations : int, optional
         Reweighting passes (1 = plain range kernel around the pixel's own time).
+    centroid_shift : (H, W, 2) ndarray, optional
+        Where each pixel's time was measured: its flux centroid minus its centre, px. The
+        times are then first taken to the pixel centres (:func:`centre_times`, with the
+        slopes of a first plane fit, which follow the pixel's own surface across
+        discontinuities) and refined from there; the correction's uncertainty joins their
+        variance.
+    shift_std : (H, W, 2) ndarray, optional
+        Standard deviation of `centroid_shift`, px.
 
     Returns
     -------
@@ -364,12 +448,14 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
         inv_var = np.where(valid & (time_std > 0), 1.0 / time_std**2, 0.0)
     inv_var = np.nan_to_num(inv_var, nan=0.0, posinf=0.0)
 
-    plane, plane_var, local_phi, quad, quad_var = _robust_plane_fit(
-        t64, inv_var, int(radius), float(range_sigma), max(int(iterations), 1))
-    phi = dispersion(local_phi)
-    tau2 = _squared_bias(plane - quad, phi * (quad_var - plane_var), int(radius))
+    plane, plane_var, slope, slope_var, phi = _plane(t64, inv_var, radius, range_sigma, iterations)
+    if centroid_shift is not None:
+        own_std = np.sqrt(np.where(inv_var > 0, phi / np.where(inv_var > 0, inv_var, 1.0), 0.0))
+        t64, centred_std = centre_times(t64, own_std, slope, slope_var, centroid_shift, shift_std=shift_std)
+        with np.errstate(invalid="ignore", divide="ignore"):  # back to the stated scale
+            inv_var = np.where(inv_var > 0, phi / centred_std**2, 0.0)
+        plane, plane_var, _, _, phi = _plane(t64, inv_var, radius, range_sigma, iterations)
     own_var = np.where(inv_var > 0, phi / np.where(inv_var > 0, inv_var, 1.0), 0.0)
-    plane_var = phi * plane_var + tau2
     with np.errstate(invalid="ignore", divide="ignore"):
         # own_var == 0: an exact own time; plane_var == 0: an exact plane (both 0: the own time)
         w_own = np.where(own_var > 0, 1.0 / own_var, np.inf)
@@ -379,6 +465,6 @@ def refine_times(time, time_std, *, radius=3, range_sigma=0.5, iterations=3):
                                      (w_own * t64 + w_plane * plane) / (w_own + w_plane)))
         combined_std = np.sqrt(1.0 / (w_own + w_plane))
     has_plane = np.isfinite(plane)
-    refined = np.where(valid & has_plane, combined, time)
+    refined = np.where(valid & has_plane, combined, t64)
     refined_std = np.where(has_plane, combined_std, np.sqrt(own_var))
     return refined.astype(time.dtype), np.where(valid, refined_std, np.nan)

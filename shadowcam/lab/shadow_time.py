@@ -32,6 +32,7 @@ import numba as nb
 import numpy as np
 from scipy.special import ndtri
 
+from shadowcam._shared.flux_centroid import flux_centroid_shift
 from shadowcam._shared.progress import Progress
 from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
 from shadowcam._shared.validation import check_in_interval, check_positive
@@ -259,7 +260,7 @@ def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
     return time, entry, exit_, std
 
 
-def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15):
+def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15, footprint_variance=None):
     """Dip centroid combined with an edge-aware local plane fit of neighbours' times.
 
     See :func:`shadowcam.lab.edge_refine.refine_times`: each pixel's centroid
@@ -269,10 +270,17 @@ def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15):
     (the on/off staircase of a shadow that crosses a pixel within one frame);
     it sets that part's share against the centroid's noise, while the common
     scale of both is measured from the map (:func:`~shadowcam.lab.edge_refine.dispersion`).
+    `footprint_variance` (px^2 per axis, a camera fact): a dip is timed at the pixel's
+    flux centroid (:func:`shadowcam._shared.flux_centroid.flux_centroid_shift` of the lit
+    level), which the refinement takes to the pixel centre; None: at the centre.
     """
     time, entry, exit_, std = time_dip_centroid(summary)
+    shift = clipped = None
+    if footprint_variance is not None:
+        shift, clipped = flux_centroid_shift(summary.lit_level, footprint_variance=footprint_variance)
     refined, refined_std = refine_times(
-        time, np.hypot(std, floor_std), radius=radius, range_sigma=range_sigma
+        time, np.hypot(std, floor_std), radius=radius, range_sigma=range_sigma, centroid_shift=shift,
+        shift_std=None if clipped is None else np.abs(clipped)
     )
     shift = refined - time
     return refined, entry + shift, exit_ + shift, refined_std

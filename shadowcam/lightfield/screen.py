@@ -15,6 +15,7 @@ screen_positions : the validated screen entries of a light-field capture descrip
 
 import numpy as np
 
+from shadowcam._shared.flux_centroid import flux_centroid_shift
 from shadowcam._shared.validation import check_array
 
 
@@ -98,11 +99,8 @@ def flux_centroids(xy, irradiance, *, footprint_variance):
     pixel, second moment `footprint_variance` px^2 per axis). A wire's shadow darkens it at
     the flux-weighted mean of the mask coordinates over that footprint, the mask point of
     the ray through the flux-weighted centroid of the footprint, not through the pixel
-    centre. To first order in the footprint's size (any symmetric footprint) the centroid is
-    ``centre + footprint_variance * grad(E) / E`` in pixel units, ``grad`` by central
-    differences of the measured image, mapped to screen mm by the pixel grid's Jacobian. The
-    shift is clipped to the half-width of the box of that variance (``sqrt(3 var)`` px per
-    axis): a centroid lies inside the footprint.
+    centre: the pixel-unit shift of :func:`shadowcam._shared.flux_centroid.flux_centroid_shift`
+    (first order, clipped to the footprint), mapped to screen mm by the pixel grid's Jacobian.
 
     Parameters
     ----------
@@ -123,15 +121,8 @@ def flux_centroids(xy, irradiance, *, footprint_variance):
     irradiance = check_array(irradiance, "irradiance", shape=xy.shape[:2], dtype_kind="iuf").astype(np.float64)
     if xy.shape[2] != 2 or min(xy.shape[:2]) < 2:
         raise ValueError(f"xy must have shape (H, W, 2) with H, W >= 2; got {xy.shape}")
-    if not (np.isfinite(footprint_variance) and footprint_variance >= 0):
-        raise ValueError(f"footprint_variance must be a finite number >= 0 (px^2); got {footprint_variance!r}")
-    usable = np.isfinite(irradiance) & (irradiance > 0)
-    e = np.where(usable, irradiance, 0.0)
-    half_width = np.sqrt(3.0 * footprint_variance)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        shift = [np.clip(footprint_variance * np.gradient(e, axis=axis) / e, -half_width, half_width)
-                 for axis in (0, 1)]
-    shift = [np.where(usable & np.isfinite(d), d, 0.0) for d in shift]
+    shift, _ = flux_centroid_shift(irradiance, footprint_variance=footprint_variance)
+    shift = (shift[..., 0], shift[..., 1])
     return xy + shift[0][..., None] * np.gradient(xy, axis=0) + shift[1][..., None] * np.gradient(xy, axis=1)
 
 

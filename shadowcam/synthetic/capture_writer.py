@@ -157,7 +157,7 @@ def _sweep_geometry(options, scene, name):
 
 def write_lab_capture(options, out_dir):
     """Render the lab capture described by `options` into `out_dir` (see :func:`write_capture`)."""
-    from shadowcam.synthetic.lab.render import SWEEP_INDEX, prepare_capture
+    from shadowcam.synthetic.lab.render import SWEEP_INDEX, footprint_variance, prepare_capture
     from shadowcam.synthetic.lab.scenes import scene_from_description
     from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance
 
@@ -220,6 +220,7 @@ def write_lab_capture(options, out_dir):
             "timing": {"source": "rate", "rate_hz": 1.0},
             "checksums": checksums,
             "dual": {"width": scene.mask.n_u, "height": scene.mask.n_v},
+            "sensor": {"footprint_variance_px2": footprint_variance(options["supersample"])},
             "ground_truth": {"format": "shadowcam_nc", "file": "ground_truth.nc",
                              "noise": "raw12" if options["noise"] else "noise_free"},
             "provenance": (f"rendered by shadowcam {__version__} 'shadowcam render' "

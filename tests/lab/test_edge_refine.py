@@ -140,7 +140,8 @@ def _reference_fit(times, inv_var, row, col, *, radius=3, range_sigma=0.5, itera
         coef = plane
     normal3 = x[:, :3].T @ (wgt[:, None] * x[:, :3])
     normal6 = x.T @ (wgt[:, None] * x)
-    plane_fit = (own + plane[0], np.linalg.inv(normal3)[0, 0])
+    inverse3 = np.linalg.inv(normal3)
+    plane_fit = (own + plane[0], inverse3[0, 0], plane[1], plane[2], inverse3[1, 1], inverse3[2, 2])
     if kernel.sum() - 6.0 <= 1.0:  # too little weight left for the quadratic's dispersion
         return plane_fit + (np.nan, np.nan, np.nan)
     quad = np.linalg.solve(normal6, x.T @ (wgt * t))
@@ -154,7 +155,7 @@ def _reference_fit(times, inv_var, row, col, *, radius=3, range_sigma=0.5, itera
 @pytest.mark.parametrize("seed", [0, 1])
 def test_kernel_solves_the_stated_normal_equations(seed):
     # curved noisy map with a 4-frame step, missing pixels and unequal variances: every
-    # pixel's five outputs against numpy least squares on its own neighbours (borders included)
+    # pixel's outputs against numpy least squares on its own neighbours (borders included)
     from shadowcam.lab.edge_refine import _robust_plane_fit
 
     rng = np.random.default_rng(seed)
@@ -163,14 +164,16 @@ def test_kernel_solves_the_stated_normal_equations(seed):
     times[:, 9:] += 4.0
     times[rng.random(times.shape) < 0.08] = np.nan
     inv_var = np.where(np.isfinite(times), 1.0 / rng.uniform(0.1, 0.3, times.shape) ** 2, 0.0)
-    got = _robust_plane_fit(times, inv_var, 3, 0.5, 3)
+    plane, plane_var, slope, slope_var, phi, quad, quad_var = _robust_plane_fit(times, inv_var, 3, 0.5, 3)
+    got = (plane, plane_var, slope[..., 0], slope[..., 1], slope_var[..., 0], slope_var[..., 1], phi, quad,
+           quad_var)
+    names = ("plane", "plane_var", "slope_r", "slope_c", "slope_r_var", "slope_c_var", "phi", "quad", "quad_var")
     for row, col in zip(*np.nonzero(np.isfinite(times))):
         want = _reference_fit(times, inv_var, row, col)
-        for name, value, expected in zip(("plane", "plane_var", "phi", "quad", "quad_var"),
-                                          [g[row, col] for g in got], want):
+        for name, value, expected in zip(names, [g[row, col] for g in got], want):
             # times to 1e-9 frame; variances and the dispersion relative to their size
             if not np.isfinite(expected):
                 assert value == expected or np.isnan(value) and np.isnan(expected), (name, row, col, value)
                 continue
-            tol = 1e-9 if name in ("plane", "quad") else 1e-9 * abs(expected)
+            tol = 1e-9 if name in ("plane", "quad", "slope_r", "slope_c") else 1e-9 * abs(expected)
             assert abs(value - expected) <= tol, (name, row, col, value, expected)

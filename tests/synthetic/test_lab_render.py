@@ -317,3 +317,14 @@ def test_ground_truth_carries_the_straight_edge_points_of_a_squares_plane():
     on_row = np.isclose(xy[:, 1], np.round(xy[:, 1]), atol=1e-6)
     on_col = np.isclose(xy[:, 0], np.round(xy[:, 0]), atol=1e-6)
     assert np.all(on_row | on_col)
+
+
+@pytest.mark.parametrize("supersample", [1, 2, 4, 7])
+def test_declared_footprint_variance_is_the_sub_samples_second_moment(supersample):
+    from shadowcam.synthetic.lab.render import _subpixel_grid, footprint_variance
+
+    x, y = _subpixel_grid(1, 1, supersample)
+    assert footprint_variance(supersample) == pytest.approx(np.mean((x - 0.5) ** 2), abs=1e-15)
+    assert footprint_variance(supersample) == pytest.approx(np.mean((y - 0.5) ** 2), abs=1e-15)
+    with pytest.raises(ValueError, match="supersample"):
+        footprint_variance(0)

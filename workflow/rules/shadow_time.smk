@@ -2,7 +2,8 @@
 # The dips are tracked per time chunk (shadow_time_chunk, one job per sweep and decode
 # part; DipTracker owning frames START:STOP, fed half a window more on each side), and
 # shadow_time merges the partials (bit for bit the single-pass result), then classifies
-# and times every pixel.
+# and times every pixel (edge_fit takes the capture description's pixel footprint, if it
+# declares one, to time each pixel at its centre).
 
 
 rule shadow_time_chunk:
@@ -31,6 +32,7 @@ rule shadow_time:
     input:
         frames=get_frames,
         partials=get_partials,
+        capture=get_capture_input,
     output:
         "results/{ds}/shadow_time.nc",
     log:
@@ -45,10 +47,12 @@ rule shadow_time:
     params:
         sweeps=get_sweeps,
         partials=get_partials_option,
+        manifest=get_capture_manifest,
         method=config["shadow_time"]["method"],
         options=as_json(
             {**config["shadow_time"]["params"], "min_coverage": config["min_coverage"]}
         ),
     shell:
         "shadowcam shadow-time --frames {input.frames} --sweeps {params.sweeps} {params.partials}"
-        " --method {params.method} --params {params.options:q} --out {output} > {log} 2>&1"
+        " --method {params.method} --params {params.options:q} --manifest {params.manifest}"
+        " --out {output} > {log} 2>&1"

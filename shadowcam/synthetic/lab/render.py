@@ -22,6 +22,7 @@ Offers
 LightPaths : the static light paths of one view (see ``trace_light_paths``).
 trace_light_paths : cast primary and shadow rays once for a camera, light and objects.
 render_image : (rows, cols, 3) image of a view from its light paths.
+footprint_variance : per-axis second moment of a rendered pixel's footprint (its sub-samples).
 sweep_frames : (T, rows, cols, 3) frames of one wire sweep from the light paths
     (optionally with the wire pushed off its plane per frame: non-planar motion).
 pixel_centre_ground_truth : exact per-pixel GT (P, lit, shadow times, cosines, distances);
@@ -165,6 +166,19 @@ def _shade(objects, hits_sel, camera, light, to_view=None):
         radiance = f * (weights[k] * (cos_l * falloff)[:, None])
         radiance[~ok] = 0.0
         yield end, radiance, ok
+
+
+def footprint_variance(supersample):
+    """Per-axis second moment, px^2, of a pixel's footprint in the renders: its sub-samples.
+
+    A pixel is the mean of ``s x s`` point samples at the centres of equal strata; along each
+    axis they sit at ``(k + 1/2) / s - 1/2``, whose mean square is ``(s**2 - 1) / (12 s**2)``
+    (1/12, the box, as ``s`` grows; 0 for one sample at the centre).
+    """
+    s = int(supersample)
+    if s < 1:
+        raise ValueError(f"supersample must be >= 1; got {supersample}")
+    return (s * s - 1) / (12.0 * s * s)
 
 
 def trace_light_paths(objects, camera, light, *, supersample=4, optics=()):
