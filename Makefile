@@ -43,8 +43,9 @@ BENCH_DIR ?= /tmp/shadowcam-bench-outdoor
 # streaming passes hold one chunk, so the default 16 would cost 4.6 GB per job
 BENCH_CHUNK ?= 1
 # column strips of the edge-tracking pass (outdoor.edge_strips): one job holds all the per-pixel
-# state of a 24 MP frame (~3 GB); each strip job the state of its columns only
-BENCH_STRIPS ?= 4
+# state of a 24 MP frame (~600 B per pixel once the descent buffers of track_edges.descent_frames
+# frames are full, ~15 GB); each strip job the state of its columns only (6 strips: ~2.5 GB)
+BENCH_STRIPS ?= 6
 
 CMD ?=
 
