@@ -239,6 +239,59 @@ def _window_rank(smooth, p, half_window, slots):
 
 
 @nb.njit(cache=True)
+def _suffix_minima(smooth, u0, m, block_first, k_from, suffix):
+    """Suffix minima ``suffix[k] = min(frames block_first + k .. block_first + K - 1)`` for ``k >= k_from``.
+
+    Read from the smoothed ring ``(r, P)`` (frame ``f`` in slot ``f % r``),
+    pixels ``u0 .. u0 + m - 1``, NaN ignored (+inf where all are NaN);
+    `suffix` is ``(K, m)``.
+    """
+    r = smooth.shape[0]
+    n_k = suffix.shape[0]
+    row = np.uint64((block_first + n_k - 1) % r)
+    for q in range(m):
+        suffix[n_k - 1, q] = np.inf
+    for q in range(m):
+        v = smooth[row, u0 + np.uint64(q)]
+        sv = suffix[n_k - 1, q]
+        suffix[n_k - 1, q] = v if v < sv else sv
+    for k in range(n_k - 2, k_from - 1, -1):
+        row = np.uint64((block_first + k) % r)
+        for q in range(m):
+            v = smooth[row, u0 + np.uint64(q)]
+            sv = suffix[k + 1, q]
+            suffix[k, q] = v if v < sv else sv
+
+
+@nb.njit(cache=True)
+def _window_minima_start(smooth, u0, m, first_index, half_window, suffix, prefix):
+    """The running window minimum's state before frame `first_index` enters the rings.
+
+    Frames are grouped in blocks of ``K = 2 * half_window + 1`` (block ``b``:
+    frames ``b K .. b K + K - 1``). The window of the first centre tested
+    (frames ``a .. a + K - 1``, ``a = first_index - 1 - 2 * half_window``)
+    needs the suffix minima of ``a``'s block from ``a`` on, when that block
+    ends before frame ``first_index - 1``, and the prefix minimum of frame
+    ``first_index - 2``'s block up to it; both are read from the ring.
+    """
+    n_k = suffix.shape[0]
+    a = first_index - 1 - 2 * half_window
+    ka = a % n_k
+    if ka > 0:  # a's block is complete before frame first_index - 1 is smoothed
+        _suffix_minima(smooth, u0, m, a - ka, ka, suffix)
+    e = first_index - 2
+    ke = e % n_k
+    for q in range(m):
+        prefix[q] = np.inf
+    for f in range(e - ke, e + 1):
+        row = np.uint64(f % smooth.shape[0])
+        for q in range(m):
+            v = smooth[row, u0 + np.uint64(q)]
+            pv = prefix[q]
+            prefix[q] = v if v < pv else pv
+
+
+@nb.njit(cache=True)
 def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation_level,
                 raw, smooth, top_value, top_frame, window, signal_sum, square_hi, square_lo,
                 count, invalid, channel_sum, saturated):
@@ -257,6 +310,10 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     hits = np.zeros(m, np.int64)
     hit = np.zeros(m, np.bool_)
     slots = np.empty(2 * h + 3, np.uint64)
+    k_win = 2 * h + 1
+    suffix = np.empty((k_win, m), np.float32)
+    prefix = np.empty(m, np.float32)
+    _window_minima_start(smooth, u0, m, first_index, h, suffix, prefix)
     t_flush = 0
     big = 0
     for t in range(n_t):
@@ -324,24 +381,38 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
                 t_flush = t + 1
         else:
             t_flush = t + 1
+        # running minimum of the smoothed values over the window (van Herk / Gil-Werman):
+        # frame e = j - 1 (just smoothed) enters the prefix minimum of its K-frame block;
+        # a completed block gets its suffix minima
+        e = j - 1
+        ke = e % k_win
+        if ke == 0:
+            prefix[:] = np.inf
+        erow = np.uint64(e % r)
+        for q in range(m):
+            p = u0 + np.uint64(q)
+            v = smooth[erow, p]
+            pv = prefix[q]
+            prefix[q] = v if v < pv else pv
+        if ke == k_win - 1:
+            _suffix_minima(smooth, u0, m, e - k_win + 1, 0, suffix)
         centre = j - h - 1
         if centre >= start and centre >= 0 and centre < stop:
-            # vectorised test: below the pixel's current 5th candidate and not above any
-            # smoothed value within h frames (NaN decides nothing): after the first few
-            # dips of a sweep rare, ever rarer as it goes on; the passing pixels are
+            # vectorised test: below the pixel's current 5th candidate and not above the
+            # least smoothed value within h frames (NaN decides nothing): after the first
+            # few dips of a sweep rare, ever rarer as it goes on; the passing pixels are
             # gathered and inserted one by one (equal values: the flat-run rules)
             _ring_slots(centre, h, r, slots)
             cslot = slots[h + 1]
+            ka = (centre - h) % k_win
             worst = np.uint64(TOP - 1)
             for q in range(m):
                 p = u0 + np.uint64(q)
-                hit[q] = smooth[cslot, p] < top_value[worst, p]
-            for d in range(1, h + 1):
-                before, after = slots[h + 1 - d], slots[h + 1 + d]
-                for q in range(m):
-                    p = u0 + np.uint64(q)
-                    sc = smooth[cslot, p]
-                    hit[q] &= (not smooth[before, p] < sc) & (not smooth[after, p] < sc)
+                sc = smooth[cslot, p]
+                sv = suffix[ka, q]
+                pv = prefix[q]
+                low = pv if pv < sv else sv
+                hit[q] = (sc < top_value[worst, p]) & (not low < sc)
             n_hits = 0
             for q in range(m):
                 hits[n_hits] = q
