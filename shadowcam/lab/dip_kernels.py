@@ -308,7 +308,8 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     acc = np.zeros(m)
     cacc = np.zeros((n_c, m))
     hits = np.zeros(m, np.int64)
-    hit = np.zeros(m, np.bool_)
+    hit = np.zeros((m + 7) // 8 * 8, np.bool_)
+    hit_words = hit.view(np.uint64)  # the flags of 8 pixels as one word
     slots = np.empty(2 * h + 3, np.uint64)
     k_win = 2 * h + 1
     suffix = np.empty((k_win, m), np.float32)
@@ -413,8 +414,13 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
                 pv = prefix[q]
                 low = pv if pv < sv else sv
                 hit[q] = (sc < top_value[worst, p]) & (not low < sc)
-            n_hits = 0
-            for q in range(m):
+            n_hits = 0  # gathered 8 flags at a time, skipping words without a hit
+            for w in range(m // 8):
+                if hit_words[w]:
+                    for q in range(8 * w, 8 * w + 8):
+                        hits[n_hits] = q
+                        n_hits += hit[q]
+            for q in range(m - m % 8, m):
                 hits[n_hits] = q
                 n_hits += hit[q]
             for i in range(n_hits):
