@@ -24,7 +24,7 @@ def _reference_update(block, first_index, start, stop, half_window, saturation_l
     Slow reference of :func:`dip_kernels.track_block`: the candidate test
     compares the centre with the ``2 * half_window`` smoothed values around it
     (NaN decides nothing); the pixels that pass are inserted by the library's
-    scalar helpers (strict minimum: directly; equal values: the flat-run rules).
+    scalar helpers (no equal value around: directly; else the flat-run rules).
     Sums are the exact per-sample fixed point (:func:`quantise_sum`,
     :func:`split_square`).
     """
@@ -67,12 +67,12 @@ def _reference_update(block, first_index, start, stop, half_window, saturation_l
             hit = sc < top_value[_k.TOP - 1]
             for d in range(1, h + 1):
                 hit &= ~(smooth[slots[h + 1 - d]] < sc) & ~(smooth[slots[h + 1 + d]] < sc)
+            neighbours = smooth[np.r_[slots[1:h + 1], slots[h + 2:2 * h + 2]]]
             for p in np.flatnonzero(hit):
-                rank = _k._window_rank(smooth, p, h, slots)
-                if rank == 1:
+                if not (neighbours[:, p] == sc[p]).any():  # a strict minimum
                     if _k._insert(top_value, top_frame, p, sc[p], centre):
                         _k._copy_window(raw, p, centre, j + 1, h, window, slots)
-                elif rank == 2:
+                else:
                     _k._consider(raw, smooth, p, centre, j + 1, h, top_value, top_frame, window, slots)
 
 
