@@ -1,9 +1,10 @@
 """Compiled per-pixel kernels of the streaming dip tracker (numba).
 
-The tracker's state is laid out pixel-major (``(P, ...)`` with ``P = H * W``)
-so that one pixel's state is contiguous; a block of frames is processed pixel
-by pixel with time innermost, so the state is read and written once per block
-and every frame sample is read once. Pixels run in parallel (``prange``).
+The tracker's state is laid out pixel-minor (``(..., P)`` with ``P = H * W``);
+a block of frames is processed in tiles of pixels, frames in order within a
+tile and pixels innermost (vectorised), so that a tile's rings and state stay
+in cache while the block streams through and every frame sample is read once.
+Tiles run in parallel (``prange``).
 
 Running sums are kept in forms whose addition is exact, hence independent of
 the order and grouping of the frames (what makes time chunks merge bit for

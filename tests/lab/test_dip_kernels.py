@@ -1,4 +1,4 @@
-"""The tracker update (running window minimum) against the window test of 2 * half_window compares."""
+"""The tracker update (running minima of the half windows) against a test of every neighbour."""
 
 import numpy as np
 from hypothesis import given, settings
