@@ -1,9 +1,10 @@
 """Compiled per-pixel kernels of the streaming dip tracker (numba).
 
-The tracker's state is laid out pixel-major (``(P, ...)`` with ``P = H * W``)
-so that one pixel's state is contiguous; a block of frames is processed pixel
-by pixel with time innermost, so the state is read and written once per block
-and every frame sample is read once. Pixels run in parallel (``prange``).
+The tracker's state is laid out pixel-minor (``(..., P)`` with ``P = H * W``);
+a block of frames is processed in tiles of pixels, frames in order within a
+tile and pixels innermost (vectorised), so that a tile's rings and state stay
+in cache while the block streams through and every frame sample is read once.
+Tiles run in parallel (``prange``).
 
 Running sums are kept in forms whose addition is exact, hence independent of
 the order and grouping of the frames (what makes time chunks merge bit for
@@ -219,23 +220,58 @@ def _exact_sums(block, t0, t1, p0, p1, signal_sum, channel_sum):
                     channel_sum[c, p] += _fixed(np.float64(v))
 
 
-@nb.njit(cache=True, inline="always")
-def _window_rank(smooth, p, half_window, slots):
-    """How pixel `p`'s centre (slot ``slots[h + 1]``) compares with the smoothed values within the window.
+@nb.njit(cache=True)
+def _suffix_minima(smooth, u0, m, block_first, k_from, suffix):
+    """Suffix minima ``suffix[k] = min(frames block_first + k .. block_first + K - 1)`` for ``k >= k_from``.
 
-    Returns 0 if one of them is lower, 1 if all are higher (a strict
-    minimum), 2 if none is lower but some are equal. NaN neighbours (also
-    frames before the sequence or the chunk) decide nothing.
+    Read from the smoothed ring ``(r, P)`` (frame ``f`` in slot ``f % r``),
+    pixels ``u0 .. u0 + m - 1``, NaN ignored (+inf where all are NaN);
+    `suffix` is ``(K, m)``.
     """
-    sc = smooth[slots[half_window + 1], p]
-    rank = 1
-    for d in range(1, half_window + 1):
-        left, right = smooth[slots[half_window + 1 - d], p], smooth[slots[half_window + 1 + d], p]
-        if left < sc or right < sc:
-            return 0
-        if left == sc or right == sc:
-            rank = 2
-    return rank
+    r = smooth.shape[0]
+    n_k = suffix.shape[0]
+    row = np.uint64((block_first + n_k - 1) % r)
+    for q in range(m):
+        suffix[n_k - 1, q] = np.inf
+    for q in range(m):
+        v = smooth[row, u0 + np.uint64(q)]
+        sv = suffix[n_k - 1, q]
+        suffix[n_k - 1, q] = v if v < sv else sv
+    for k in range(n_k - 2, k_from - 1, -1):
+        row = np.uint64((block_first + k) % r)
+        for q in range(m):
+            v = smooth[row, u0 + np.uint64(q)]
+            sv = suffix[k + 1, q]
+            suffix[k, q] = v if v < sv else sv
+
+
+@nb.njit(cache=True)
+def _window_minima_start(smooth, u0, m, first_index, suffix, prefix):
+    """The running minimum's state before frame `first_index` enters the rings.
+
+    The minimum runs over the last ``K = suffix.shape[0]`` smoothed frames.
+    Frames are grouped in blocks of ``K`` (block ``b``: frames
+    ``b K .. b K + K - 1``). The first minimum computed (frames
+    ``a .. a + K - 1``, ``a = first_index - K``) needs the suffix minima of
+    ``a``'s block from ``a`` on, when that block ends before frame
+    ``first_index - 1``, and the prefix minimum of frame ``first_index - 2``'s
+    block up to it; both are read from the ring.
+    """
+    n_k = suffix.shape[0]
+    a = first_index - n_k
+    ka = a % n_k
+    if ka > 0:  # a's block is complete before frame first_index - 1 is smoothed
+        _suffix_minima(smooth, u0, m, a - ka, ka, suffix)
+    e = first_index - 2
+    ke = e % n_k
+    for q in range(m):
+        prefix[q] = np.inf
+    for f in range(e - ke, e + 1):
+        row = np.uint64(f % smooth.shape[0])
+        for q in range(m):
+            v = smooth[row, u0 + np.uint64(q)]
+            pv = prefix[q]
+            prefix[q] = v if v < pv else pv
 
 
 @nb.njit(cache=True)
@@ -255,8 +291,24 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
     acc = np.zeros(m)
     cacc = np.zeros((n_c, m))
     hits = np.zeros(m, np.int64)
-    hit = np.zeros(m, np.bool_)
+    hit = np.zeros((m + 7) // 8 * 8, np.uint8)  # 0: no candidate, 1: strict minimum, 2: equal values
+    hit_words = hit.view(np.uint64)  # the codes of 8 pixels as one word
     slots = np.empty(2 * h + 3, np.uint64)
+    # minimum of the smoothed values of frames e - h + 1 .. e (NaN ignored, +inf if none),
+    # frame e's in row e % (h + 2): the h frames after a centre and the h before it
+    n_w = h + 2
+    half_min = np.full((n_w, m), np.inf, np.float32)
+    for e in range(first_index - h - 2, first_index - 1):
+        w_row = np.uint64(e % n_w)
+        for f in range(e - h + 1, e + 1):
+            f_row = np.uint64(f % r)
+            for q in range(m):
+                v = smooth[f_row, u0 + np.uint64(q)]
+                cur = half_min[w_row, q]
+                half_min[w_row, q] = v if v < cur else cur
+    suffix = np.empty((h, m), np.float32)
+    prefix = np.empty(m, np.float32)
+    _window_minima_start(smooth, u0, m, first_index, suffix, prefix)
     t_flush = 0
     big = 0
     for t in range(n_t):
@@ -324,38 +376,64 @@ def _track_tile(block, p0, p1, first_index, start, stop, half_window, saturation
                 t_flush = t + 1
         else:
             t_flush = t + 1
+        # running minimum of the last h smoothed values (van Herk / Gil-Werman): frame
+        # e = j - 1 (just smoothed) enters the prefix minimum of its h-frame block; a
+        # completed block gets its suffix minima; their minimum is that of frames e - h + 1 .. e
+        e = j - 1
+        ke = e % h
+        if ke == 0:
+            prefix[:] = np.inf
+        erow = np.uint64(e % r)
+        for q in range(m):
+            p = u0 + np.uint64(q)
+            v = smooth[erow, p]
+            pv = prefix[q]
+            prefix[q] = v if v < pv else pv
+        if ke == h - 1:
+            _suffix_minima(smooth, u0, m, e - h + 1, 0, suffix)
+        ka = np.uint64((e - h + 1) % h)
+        w_row = np.uint64(e % n_w)
+        for q in range(m):
+            sv = suffix[ka, q]
+            pv = prefix[q]
+            half_min[w_row, q] = pv if pv < sv else sv
         centre = j - h - 1
         if centre >= start and centre >= 0 and centre < stop:
-            # vectorised test: below the pixel's current 5th candidate and not above any
-            # smoothed value within h frames (NaN decides nothing): after the first few
-            # dips of a sweep rare, ever rarer as it goes on; the passing pixels are
+            # vectorised test: below the pixel's current 5th candidate and not above the
+            # least smoothed value within h frames (NaN decides nothing): after the first
+            # few dips of a sweep rare, ever rarer as it goes on; the passing pixels are
             # gathered and inserted one by one (equal values: the flat-run rules)
             _ring_slots(centre, h, r, slots)
             cslot = slots[h + 1]
+            before_row = np.uint64((centre - 1) % n_w)  # frames centre - h .. centre - 1
+            after_row = np.uint64((centre + h) % n_w)  # frames centre + 1 .. centre + h
             worst = np.uint64(TOP - 1)
             for q in range(m):
                 p = u0 + np.uint64(q)
-                hit[q] = smooth[cslot, p] < top_value[worst, p]
-            for d in range(1, h + 1):
-                before, after = slots[h + 1 - d], slots[h + 1 + d]
-                for q in range(m):
-                    p = u0 + np.uint64(q)
-                    sc = smooth[cslot, p]
-                    hit[q] &= (not smooth[before, p] < sc) & (not smooth[after, p] < sc)
-            n_hits = 0
-            for q in range(m):
+                sc = smooth[cslot, p]
+                lv = half_min[before_row, q]
+                rv = half_min[after_row, q]
+                low = lv if lv < rv else rv
+                passes = (sc < top_value[worst, p]) & (not low < sc)
+                hit[q] = np.uint8(passes) + np.uint8(passes & (low == sc))
+            n_hits = 0  # gathered 8 flags at a time, skipping words without a hit
+            for w in range(m // 8):
+                if hit_words[w]:
+                    for q in range(8 * w, 8 * w + 8):
+                        hits[n_hits] = q
+                        n_hits += hit[q] != 0
+            for q in range(m - m % 8, m):
                 hits[n_hits] = q
-                n_hits += hit[q]
+                n_hits += hit[q] != 0
             for i in range(n_hits):
                 q = hits[i]
                 p = u0 + np.uint64(q)
-                rank = _window_rank(smooth, p, h, slots)
-                if rank == 1:
+                if hit[q] == 1:
                     # a strict minimum is the middle of its own flat run: a local minimum
                     # (what _is_candidate finds)
                     if _insert(top_value, top_frame, p, smooth[cslot, p], centre):
                         _copy_window(raw, p0 + q, centre, j + 1, h, window, slots)
-                elif rank == 2:  # equal values around: the flat-run rules decide
+                else:  # equal values around: the flat-run rules decide
                     _consider(raw, smooth, p0 + q, centre, j + 1, h, top_value, top_frame, window, slots)
 
 
@@ -378,12 +456,14 @@ def track_block(block, first_index, start, stop, half_window, saturation_level,
     accumulated as integer-valued float64 over :data:`_FLUSH` frames, then
     added to the int64 sums: exact for samples below ``2**17`` in magnitude;
     a tile and frame range with a larger sample is summed again one sample
-    at a time. Centres are tested vectorised (below the pixel's last
-    candidate and not above the smoothed values within ``half_window``
-    frames); the pixels that pass are gathered: a strict minimum
-    (:func:`_window_rank`) is a local minimum and is inserted directly
-    (:func:`_insert`); only centres with an equal value in their window take
-    the full flat-run test (:func:`_is_candidate`).
+    at a time. Centres are tested vectorised against the least smoothed
+    value of the ``half_window`` frames before and of those after them
+    (running minima over ``half_window`` frames, prefix and suffix minima of
+    ``half_window``-frame groups, ~3 compares per pixel-frame): a centre
+    below the pixel's last candidate and not above either is gathered; a
+    strict minimum (both above it) is a local minimum and is inserted
+    directly (:func:`_insert`); only centres with an equal value in their
+    window take the full flat-run test (:func:`_is_candidate`).
     """
     n_p = block.shape[1]
     n_tiles = (n_p + TILE - 1) // TILE
