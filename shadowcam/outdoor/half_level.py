@@ -32,6 +32,7 @@ half_level_crossings : crossing time of a half level and its standard error.
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in, check_in_interval, check_positive
+from shadowcam.outdoor.ramp_kernels import half_level_pixels
 
 #: samples at an end of a descent whose mean and slope give its level and the plateau test
 END_SAMPLES = 10
@@ -172,30 +173,4 @@ def half_level_crossings(values, time_s, *, half_level, half_window):
     k = np.broadcast_to(np.asarray(half_window), (n,)).astype(np.int64)
     if np.any(k < 1):
         raise ValueError("half_window must be >= 1")
-    crossing = np.full(n, np.nan)
-    sigma = np.full(n, np.nan)
-    step = np.full(n, np.nan)
-    rate = np.full(n, np.nan)
-    for i in np.nonzero(np.isfinite(level))[0]:
-        finite = np.isfinite(y[i])
-        yi, ti = y[i, finite] - level[i], t[i, finite]
-        down = np.nonzero((yi[:-1] >= 0) & (yi[1:] < 0))[0]
-        if down.size == 0:
-            continue
-        j = down[-1]
-        step[i] = yi[j] - yi[j + 1]
-        a, b = max(j - k[i] + 1, 0), min(j + k[i] + 1, yi.size)
-        tw, yw = ti[a:b], yi[a:b]
-        tm = tw.mean()
-        sxx = ((tw - tm) ** 2).sum()
-        slope = ((tw - tm) * (yw - yw.mean())).sum() / sxx
-        if slope < 0 and yw.size > 2:
-            crossing[i] = tm - yw.mean() / slope
-            s2 = ((yw - yw.mean() - slope * (tw - tm)) ** 2).sum() / (yw.size - 2)
-            sigma[i] = np.sqrt(s2 * (1.0 / yw.size + (crossing[i] - tm) ** 2 / sxx)) / -slope
-            rate[i] = slope
-        else:
-            crossing[i] = ti[j] + yi[j] / (yi[j] - yi[j + 1]) * (ti[j + 1] - ti[j])
-            sigma[i] = np.inf
-            rate[i] = -step[i] / (ti[j + 1] - ti[j])
-    return crossing, sigma, step, rate
+    return half_level_pixels(np.ascontiguousarray(t), y, level, np.ascontiguousarray(k))

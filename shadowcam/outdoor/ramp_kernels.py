@@ -1,4 +1,4 @@
-"""Compiled per-pixel fit of the disc-sun ramp (numba), optionally with an edge speed that changes.
+"""Compiled per-pixel fits of the outdoor wing (numba): the disc-sun ramp and the half-level line.
 
 One pixel at a time (pixels in parallel with ``prange``): its finite samples are gathered
 once, the grid start is scanned, then Levenberg-Marquardt steps are taken with the 5x5
@@ -10,9 +10,15 @@ All arithmetic is float64. The law and the fit are those of
 :func:`shadowcam.outdoor.penumbra.fit_ramps`, which validates the inputs and turns the
 normal equations into the centre's standard error.
 
+The half-level crossing (:func:`half_level_pixels`) takes one pass over a pixel's samples to
+gather the finite ones and find the last downward crossing, then a line over the window
+around it from its centred sums; :func:`shadowcam.outdoor.half_level.half_level_crossings`
+validates the inputs.
+
 Offers
 ------
 fit_ramp_pixels : grid start and Levenberg-Marquardt fit of every pixel's series.
+half_level_pixels : last downward crossing of each pixel's half level and its local line.
 """
 
 import numba as nb
@@ -295,3 +301,74 @@ def fit_ramp_pixels(t_all, y_all, start, fixed, shadow_fixed, durations, shifts,
         lag_out[i] = lag
         inside_out[i] = inside
     return p_out, sse_out, jtj_out, lag_out, inside_out, count_out
+
+
+@nb.njit(cache=True, parallel=True, error_model="numpy")
+def half_level_pixels(t_all, y_all, level, half_window):
+    """The last downward crossing of each pixel's `level`, refined by a line over +-`half_window` samples.
+
+    Parameters
+    ----------
+    t_all, y_all : (N, K) float64 ndarray
+        Times and values; a sample takes part where both are finite.
+    level : (N,) float64 ndarray
+        Half level (not finite: no crossing).
+    half_window : (N,) int64 ndarray
+        ``k`` (>= 1): the line runs over the ``k`` finite samples each side of the crossing.
+
+    Returns
+    -------
+    crossing, sigma, step, slope : (N,) float64 ndarray
+        As :func:`shadowcam.outdoor.half_level.half_level_crossings` (NaN where there is no
+        crossing).
+    """
+    n, kk = y_all.shape
+    out = np.full((4, n), np.nan)
+    crossing, sigma, step, rate = out[0], out[1], out[2], out[3]
+    for i in nb.prange(n):
+        if not np.isfinite(level[i]):
+            continue
+        t = np.empty(kk)
+        y = np.empty(kk)
+        m = 0
+        j = -1
+        for k in range(kk):
+            if np.isfinite(t_all[i, k]) and np.isfinite(y_all[i, k]):
+                t[m] = t_all[i, k]
+                y[m] = y_all[i, k] - level[i]
+                if m > 0 and y[m - 1] >= 0.0 and y[m] < 0.0:
+                    j = m - 1
+                m += 1
+        if j < 0:
+            continue
+        step[i] = y[j] - y[j + 1]
+        a = max(j - half_window[i] + 1, 0)
+        b = min(j + half_window[i] + 1, m)
+        w = b - a
+        tm = 0.0
+        ym = 0.0
+        for q in range(a, b):
+            tm += t[q]
+            ym += y[q]
+        tm /= w
+        ym /= w
+        sxx = 0.0
+        sxy = 0.0
+        for q in range(a, b):
+            sxx += (t[q] - tm) * (t[q] - tm)
+            sxy += (t[q] - tm) * (y[q] - ym)
+        slope = sxy / sxx
+        if slope < 0.0 and w > 2:
+            crossing[i] = tm - ym / slope
+            s2 = 0.0
+            for q in range(a, b):
+                r = y[q] - ym - slope * (t[q] - tm)
+                s2 += r * r
+            s2 /= w - 2
+            sigma[i] = np.sqrt(s2 * (1.0 / w + (crossing[i] - tm) ** 2 / sxx)) / -slope
+            rate[i] = slope
+        else:
+            crossing[i] = t[j] + y[j] / (y[j] - y[j + 1]) * (t[j + 1] - t[j])
+            sigma[i] = np.inf
+            rate[i] = -step[i] / (t[j + 1] - t[j])
+    return crossing, sigma, step, rate

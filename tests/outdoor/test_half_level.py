@@ -134,3 +134,94 @@ def test_levels_against_the_renderers_exact_levels():
     crossing, _, _, _ = half_level_crossings(y[descends], times, half_level=levels["half"], half_window=3)
     truth, _, _, _ = half_level_crossings(fraction[descends], times, half_level=np.full(descends.sum(), 0.5), half_window=1)
     assert np.abs(crossing - truth)[seen].max() / interval < 0.3
+
+
+def _reference_crossings(values, time_s, half_level, half_window):
+    """The half-level crossing written per pixel in numpy: the formulation the compiled kernel follows.
+
+    Returns (crossing, sigma, step, slope) and, where the line descends, the line's residual
+    RMS and the factor that turns it into ``sigma``, as (6, N) rows.
+    """
+    y = np.asarray(values, dtype=np.float64)
+    t = np.broadcast_to(np.asarray(time_s, dtype=np.float64), y.shape)
+    y = np.where(np.isfinite(t), y, np.nan)
+    n = y.shape[0]
+    k = np.broadcast_to(np.asarray(half_window), (n,)).astype(np.int64)
+    out = np.full((6, n), np.nan)
+    for i in np.nonzero(np.isfinite(half_level))[0]:
+        finite = np.isfinite(y[i])
+        yi, ti = y[i, finite] - half_level[i], t[i, finite]
+        down = np.nonzero((yi[:-1] >= 0) & (yi[1:] < 0))[0]
+        if down.size == 0:
+            continue
+        j = down[-1]
+        out[2, i] = yi[j] - yi[j + 1]
+        a, b = max(j - k[i] + 1, 0), min(j + k[i] + 1, yi.size)
+        tw, yw = ti[a:b], yi[a:b]
+        tm = tw.mean()
+        sxx = ((tw - tm) ** 2).sum()
+        with np.errstate(invalid="ignore", divide="ignore"):
+            slope = ((tw - tm) * (yw - yw.mean())).sum() / sxx
+        if slope < 0 and yw.size > 2:
+            out[0, i] = tm - yw.mean() / slope
+            s2 = ((yw - yw.mean() - slope * (tw - tm)) ** 2).sum() / (yw.size - 2)
+            out[1, i] = np.sqrt(s2 * (1.0 / yw.size + (out[0, i] - tm) ** 2 / sxx)) / -slope
+            out[3, i] = slope
+            out[4, i], out[5, i] = np.sqrt(s2), np.sqrt(1.0 / yw.size + (out[0, i] - tm) ** 2 / sxx) / -slope
+        else:
+            out[0, i] = ti[j] + yi[j] / (yi[j] - yi[j + 1]) * (ti[j + 1] - ti[j])
+            out[1, i] = np.inf
+            out[3, i] = -out[2, i] / (ti[j + 1] - ti[j])
+    return out
+
+
+#: a sample: missing, on one of a few levels (plateaus, exact ties with the half level), or anywhere
+_SAMPLE = st.one_of(st.just(np.nan), st.sampled_from([0.0, 0.25, 0.5, 0.75, 1.0]), st.floats(-1.0, 2.0))
+
+
+@settings(max_examples=300, deadline=None)
+@given(series=st.lists(st.lists(_SAMPLE, min_size=1, max_size=24), min_size=1, max_size=6),
+       half=st.lists(st.one_of(st.just(np.nan), st.sampled_from([0.25, 0.5]), st.floats(-0.5, 1.5)), min_size=6,
+                     max_size=6),
+       window=st.lists(st.integers(1, 30), min_size=6, max_size=6),
+       gaps=st.lists(st.floats(0.5, 10.0), min_size=24, max_size=24),
+       missing_time=st.integers(-1, 23))
+def test_the_compiled_crossing_is_the_numpy_formulation(series, half, window, gaps, missing_time):
+    # random series: missing samples, plateaus, several crossings or none, crossings at the ends,
+    # windows from 1 sample to wider than the series, irregular times (one of them unknown)
+    length = max(len(s) for s in series)
+    values = np.array([s + [np.nan] * (length - len(s)) for s in series])
+    n = len(values)
+    time_s = np.cumsum(gaps[:length])
+    if 0 <= missing_time < length:
+        time_s[missing_time] = np.nan
+    level, k = np.array(half[:n]), np.array(window[:n])
+    got = np.array(half_level_crossings(values, time_s, half_level=level, half_window=k))
+    want, (rms, factor) = np.split(_reference_crossings(values, time_s, level, k), [4])
+    np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+    np.testing.assert_array_equal(np.isinf(got), np.isinf(want))
+    # samples on a line to within rounding (1e-16 of the values): the residual, and the
+    # standard error from it, are rounding in either summation order; they stay below 1e-6
+    scale = np.abs(np.nan_to_num(values, nan=0.0)).max() + np.abs(np.nan_to_num(level, nan=0.0)).max() + 1.0
+    rounding = rms <= 1e-6 * scale
+    assert (got[1][rounding] <= 1e-6 * scale * factor[rounding]).all()
+    rows = np.isfinite(want)
+    rows[1] &= ~rounding
+    np.testing.assert_allclose(got[rows], want[rows], rtol=1e-9)
+
+
+def test_the_compiled_crossing_on_noisy_ramps():
+    # realistic inputs: noisy disc ramps with missing samples, windows an eighth of the duration
+    rng = np.random.default_rng(1)
+    n = 2000
+    centre, duration = rng.uniform(30, 100, n) * INTERVAL, rng.uniform(20, 60, n) * INTERVAL
+    series = SHADOW + (LIT - SHADOW) * visible_fraction(2 * (TIMES[None, :] - centre[:, None]) / duration[:, None])
+    series += rng.normal(0.0, 0.004, series.shape)
+    series[rng.random(series.shape) < 0.02] = np.nan
+    level = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)["half"]
+    k = np.maximum(1, np.rint(duration / INTERVAL / 8)).astype(np.int64)
+    got = np.array(half_level_crossings(series, TIMES, half_level=level, half_window=k))
+    want = _reference_crossings(series, TIMES, level, k)[:4]
+    assert np.isfinite(got[0]).mean() > 0.8 and np.isfinite(got[1]).mean() > 0.8
+    np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+    np.testing.assert_allclose(got[np.isfinite(want)], want[np.isfinite(want)], rtol=1e-9)
