@@ -173,4 +173,4 @@ def half_level_crossings(values, time_s, *, half_level, half_window):
     k = np.broadcast_to(np.asarray(half_window), (n,)).astype(np.int64)
     if np.any(k < 1):
         raise ValueError("half_window must be >= 1")
-    return half_level_pixels(np.ascontiguousarray(t), y, level, np.ascontiguousarray(k))
+    return half_level_pixels(np.ascontiguousarray(t), y, np.ascontiguousarray(level), np.ascontiguousarray(k))
