@@ -148,7 +148,8 @@ def test_workflow_killed_and_restarted_equals_uninterrupted(tmp_path, workflow_c
                                     open_frames(frames / f"{sweep}.zarr").load())
     subprocess.run([shadowcam, "shadow-time", "--frames", *(str(reference / f"{s}.zarr") for s in SWEEPS),
                     "--sweeps", *SWEEPS, "--method", "edge_fit", "--params", '{"min_coverage": 0.01}',
-                    "--out", str(reference / "shadow_time.nc")], check=True, capture_output=True)
+                    "--manifest", str(manifest), "--out", str(reference / "shadow_time.nc")],
+                   check=True, capture_output=True)
     with xr.open_dataset(reference / "shadow_time.nc", engine="h5netcdf") as a, \
             xr.open_dataset(workdir / "results" / DS / "shadow_time.nc", engine="h5netcdf") as b:
         xr.testing.assert_identical(a.load(), b.load())
