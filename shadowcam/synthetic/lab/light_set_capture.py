@@ -11,9 +11,10 @@ import numpy as np
 import xarray as xr
 
 from shadowcam.synthetic.lab.light_sets import TubeLight, light_set_ground_truth, trace_light_set
-from shadowcam.synthetic.lab.render import render_image, sweep_frames
+from shadowcam.synthetic.lab.render import SWEEP_INDEX, render_image, sweep_frames
 from shadowcam.synthetic.lab.scene import PointLight
 from shadowcam.synthetic.lab.scenes import make_scene
+from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
 
 
 def make_lights(entries, scene):
@@ -59,7 +60,12 @@ def render_light_set_capture(synthetic, *, light="point"):
         The manifest's ``synthetic`` block with ``lights``; its optional ``shutter`` is the
         exposure of each frame as a fraction of the frame interval (absent: an instant
         exposure), as for the single-light lab renderer
-        (:func:`~shadowcam.synthetic.lab.render.sweep_frames`).
+        (:func:`~shadowcam.synthetic.lab.render.sweep_frames`). With ``noise: true`` every
+        image passes through the sensor model (:mod:`shadowcam.synthetic.sensor`: Poisson
+        shot noise, Gaussian read noise, ``bit_depth``-bit quantisation, per channel, no
+        mosaic) exposed so that the reference's 99.5th percentile reaches ``exposure``
+        (default 0.8) of the range, seeded ``[seed, sweep_index, frame]`` as the capture
+        writer's frames, and is returned in radiance units.
     light : str
         The manifest's ``light`` (``point``).
 
@@ -81,11 +87,14 @@ def render_light_set_capture(synthetic, *, light="point"):
     shutter = float(synthetic.get("shutter", 0.0))
     paths, source = trace_light_set(scene.objects, scene.camera, lights,
                                     supersample=int(synthetic.get("supersample", 3)))
-    data = {"reference": (("y", "x", "channel"), render_image(paths).astype(np.float32))}
+    reference = render_image(paths)
+    sense = _sensor_exposure(synthetic, reference)
+    data = {"reference": (("y", "x", "channel"), sense(reference, "reference", 0))}
     for name in ("u", "v"):
         sweep = scene.sweeps[name]
+        frames = sweep_frames(paths, sweep, scene.mask, shutter=shutter)
         data[f"frames_{name}"] = ((f"t_{name}", "y", "x", "channel"),
-                                  sweep_frames(paths, sweep, scene.mask, shutter=shutter).astype(np.float32))
+                                  np.stack([sense(frame, name, k) for k, frame in enumerate(frames)]))
         truth = light_set_ground_truth(scene.objects, scene.camera, lights, sweep, paths, source)
         for key in ("t_center", "t_first", "t_last"):
             data[f"{key}_{name}"] = (("light", "y", "x"), truth[key])
@@ -97,3 +106,20 @@ def render_light_set_capture(synthetic, *, light="point"):
              for light in lights]))
     return xr.Dataset(data, coords={"channel": ["R", "G", "B"], "light": np.arange(len(lights))},
                       attrs={"lights": str(list(synthetic["lights"]))})
+
+
+def _sensor_exposure(synthetic, reference):
+    """Image -> float32 image: through the noisy sensor when ``synthetic.noise``, else as is."""
+    if not synthetic.get("noise", False):
+        return lambda image, sweep, frame: np.asarray(image, dtype=np.float32)
+    sensor = SensorModel(bit_depth=int(synthetic.get("bit_depth", 12)))
+    scale = electrons_per_unit_radiance(reference, sensor=sensor,
+                                        target_fraction=float(synthetic.get("exposure", 0.8)))
+    to_radiance = np.float32((sensor.white_level - sensor.black_level) / (sensor.gain * scale))
+    seed = int(synthetic["seed"])
+
+    def sense(image, sweep, frame):
+        raw = simulate_raw(image, sensor=sensor, scale=scale, seed=[seed, SWEEP_INDEX[sweep], frame],
+                           noise=True, mosaic=False)
+        return raw_to_linear(raw, sensor=sensor) * to_radiance
+    return sense
