@@ -40,11 +40,17 @@ END_SAMPLES = 10
 PLATEAU_Z = 2.0
 
 
-def _series(values, time_s):
-    y = check_array(values, "values", ndim=2).astype(np.float64)
+def _contiguous(values, time_s):
+    """`values` and `time_s` (broadcast to its shape) as C-contiguous float64 (N, K) arrays."""
+    y = np.ascontiguousarray(check_array(values, "values", ndim=2), dtype=np.float64)
     t = np.broadcast_to(np.asarray(time_s, dtype=np.float64), y.shape)
     if t.shape != y.shape:
         raise ValueError(f"time_s must have shape {y.shape} or ({y.shape[1]},); got {np.shape(time_s)}")
+    return y, np.ascontiguousarray(t)
+
+
+def _series(values, time_s):
+    y, t = _contiguous(values, time_s)
     return np.where(np.isfinite(t), y, np.nan), t
 
 
@@ -56,7 +62,7 @@ def _check_end(side, samples, z):
 
 
 def _end_levels(y, t, side, samples, z):
-    """(level, plateau, slope, lowest sample) at one end of each row of `y` (contiguous `t`)."""
+    """(level, plateau, slope, lowest sample) at one end of each row of `y` (times `t`; both contiguous)."""
     level, slope, low, plateau = end_level_pixels(t, y, int(samples), float(z) ** 2, side == "end")
     return level, plateau, slope, low
 
@@ -86,8 +92,7 @@ def end_level(values, time_s, *, side, samples=END_SAMPLES, z=PLATEAU_Z):
         Their line's slope (per s).
     """
     _check_end(side, samples, z)
-    y, t = _series(values, time_s)
-    return _end_levels(y, np.ascontiguousarray(t), side, samples, z)[:3]
+    return _end_levels(*_contiguous(values, time_s), side, samples, z)[:3]
 
 
 def half_levels(values, time_s, *, shadow_ratio, samples=END_SAMPLES, z=PLATEAU_Z):
@@ -116,8 +121,7 @@ def half_levels(values, time_s, *, shadow_ratio, samples=END_SAMPLES, z=PLATEAU_
     """
     check_in_interval(shadow_ratio, "shadow_ratio", 0.0, 1.0, closed="left")
     _check_end("start", samples, z)
-    y, t = _series(values, time_s)
-    t = np.ascontiguousarray(t)
+    y, t = _contiguous(values, time_s)
     lit, lit_seen, lit_slope, lowest = _end_levels(y, t, "start", samples, z)
     shadow, shadow_seen, _, _ = _end_levels(y, t, "end", samples, z)
     with np.errstate(invalid="ignore"):

@@ -15,8 +15,9 @@ gather the finite ones and find the last downward crossing, then a line over the
 around it from its centred sums; :func:`shadowcam.outdoor.half_level.half_level_crossings`
 validates the inputs.
 
-The levels at the ends of a descent (:func:`end_level_pixels`) gather a pixel's first (or
-last) finite samples in one pass from that end, then take their mean and line from centred
+The levels at the ends of a descent (:func:`end_level_pixels`, pixels in turn: a few hundred
+operations per pixel, less than a parallel launch costs on a loaded machine) gather a
+pixel's first (or last) finite samples in one pass from that end, then take their mean and line from centred
 sums added in numpy's pairwise order (eight running sums, then the remainder; up to 128
 samples), so that the results are those of the vectorised formulation bit for bit;
 :func:`shadowcam.outdoor.half_level.end_level` validates the inputs.
@@ -390,16 +391,21 @@ def _pairwise_block(a, lo, hi):
         for q in range(lo, hi):
             s += a[q]
         return s
-    r = np.empty(8)
-    for j in range(8):
-        r[j] = a[lo + j]
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
     q = lo + 8
     stop = lo + n - n % 8
     while q < stop:
-        for j in range(8):
-            r[j] += a[q + j]
+        r0 += a[q]
+        r1 += a[q + 1]
+        r2 += a[q + 2]
+        r3 += a[q + 3]
+        r4 += a[q + 4]
+        r5 += a[q + 5]
+        r6 += a[q + 6]
+        r7 += a[q + 7]
         q += 8
-    s = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
+    s = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
     while q < hi:
         s += a[q]
         q += 1
@@ -415,7 +421,7 @@ def _pairwise_sum(a, n):
     return s
 
 
-@nb.njit(cache=True, parallel=True, error_model="numpy")
+@nb.njit(cache=True, error_model="numpy")
 def end_level_pixels(t_all, y_all, samples, z_squared, from_end):
     """Level, line slope, plateau test and lowest value of each pixel's first (or last) `samples` finite samples.
 
@@ -441,10 +447,10 @@ def end_level_pixels(t_all, y_all, samples, z_squared, from_end):
     out = np.full((3, n), np.nan)
     level, rate, low = out[0], out[1], out[2]
     plateau = np.zeros(n, dtype=np.bool_)
-    for i in nb.prange(n):
-        t = np.empty(samples)
-        y = np.empty(samples)
-        work = np.empty(samples)
+    t = np.empty(samples)
+    y = np.empty(samples)
+    work = np.empty(samples)
+    for i in range(n):
         m = 0
         for step in range(kk):
             k = kk - 1 - step if from_end else step
