@@ -32,7 +32,7 @@ half_level_crossings : crossing time of a half level and its standard error.
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in, check_in_interval, check_positive
-from shadowcam.outdoor.ramp_kernels import half_level_pixels
+from shadowcam.outdoor.ramp_kernels import end_level_pixels, half_level_pixels
 
 #: samples at an end of a descent whose mean and slope give its level and the plateau test
 END_SAMPLES = 10
@@ -40,24 +40,31 @@ END_SAMPLES = 10
 PLATEAU_Z = 2.0
 
 
-def _series(values, time_s):
-    y = check_array(values, "values", ndim=2).astype(np.float64)
+def _contiguous(values, time_s):
+    """`values` and `time_s` (broadcast to its shape) as C-contiguous float64 (N, K) arrays."""
+    y = np.ascontiguousarray(check_array(values, "values", ndim=2), dtype=np.float64)
     t = np.broadcast_to(np.asarray(time_s, dtype=np.float64), y.shape)
     if t.shape != y.shape:
         raise ValueError(f"time_s must have shape {y.shape} or ({y.shape[1]},); got {np.shape(time_s)}")
+    return y, np.ascontiguousarray(t)
+
+
+def _series(values, time_s):
+    y, t = _contiguous(values, time_s)
     return np.where(np.isfinite(t), y, np.nan), t
 
 
-def _ends(y, t, samples, side):
-    """The first (``side="start"``) or last `samples` finite samples of each row (NaN-padded)."""
-    finite = np.isfinite(y)
-    key = np.where(finite, np.arange(y.shape[1])[None, :], y.shape[1] if side == "start" else -1)
-    order = np.sort(key, axis=1) if side == "start" else -np.sort(-key, axis=1)
-    pick = order[:, :samples]
-    valid = (pick >= 0) & (pick < y.shape[1])
-    index = np.clip(pick, 0, y.shape[1] - 1)
-    return (np.where(valid, np.take_along_axis(y, index, axis=1), np.nan),
-            np.where(valid, np.take_along_axis(t, index, axis=1), np.nan))
+def _check_end(side, samples, z):
+    check_in(side, "side", ("start", "end"))
+    if int(samples) < 3:
+        raise ValueError(f"samples must be >= 3; got {samples}")
+    check_positive(z, "z", finite=True)
+
+
+def _end_levels(y, t, side, samples, z):
+    """(level, plateau, slope, lowest sample) at one end of each row of `y` (times `t`; both contiguous)."""
+    level, slope, low, plateau = end_level_pixels(t, y, int(samples), float(z) ** 2, side == "end")
+    return level, plateau, slope, low
 
 
 def end_level(values, time_s, *, side, samples=END_SAMPLES, z=PLATEAU_Z):
@@ -84,21 +91,8 @@ def end_level(values, time_s, *, side, samples=END_SAMPLES, z=PLATEAU_Z):
     slope : (N,) float64 ndarray
         Their line's slope (per s).
     """
-    check_in(side, "side", ("start", "end"))
-    if int(samples) < 3:
-        raise ValueError(f"samples must be >= 3; got {samples}")
-    check_positive(z, "z", finite=True)
-    y, t = _ends(*_series(values, time_s), int(samples), side)
-    full = np.isfinite(y).all(1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mean_y, mean_t = y.mean(1), t.mean(1)
-        dt = t - mean_t[:, None]
-        sxx = (dt**2).sum(1)
-        slope = (dt * (y - mean_y[:, None])).sum(1) / sxx
-        residual = y - mean_y[:, None] - slope[:, None] * dt
-        s2 = (residual**2).sum(1) / (int(samples) - 2)
-        plateau = full & (sxx > 0) & (slope**2 <= z**2 * s2 / sxx)
-    return np.where(full, mean_y, np.nan), plateau, np.where(full, slope, np.nan)
+    _check_end(side, samples, z)
+    return _end_levels(*_contiguous(values, time_s), side, samples, z)[:3]
 
 
 def half_levels(values, time_s, *, shadow_ratio, samples=END_SAMPLES, z=PLATEAU_Z):
@@ -126,15 +120,16 @@ def half_levels(values, time_s, *, shadow_ratio, samples=END_SAMPLES, z=PLATEAU_
         on a plateau).
     """
     check_in_interval(shadow_ratio, "shadow_ratio", 0.0, 1.0, closed="left")
-    lit, lit_seen, lit_slope = end_level(values, time_s, side="start", samples=samples, z=z)
-    shadow, shadow_seen, _ = end_level(values, time_s, side="end", samples=samples, z=z)
+    _check_end("start", samples, z)
+    y, t = _contiguous(values, time_s)
+    lit, lit_seen, lit_slope, lowest = _end_levels(y, t, "start", samples, z)
+    shadow, shadow_seen, _, _ = _end_levels(y, t, "end", samples, z)
     with np.errstate(invalid="ignore"):
         own = shadow_seen & lit_seen & (shadow < lit)
-    start, _ = _ends(*_series(values, time_s), int(samples), "start")
     level = np.where(own | (~lit_seen & shadow_seen), shadow, float(shadow_ratio) * lit)
     half = 0.5 * (lit + level)
     with np.errstate(invalid="ignore"):
-        under_way = ~lit_seen & (lit_slope < 0) & (np.min(start, axis=1) > half)
+        under_way = ~lit_seen & (lit_slope < 0) & (lowest > half)
     return {"half": np.where(lit_seen, half, np.nan), "lit": lit, "contrast": lit - level, "lit_seen": lit_seen,
             "under_way": under_way, "own_shadow": own}
 

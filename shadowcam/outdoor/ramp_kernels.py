@@ -15,10 +15,18 @@ gather the finite ones and find the last downward crossing, then a line over the
 around it from its centred sums; :func:`shadowcam.outdoor.half_level.half_level_crossings`
 validates the inputs.
 
+The levels at the ends of a descent (:func:`end_level_pixels`, pixels in turn: a few hundred
+operations per pixel, less than a parallel launch costs on a loaded machine) gather a
+pixel's first (or last) finite samples in one pass from that end, then take their mean and line from centred
+sums added in numpy's pairwise order (eight running sums, then the remainder; up to 128
+samples), so that the results are those of the vectorised formulation bit for bit;
+:func:`shadowcam.outdoor.half_level.end_level` validates the inputs.
+
 Offers
 ------
 fit_ramp_pixels : grid start and Levenberg-Marquardt fit of every pixel's series.
 half_level_pixels : last downward crossing of each pixel's half level and its local line.
+end_level_pixels : level, line slope, plateau test and lowest sample at an end of each pixel's series.
 """
 
 import numba as nb
@@ -372,3 +380,105 @@ def half_level_pixels(t_all, y_all, level, half_window):
             sigma[i] = np.inf
             rate[i] = -step[i] / (t[j + 1] - t[j])
     return crossing, sigma, step, rate
+
+
+@nb.njit(cache=True)
+def _pairwise_block(a, lo, hi):
+    """Sum of ``a[lo:hi]`` (at most 128 values) in numpy's pairwise order."""
+    n = hi - lo
+    if n < 8:
+        s = 0.0
+        for q in range(lo, hi):
+            s += a[q]
+        return s
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    q = lo + 8
+    stop = lo + n - n % 8
+    while q < stop:
+        r0 += a[q]
+        r1 += a[q + 1]
+        r2 += a[q + 2]
+        r3 += a[q + 3]
+        r4 += a[q + 4]
+        r5 += a[q + 5]
+        r6 += a[q + 6]
+        r7 += a[q + 7]
+        q += 8
+    s = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while q < hi:
+        s += a[q]
+        q += 1
+    return s
+
+
+@nb.njit(cache=True)
+def _pairwise_sum(a, n):
+    """Sum of ``a[:n]``: numpy's ``add.reduce`` order up to 128 values, its 128-value blocks added in turn beyond."""
+    s = _pairwise_block(a, 0, min(n, 128))
+    for lo in range(128, n, 128):
+        s += _pairwise_block(a, lo, min(n, lo + 128))
+    return s
+
+
+@nb.njit(cache=True, error_model="numpy")
+def end_level_pixels(t_all, y_all, samples, z_squared, from_end):
+    """Level, line slope, plateau test and lowest value of each pixel's first (or last) `samples` finite samples.
+
+    Parameters
+    ----------
+    t_all, y_all : (N, K) float64 ndarray
+        Times and values; a sample takes part where both are finite.
+    samples : int
+        Samples at the end (at least 3).
+    z_squared : float
+        Square of the standard errors of the slope within which the samples are a plateau.
+    from_end : bool
+        The last samples (taken from the last one backwards) instead of the first.
+
+    Returns
+    -------
+    level, slope, low : (N,) float64 ndarray
+        Mean, line slope and smallest of the samples (NaN where fewer than `samples` are finite).
+    plateau : (N,) bool ndarray
+        The slope is within ``sqrt(z_squared)`` standard errors of zero (and the times differ).
+    """
+    n, kk = y_all.shape
+    out = np.full((3, n), np.nan)
+    level, rate, low = out[0], out[1], out[2]
+    plateau = np.zeros(n, dtype=np.bool_)
+    t = np.empty(samples)
+    y = np.empty(samples)
+    work = np.empty(samples)
+    for i in range(n):
+        m = 0
+        for step in range(kk):
+            k = kk - 1 - step if from_end else step
+            if np.isfinite(t_all[i, k]) and np.isfinite(y_all[i, k]):
+                t[m] = t_all[i, k]
+                y[m] = y_all[i, k]
+                m += 1
+                if m == samples:
+                    break
+        if m < samples:
+            continue
+        mean_y = _pairwise_sum(y, samples) / samples
+        mean_t = _pairwise_sum(t, samples) / samples
+        smallest = y[0]
+        for q in range(samples):
+            t[q] -= mean_t
+            work[q] = t[q] * t[q]
+            smallest = min(smallest, y[q])
+        sxx = _pairwise_sum(work, samples)
+        for q in range(samples):
+            work[q] = t[q] * (y[q] - mean_y)
+        slope = _pairwise_sum(work, samples) / sxx
+        for q in range(samples):
+            r = y[q] - mean_y - slope * t[q]
+            work[q] = r * r
+        s2 = _pairwise_sum(work, samples) / (samples - 2)
+        level[i] = mean_y
+        rate[i] = slope
+        low[i] = smallest
+        plateau[i] = sxx > 0.0 and slope * slope <= z_squared * s2 / sxx
+    return level, rate, low, plateau

@@ -225,3 +225,97 @@ def test_the_compiled_crossing_on_noisy_ramps():
     assert np.isfinite(got[0]).mean() > 0.8 and np.isfinite(got[1]).mean() > 0.8
     np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
     np.testing.assert_allclose(got[np.isfinite(want)], want[np.isfinite(want)], rtol=1e-9)
+
+
+def _reference_levels(values, time_s, shadow_ratio, samples=10, z=2.0):
+    """The end levels and half levels written vectorised in numpy: the formulation the compiled kernel follows.
+
+    Returns the :func:`half_levels` dict and the end levels' (level, plateau, slope) of both sides.
+    """
+    y = np.asarray(values, dtype=np.float64)
+    t = np.broadcast_to(np.asarray(time_s, dtype=np.float64), y.shape)
+    y = np.where(np.isfinite(t), y, np.nan)
+
+    def ends(side):
+        key = np.where(np.isfinite(y), np.arange(y.shape[1])[None, :], y.shape[1] if side == "start" else -1)
+        pick = (np.sort(key, axis=1) if side == "start" else -np.sort(-key, axis=1))[:, :samples]
+        valid = (pick >= 0) & (pick < y.shape[1])
+        index = np.clip(pick, 0, y.shape[1] - 1)
+        return (np.where(valid, np.take_along_axis(y, index, axis=1), np.nan),
+                np.where(valid, np.take_along_axis(t, index, axis=1), np.nan))
+
+    def level(side):
+        ys, ts = ends(side)
+        full = np.isfinite(ys).all(1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean_y, mean_t = ys.mean(1), ts.mean(1)
+            dt = ts - mean_t[:, None]
+            sxx = (dt**2).sum(1)
+            slope = (dt * (ys - mean_y[:, None])).sum(1) / sxx
+            residual = ys - mean_y[:, None] - slope[:, None] * dt
+            s2 = (residual**2).sum(1) / (samples - 2)
+            plateau = full & (sxx > 0) & (slope**2 <= z**2 * s2 / sxx)
+        return np.where(full, mean_y, np.nan), plateau, np.where(full, slope, np.nan), ys
+
+    lit, lit_seen, lit_slope, start = level("start")
+    shadow, shadow_seen, shadow_slope, _ = level("end")
+    with np.errstate(invalid="ignore"):
+        own = shadow_seen & lit_seen & (shadow < lit)
+    low = np.where(own | (~lit_seen & shadow_seen), shadow, shadow_ratio * lit)
+    half = 0.5 * (lit + low)
+    with np.errstate(invalid="ignore"):
+        under_way = ~lit_seen & (lit_slope < 0) & (np.min(start, axis=1) > half)
+    out = {"half": np.where(lit_seen, half, np.nan), "lit": lit, "contrast": lit - low, "lit_seen": lit_seen,
+           "under_way": under_way, "own_shadow": own}
+    return out, (lit, lit_seen, lit_slope), (shadow, shadow_seen, shadow_slope)
+
+
+def _assert_same(got, want):
+    got, want = np.asarray(got), np.asarray(want)
+    if want.dtype == bool:
+        np.testing.assert_array_equal(got, want)
+    else:
+        np.testing.assert_array_equal(np.isnan(got), np.isnan(want))
+        np.testing.assert_allclose(got[np.isfinite(want)], want[np.isfinite(want)], rtol=1e-9, atol=0)
+
+
+@settings(max_examples=300, deadline=None)
+@given(series=st.lists(st.one_of(st.lists(_SAMPLE, min_size=1, max_size=30),
+                                 st.lists(st.sampled_from([0.1, 0.3]), min_size=1, max_size=30).map(
+                                     lambda s: s[:1] * len(s))),  # constant series
+                       min_size=1, max_size=6),
+       gaps=st.lists(st.floats(0.5, 10.0), min_size=30, max_size=30),
+       missing_time=st.integers(-1, 29), samples=st.sampled_from([3, 5, 10]), ratio=st.floats(0.0, 0.9))
+def test_the_compiled_levels_are_the_numpy_formulation(series, gaps, missing_time, samples, ratio):
+    # random series: missing samples, fewer finite samples than the levels take, constant
+    # series, exact ties with the levels, irregular times (one of them unknown); records of at
+    # least `samples` frames (the numpy formulation took a shorter record's samples as full)
+    length = max(max(len(s) for s in series), samples)
+    values = np.array([s + [np.nan] * (length - len(s)) for s in series])
+    time_s = np.cumsum(gaps[:length])
+    if 0 <= missing_time < length:
+        time_s[missing_time] = np.nan
+    want, want_start, want_end = _reference_levels(values, time_s, ratio, samples=samples)
+    got = half_levels(values, time_s, shadow_ratio=ratio, samples=samples)
+    assert set(got) == set(want)
+    for key in want:
+        _assert_same(got[key], want[key])
+    for side, expected in (("start", want_start), ("end", want_end)):
+        for g, w in zip(end_level(values, time_s, side=side, samples=samples), expected):
+            _assert_same(g, w)
+
+
+def test_the_compiled_levels_on_noisy_ramps():
+    # realistic inputs: noisy disc ramps with missing samples, some records missing their start
+    rng = np.random.default_rng(2)
+    n = 3000
+    centre, duration = rng.uniform(5, 120, n) * INTERVAL, rng.uniform(4, 60, n) * INTERVAL
+    series = SHADOW + (LIT - SHADOW) * visible_fraction(2 * (TIMES[None, :] - centre[:, None]) / duration[:, None])
+    series += rng.normal(0.0, 0.004, series.shape)
+    series[rng.random(series.shape) < 0.02] = np.nan
+    series[rng.random(n) < 0.2, :10] = np.nan
+    want, _, _ = _reference_levels(series, TIMES, SHADOW / LIT)
+    got = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)
+    assert 0.3 < got["lit_seen"].mean() < 0.95 and got["under_way"].any() and got["own_shadow"].any()
+    for key in want:  # the same sums in the same order: equal bit for bit
+        np.testing.assert_array_equal(got[key], want[key])
