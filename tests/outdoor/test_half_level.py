@@ -210,14 +210,21 @@ def test_the_compiled_crossing_is_the_numpy_formulation(series, half, window, ga
     np.testing.assert_allclose(got[rows], want[rows], rtol=1e-9)
 
 
+def _noisy_ramps(rng, n, *, centres, durations):
+    """`n` noisy disc-sun ramps over TIMES (2 % of samples missing), centres and durations
+    uniform in the given ranges of intervals; returns (series (n, K), durations (n,) s)."""
+    centre, duration = rng.uniform(*centres, n) * INTERVAL, rng.uniform(*durations, n) * INTERVAL
+    series = SHADOW + (LIT - SHADOW) * visible_fraction(2 * (TIMES[None, :] - centre[:, None]) / duration[:, None])
+    series += rng.normal(0.0, 0.004, series.shape)
+    series[rng.random(series.shape) < 0.02] = np.nan
+    return series, duration
+
+
 def test_the_compiled_crossing_on_noisy_ramps():
     # realistic inputs: noisy disc ramps with missing samples, windows an eighth of the duration
     rng = np.random.default_rng(1)
     n = 2000
-    centre, duration = rng.uniform(30, 100, n) * INTERVAL, rng.uniform(20, 60, n) * INTERVAL
-    series = SHADOW + (LIT - SHADOW) * visible_fraction(2 * (TIMES[None, :] - centre[:, None]) / duration[:, None])
-    series += rng.normal(0.0, 0.004, series.shape)
-    series[rng.random(series.shape) < 0.02] = np.nan
+    series, duration = _noisy_ramps(rng, n, centres=(30, 100), durations=(20, 60))
     level = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)["half"]
     k = np.maximum(1, np.rint(duration / INTERVAL / 8)).astype(np.int64)
     got = np.array(half_level_crossings(series, TIMES, half_level=level, half_window=k))
@@ -309,10 +316,7 @@ def test_the_compiled_levels_on_noisy_ramps():
     # realistic inputs: noisy disc ramps with missing samples, some records missing their start
     rng = np.random.default_rng(2)
     n = 3000
-    centre, duration = rng.uniform(5, 120, n) * INTERVAL, rng.uniform(4, 60, n) * INTERVAL
-    series = SHADOW + (LIT - SHADOW) * visible_fraction(2 * (TIMES[None, :] - centre[:, None]) / duration[:, None])
-    series += rng.normal(0.0, 0.004, series.shape)
-    series[rng.random(series.shape) < 0.02] = np.nan
+    series, _ = _noisy_ramps(rng, n, centres=(5, 120), durations=(4, 60))
     series[rng.random(n) < 0.2, :10] = np.nan
     want, _, _ = _reference_levels(series, TIMES, SHADOW / LIT)
     got = half_levels(series, TIMES, shadow_ratio=SHADOW / LIT)
