@@ -18,6 +18,7 @@ import numpy as np
 import xarray as xr
 
 from shadowcam.outdoor.descent import RAMP_STATES
+from shadowcam.outdoor.normalise import GAIN_SOURCES
 
 _CHANNELS = np.array(["R", "G", "B"], dtype=object)
 
@@ -43,7 +44,8 @@ def photometry_dataset(result, time_s, *, exposure_gain=None, sky_source="auto")
     Returns
     -------
     xarray.Dataset
-        ``gain_sky``, ``kept_lit``, ``exposure_gain`` over ``time`` (coords
+        ``gain_sky``, ``kept_lit``, ``gain_source``
+        (:data:`shadowcam.outdoor.normalise.GAIN_SOURCES`), ``exposure_gain`` over ``time`` (coords
         ``time_s``, ``shift_row``, ``shift_col``, ``gain``); ``sky``,
         ``lit_at_start``, ``lit_level``, ``shadow_level`` over ``(row, col)``;
         ``reference (row, col, channel)``; attrs ``shadow_ratio``, ``sky_source``.
@@ -56,6 +58,10 @@ def photometry_dataset(result, time_s, *, exposure_gain=None, sky_source="auto")
     data = {
         "gain_sky": ("time", np.asarray(result["gain_sky"]), {"units": "1", "long_name": "sky-light gain relative to the first frame"}),
         "kept_lit": ("time", np.asarray(result["kept_lit"]), {"units": "pixel", "long_name": "pixels used for the lit gain"}),
+        "gain_source": ("time", np.asarray(result["gain_source"], dtype=np.int8),
+                        {"units": "1", "long_name": "where the lit gain comes from",
+                         "flag_values": np.array(list(GAIN_SOURCES), dtype=np.int8),
+                         "flag_meanings": " ".join(name.replace(" ", "_") for name in GAIN_SOURCES.values())}),
         "exposure_gain": ("time", exposure, {"units": "1", "long_name": "gain from exposure metadata (NaN unknown)"}),
         "sky": (cam, np.asarray(result["sky"], dtype=bool), {"long_name": "sky mask"}),
         "lit_at_start": (cam, np.asarray(result["lit_at_start"], dtype=bool), {"long_name": "sunlit in the first frame"}),
@@ -100,7 +106,7 @@ def photometry_part_dataset(part, time_s, *, exposure_gain=None, sky_source="aut
     -------
     xarray.Dataset
         Over ``time`` (the part's frame indices): coords ``time_s``, ``shift_row``,
-        ``shift_col``, ``gain``; ``gain_sky``, ``kept_lit``, ``exposure_gain``; over
+        ``shift_col``, ``gain``; ``gain_sky``, ``kept_lit``, ``gain_source``, ``exposure_gain``; over
         ``(row, col)``: ``shadow_min`` (linear), ``sky``, ``lit_at_start``;
         ``reference (row, col, channel)`` only in the part holding frame 0.
         Attrs ``first_frame``, ``sky_source``.
@@ -127,6 +133,7 @@ def photometry_part_arrays(dataset):
         "gain_lit": dataset["gain"].values,
         "gain_sky": dataset["gain_sky"].values,
         "kept_lit": dataset["kept_lit"].values,
+        "gain_source": dataset["gain_source"].values,
         "shadow_min": dataset["shadow_min"].values,
         "sky": dataset["sky"].values.astype(bool),
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),

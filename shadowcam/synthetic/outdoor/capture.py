@@ -157,7 +157,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
     if not cloud_on:
         clouds = []
     hit = ~samples.sky
-    radiance, clean, cloud_att = [], [], []
+    radiance, clean, cloud_att, sun_seen = [], [], [], []
     progress = Progress(len(times), "outdoor render: frames")
     for k, t in enumerate(times):
         trans = np.ones(len(samples.sky))
@@ -170,6 +170,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
         radiance.append(L)
         clean.append(L_clear)
         cloud_att.append(_pixel_mean(trans, (rows, cols), s2).astype(np.float32))
+        sun_seen.append(_pixel_mean(np.asarray(lit, dtype=np.float64), (rows, cols), s2))
         progress.update(k + 1)
     log.info("outdoor render: exposure, shake and the pushbroom ground truth")
     radiance = np.stack(radiance)
@@ -177,6 +178,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
     levels = np.array([nz.metered_level(L) for L in radiance])
     gain, ae_ev = nz.auto_exposure(levels, seed=seed, enabled=bool(opts["auto_exposure"]))
     dx, dy = nz.shake_offsets(len(times), seed=seed, max_px=float(opts["shake_px"]))
+    lit_gain, sky_gain = gt.state_gains(clean, np.stack(sun_seen), sky_img, exposure_gain=gain)
     sensor_frames = np.stack([
         (gain[k] * nz.apply_shake(radiance[k], dx[k], dy[k])).astype(np.float32)
         for k in range(len(times))])
@@ -250,6 +252,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
         "sun_rgb": var(("time", "channel"), sun_colour(elev, reference_elevation_deg=scene.start_elevation_deg), "1", "sun colour"),
         "sky_rgb": var(("time", "channel"), sky_colour(elev, start_elevation_deg=scene.start_elevation_deg), "1", "radiance of the uniform sky light"),
         "exposure_gain": var(("time",), gain, "1", "true total exposure gain (steps x flicker)"),
+        "lit_gain": var(("time",), lit_gain, "1", gt.DEFINITIONS["lit_gain"]),
+        "sky_gain": var(("time",), sky_gain, "1", gt.DEFINITIONS["sky_gain"]),
         "ae_ev": var(("time",), ae_ev, "EV", "auto-exposure step part"),
         "metered_level": var(("time",), levels, "1", "centre-weighted mean radiance metered by auto-exposure"),
         "shake_dx_px": var(("time",), dx, "pixel", "camera shake: content moves by +dx (columns)"),
