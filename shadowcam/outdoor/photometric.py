@@ -155,6 +155,12 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
 HALF_NORMAL_MEDIAN = 0.6744897501960817
 
 
+def _sorted_median(values):
+    """Median of a sorted 1-D array (as :func:`numpy.median`)."""
+    middle = values.size // 2
+    return float(values[middle]) if values.size % 2 else float(0.5 * (values[middle - 1] + values[middle]))
+
+
 def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0, min_ratio=0.5,
                       iterations=3):
     """Gain of the lit pixels a cloud shadow left unchanged: the brightest population of ratios.
@@ -176,7 +182,8 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     expected : float, optional
         Where the unchanged population is expected (the sky gain times the
         previous frame's lit-to-sky gain ratio: no cloud moves it). None: the
-        90th percentile of the ratios.
+        90th percentile of the ratios (the unchanged population must then hold
+        more than a tenth of the lit pixels).
     spread : float, optional
         Half-width of the population in scales (a Gaussian's 3 keeps 99.7 %).
     min_ratio : float, optional
@@ -203,19 +210,21 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     if expected is not None:
         check_positive(expected, "expected")
     use = pixels & (ref > 0)
-    ratio = luma[use] / ref[use]
+    ratio = np.sort(luma[use] / ref[use])  # once: every band below is a slice, its median an index
     if ratio.size < 10:
         return (np.nan if expected is None else float(expected)), 0, False
     gain = float(np.percentile(ratio, 90)) if expected is None else float(expected)
     start, kept = gain, 0
+    top = np.searchsorted(ratio, start / min_ratio, side="left")
     for _ in range(iterations):
-        above = ratio[(ratio >= gain) & (ratio < start / min_ratio)]
+        above = ratio[np.searchsorted(ratio, gain, side="left"):top]
         if above.size < 10:
             return start, 0, False
-        scale = float(np.median(above - gain)) / HALF_NORMAL_MEDIAN
-        band = ratio[np.abs(ratio - gain) <= spread * scale]
+        half_width = spread * (_sorted_median(above) - gain) / HALF_NORMAL_MEDIAN
+        band = ratio[np.searchsorted(ratio, gain - half_width, side="left"):
+                     np.searchsorted(ratio, gain + half_width, side="right")]
         kept = band.size
-        gain = float(np.median(band))
+        gain = _sorted_median(band)
     return gain, int(kept), True
 
 

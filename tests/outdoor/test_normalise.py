@@ -175,3 +175,44 @@ def test_later_frames_as_luminance_give_the_colour_pass_bit_for_bit(make_timelap
                                                                 reference=frames[0])["shift"])
     with pytest.raises(ValueError, match="frame must have 3 dimension"):
         normalise_frames([luminance(frames[0])] + list(frames[1:3]))  # the first frame sets the sky mask: colour
+
+
+def test_lit_gain_is_the_exposure_and_light_change_whatever_a_cloud_covers():
+    # lit rows 0-59, sky-lit rows 60-95 of a textured scene; exposure steps and a fading sun;
+    # a hard-rimmed cloud shadow (transmittance 0.6 of the sun term) over 0, 50, 90, 100 %
+    # of the lit pixels, then gone. Truth: the lit gain is exposure x the median over the
+    # lit pixels of the cloud-free ratio, the sky gain exposure x sky.
+    rng = np.random.default_rng(11)
+    texture = _texture((96, 128), seed=4)
+    sun_term, sky_term = 0.8 * texture, 0.12 * texture
+    lit = np.zeros((96, 128), bool)
+    lit[:60] = True
+    reference = np.where(lit, sun_term + sky_term, sky_term)
+    rows, cols = np.mgrid[:96, :128]
+    order = np.argsort((cols + 0.3 * rows)[lit])  # the cloud advances from the left
+    shares = [0.0, 0.0, 0.5, 0.9, 1.0, 1.0, 0.0, 0.5]
+    exposure = [1.0, 1.0, 1.26, 1.26, 1.26, 1.59, 1.59, 1.59]
+    sun = [1.0, 0.99, 0.98, 0.97, 0.97, 0.97, 0.96, 0.95]
+    frames, true_lit = [], []
+    for share, gain, fade in zip(shares, exposure, sun):
+        transmittance = np.ones(lit.sum())
+        transmittance[order[:int(round(share * lit.sum()))]] = 0.6
+        cloud = np.ones((96, 128))
+        cloud[lit] = transmittance
+        clear = gain * np.where(lit, fade * sun_term + sky_term, sky_term)
+        frame = gain * np.where(lit, cloud * fade * sun_term + sky_term, sky_term)
+        frame *= 1.0 + 0.005 * rng.standard_normal(frame.shape)
+        frames.append(np.repeat(frame[..., None], 3, axis=2).astype(np.float32))
+        true_lit.append(np.median(clear[lit] / reference[lit]))
+    frames[0] = np.repeat(reference[..., None], 3, axis=2).astype(np.float32)
+    result = normalise_frames(frames, sky=np.zeros((96, 128), bool))
+    error = result["gain_lit"] / np.array(true_lit) - 1
+    # with part of the lit pixels unclouded: the median of their ratios (0.5 % noise)
+    found = np.array(shares) < 1
+    assert np.all(np.abs(error[found]) < 0.002), error
+    assert np.all(result["gain_source"][found] == 0)
+    # under a cloud over every lit pixel: the sky gain x the lit-to-sky ratio of frame 3
+    # (the sun has not faded since: exact but for the sky gain's noise)
+    assert np.all(result["gain_source"][~found] == 1)
+    assert np.all(np.abs(error[~found]) < 0.002), error
+    np.testing.assert_allclose(result["gain_sky"], exposure, rtol=2e-3)
