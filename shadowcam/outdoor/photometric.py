@@ -171,7 +171,9 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     the pixels' own spread are on both sides. The population's scale is
     measured on the side a cloud cannot reach (above the current estimate: the
     median of a half-normal deviation is ``HALF_NORMAL_MEDIAN`` scales), the
-    gain is the median of the ratios within `spread` scales of it, repeated.
+    gain is the median of the ratios within `spread` scales of it, repeated
+    with the scale never growing (so that the band cannot widen into the
+    pixels below the population).
 
     Parameters
     ----------
@@ -187,8 +189,9 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     spread : float, optional
         Half-width of the population in scales (a Gaussian's 3 keeps 99.7 %).
     min_ratio : float, optional
-        Ratios above ``expected / min_ratio`` are left out of the scale (glints,
-        pixels not lit in the reference).
+        Ratios below ``min_ratio`` times the starting level (pixels the ridge
+        has shadowed since) or above it divided by ``min_ratio`` (glints, pixels
+        not fully lit in the reference) are left out.
     iterations : int, optional
 
     Returns
@@ -214,15 +217,20 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     if ratio.size < 10:
         return (np.nan if expected is None else float(expected)), 0, False
     gain = float(np.percentile(ratio, 90)) if expected is None else float(expected)
-    start, kept = gain, 0
+    start, kept, scale = gain, 0, np.inf
+    # ratios beyond min_ratio of the start either way changed state (newly shadowed, glints)
+    bottom = np.searchsorted(ratio, min_ratio * start, side="right")
     top = np.searchsorted(ratio, start / min_ratio, side="left")
     for _ in range(iterations):
         above = ratio[np.searchsorted(ratio, gain, side="left"):top]
         if above.size < 10:
             return start, 0, False
-        half_width = spread * (_sorted_median(above) - gain) / HALF_NORMAL_MEDIAN
-        band = ratio[np.searchsorted(ratio, gain - half_width, side="left"):
-                     np.searchsorted(ratio, gain + half_width, side="right")]
+        # the scale never grows: the band slides toward the population's centre, it cannot
+        # widen into the pixels below it (a cloud's, clipped ones)
+        scale = min(scale, (_sorted_median(above) - gain) / HALF_NORMAL_MEDIAN)
+        half_width = spread * scale
+        band = ratio[max(np.searchsorted(ratio, gain - half_width, side="left"), bottom):
+                     min(np.searchsorted(ratio, gain + half_width, side="right"), top)]
         kept = band.size
         gain = _sorted_median(band)
     return gain, int(kept), True
