@@ -32,6 +32,7 @@ merge_parts : merge the parts' results (concatenation and per-pixel minimum).
 PartMerger : the same, one part at a time (memory independent of the number of parts).
 aligned_luminance : one frame's registered luminance from the pass's results.
 GAIN_SOURCES : where a frame's lit gain comes from (the pass's ``gain_source`` codes).
+cloud_shade : the sun term's transmittance under a cloud over every lit pixel, per frame.
 """
 
 import numpy as np
@@ -46,7 +47,7 @@ from shadowcam.outdoor.translation import translate
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
 #: per-frame results of the pass, concatenated over time parts
-_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source")
+_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source", "gain_median")
 #: ``gain_source`` codes: where a frame's lit gain comes from
 GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before",
                 2: "median of the lit pixels (no sky-lit pixels)"}
@@ -112,6 +113,7 @@ class SequenceNormaliser:
             raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
                              "0 <= first_index <= record_from - 2 (two warm-up frames), or both 0")
         self.shifts, self.gain_lit, self.gain_sky, self.kept_lit, self.gain_source = [], [], [], [], []
+        self.gain_median = []  # median ratio of every lit pixel: follows a cloud (its shade, see result)
         self._recent = []
         self._last = None  # (shift, gain_lit, gain_sky) of the previous frame processed
         self._lit_to_sky = 1.0  # gain_lit / gain_sky of the previous frame (None: not known yet)
@@ -185,7 +187,7 @@ class SequenceNormaliser:
         if k == 0:
             self._start(frame)
             shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
-            kept, source = int(self._small_lit.sum()), 0
+            kept, source, rough = int(self._small_lit.sum()), 0, 1.0
         else:
             if frame.shape[:2] != self.reference.shape[:2] or frame.shape[2:] not in ((), self.reference.shape[2:]):
                 raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
@@ -210,6 +212,7 @@ class SequenceNormaliser:
             self.gain_sky.append(self._last[2])
             self.kept_lit.append(int(kept))
             self.gain_source.append(int(source))
+            self.gain_median.append(float(rough))
         if luma is not self.reference_luma:
             luma /= np.float32(gain_sky)  # a fresh array (translate); in place saves a frame-sized copy
         else:
@@ -246,6 +249,7 @@ class SequenceNormaliser:
             "gain_sky": np.array(self.gain_sky),
             "kept_lit": np.array(self.kept_lit),
             "gain_source": np.array(self.gain_source, dtype=np.int8),
+            "gain_median": np.array(self.gain_median),
             "shadow_min": self._shadow_min,
             "sky": self._sky,
             "lit_at_start": self.lit_at_start,
@@ -302,8 +306,11 @@ class PartMerger:
         ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
         lit_level = np.where(lit, ref, shadow_min / ratio)
+        curves = {key: np.concatenate(values) for key, values in self._curves.items()}
         return {
-            **{key: np.concatenate(values) for key, values in self._curves.items()},
+            **curves,
+            "cloud_shade": cloud_shade(curves["gain_median"], curves["gain_lit"], curves["gain_source"],
+                                       shadow_ratio=ratio),
             "sky": sky,
             "lit_at_start": lit,
             "lit_level": lit_level.astype(np.float32),
@@ -311,6 +318,37 @@ class PartMerger:
             "shadow_ratio": ratio,
             "reference": self._reference,
         }
+
+
+def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
+    """Transmittance of the sun term under a cloud that covers every lit pixel, per frame.
+
+    A lit pixel whose sky light is ``rho`` of its lit luminance reads ``rho + T (1 - rho)``
+    of the lit gain under a cloud of transmittance ``T``; the median ratio of the lit
+    pixels over the lit gain, with ``rho`` the pass's shadow-to-lit ratio, gives the median
+    ``T``. Only in frames without an unclouded lit population (``gain_source`` 1): where
+    part of the lit pixels is unclouded the cloud's shade varies over the frame and is
+    measured at the edge by the tracker (:mod:`shadowcam.outdoor.shade`).
+
+    Parameters
+    ----------
+    gain_median, gain_lit : (T,) ndarray
+        The median ratio of every lit pixel and the lit gain (:data:`GAIN_SOURCES`).
+    gain_source : (T,) int ndarray
+    shadow_ratio : float, keyword-only
+
+    Returns
+    -------
+    (T,) float64 ndarray
+        In (0, 1]; 1 in the other frames.
+    """
+    median = np.asarray(gain_median, dtype=np.float64)
+    lit = np.asarray(gain_lit, dtype=np.float64)
+    covered = np.asarray(gain_source) == 1
+    rho = float(np.clip(shadow_ratio, 0.0, 0.99))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shade = (median / lit - rho) / (1.0 - rho)
+    return np.where(covered & np.isfinite(shade), np.clip(shade, 0.05, 1.0), 1.0)
 
 
 def merge_parts(parts):
@@ -350,7 +388,8 @@ def normalise_frames(frames, **options):
     dict
         ``shift (T, 2)`` (row, col; pixels), ``gain_lit (T,)``, ``gain_sky (T,)``,
         ``kept_lit (T,)`` (pixels used for the lit gain), ``gain_source (T,)`` (int8, where
-        the lit gain comes from: :data:`GAIN_SOURCES`), ``sky``,
+        the lit gain comes from: :data:`GAIN_SOURCES`), ``gain_median (T,)`` (median ratio of
+        every lit pixel), ``cloud_shade (T,)`` (:func:`cloud_shade`), ``sky``,
         ``lit_at_start (H, W)`` bool, ``lit_level``, ``shadow_level (H, W)``
         (luminance of the reference frame's scale: lit in the reference, and
         sky-lit, normalised by ``gain_sky``), ``shadow_ratio`` (median

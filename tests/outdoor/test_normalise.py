@@ -215,4 +215,21 @@ def test_lit_gain_is_the_exposure_and_light_change_whatever_a_cloud_covers():
     # (the sun has not faded since: exact but for the sky gain's noise)
     assert np.all(result["gain_source"][~found] == 1)
     assert np.all(np.abs(error[~found]) < 0.002), error
+    # the cloud's shade there: 0.6 (no lit pixel is shadowed in this sequence, so the pass's
+    # shadow-to-lit ratio is its default 0.1 against the scene's 0.13: T reads 0.613)
+    assert np.all(result["cloud_shade"][found] == 1.0)
+    np.testing.assert_allclose(result["cloud_shade"][~found], 0.6, atol=0.02)
     np.testing.assert_allclose(result["gain_sky"], exposure, rtol=2e-3)
+
+
+def test_cloud_shade_is_the_median_transmittance_where_a_cloud_covers_every_lit_pixel():
+    from shadowcam.outdoor.normalise import cloud_shade
+
+    gain = np.array([1.0, 1.3, 1.3, 2.0, 2.0])
+    rho, transmittance = 0.15, np.array([1.0, 1.0, 0.55, 0.3, 1.0])
+    median = gain * (rho + transmittance * (1 - rho))  # the median lit pixel's ratio
+    source = np.array([0, 0, 1, 1, 0])
+    shade = cloud_shade(median, gain, source, shadow_ratio=rho)
+    np.testing.assert_allclose(shade, [1.0, 1.0, 0.55, 0.3, 1.0], rtol=1e-12)
+    # where an unclouded population was found the shade stays 1 (the tracker measures it at the edge)
+    assert np.all(cloud_shade(0.5 * gain, gain, np.zeros(5, int), shadow_ratio=rho) == 1.0)
