@@ -151,8 +151,8 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
     return float(prior), kept
 
 
-#: median of a half-normal variable over its scale
-HALF_NORMAL_MEDIAN = 0.6744897501960817
+#: lower quartile of a half-normal variable over its scale (``Phi^-1(5 / 8)``)
+HALF_NORMAL_QUARTILE = 0.31863936396437514
 
 
 def _sorted_median(values):
@@ -170,7 +170,9 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     gain of the unchanged ones, whatever its size, depth or border; noise and
     the pixels' own spread are on both sides. The population's scale is
     measured on the side a cloud cannot reach (above the current estimate: the
-    median of a half-normal deviation is ``HALF_NORMAL_MEDIAN`` scales), the
+    lower quartile of a half-normal deviation is ``HALF_NORMAL_QUARTILE`` scales;
+    the quartile, not the median, because pixels darker in the reference than
+    now (a cloud or the penumbra over them then) lie above too), the
     gain is the median of the ratios within `spread` scales of it, repeated
     with the scale never growing (so that the band cannot widen into the
     pixels below the population).
@@ -227,7 +229,7 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
             return start, 0, False
         # the scale never grows: the band slides toward the population's centre, it cannot
         # widen into the pixels below it (a cloud's, clipped ones)
-        scale = min(scale, (_sorted_median(above) - gain) / HALF_NORMAL_MEDIAN)
+        scale = min(scale, (above[(above.size - 1) // 4] - gain) / HALF_NORMAL_QUARTILE)
         half_width = spread * scale
         band = ratio[max(np.searchsorted(ratio, gain - half_width, side="left"), bottom):
                      min(np.searchsorted(ratio, gain + half_width, side="right"), top)]
