@@ -28,9 +28,8 @@ from shadowcam.outdoor.accuracy import PRIMARY_DEFINITION, evaluate_arrivals, ma
 from shadowcam.outdoor.arrival import arrival_map
 from shadowcam.outdoor.edges import track_edges
 from shadowcam.outdoor.photometry import photometry_from_frames
-from shadowcam.synthetic.outdoor.capture import render_outdoor_capture
+from shadowcam.synthetic.outdoor.capture import noisy_frame_store, render_outdoor_capture
 from shadowcam.synthetic.outdoor.render import SUN_DIAMETER_DEG, make_outdoor_scene
-from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
 
 SEED = 3
 
@@ -43,15 +42,7 @@ def render(args):
     capture = render_outdoor_capture(scene, frames=args.frames, supersample=args.supersample, seed=SEED,
                                      sun_diameter_deg=0.0 if args.point_sun else SUN_DIAMETER_DEG, cloud=cloud,
                                      shake_px=args.shake)
-    truth = capture.ground_truth
-    sensor = SensorModel(bit_depth=14)
-    scale = electrons_per_unit_radiance(truth["reference_radiance"].values, sensor=sensor, target_fraction=0.6)
-    images = np.stack([raw_to_linear(simulate_raw(f, sensor=sensor, scale=scale, seed=[SEED, k], mosaic=False),
-                                     sensor=sensor) for k, f in enumerate(capture.frames)])
-    store = xr.Dataset({"image": (("time", "row", "col", "channel"), images)},
-                       coords={"time_s": ("time", capture.times_s),
-                               "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)})
-    return store, truth
+    return noisy_frame_store(capture, seed=SEED), capture.ground_truth
 
 
 def load(args):

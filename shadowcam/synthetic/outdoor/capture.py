@@ -14,6 +14,7 @@ NUISANCES : switch -> default (auto_exposure, shake_px, cloud, irregular_timing,
 OutdoorCapture : times, per-frame records, noise-free sensor-plane frames ``E_k`` and the
     ground-truth Dataset.
 render_outdoor_capture : render a capture of an :class:`~shadowcam.synthetic.outdoor.render.OutdoorScene`.
+noisy_frame_store : a capture's frames through the sensor's noise, as an in-memory frame store.
 edge_speed : fraction of vertically adjacent class-3 pixel pairs the edge crosses in under a
     frame (edge faster than 1 px / frame there).
 """
@@ -293,6 +294,40 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
         "sun_diameter_deg": float(sun_diameter_deg),
     })
     return OutdoorCapture(frames=sensor_frames, ground_truth=ds)
+
+
+def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6):
+    """A capture's frames with Poisson-Gaussian sensor noise on linear RGB (no mosaic), as a frame store.
+
+    Parameters
+    ----------
+    capture : OutdoorCapture
+    bit_depth : int, keyword-only
+        Of the :class:`shadowcam.synthetic.sensor.SensorModel`.
+    seed : int, keyword-only
+        Frame ``k``'s noise is drawn with seed ``[seed, k]``.
+    exposure : float, keyword-only
+        The reference radiance's share of the sensor's range
+        (:func:`shadowcam.synthetic.sensor.electrons_per_unit_radiance`).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``image (time, row, col, channel)`` float32 in [0, 1], coords ``time_s`` and
+        ``exposure_s`` (4 ms times the auto-exposure steps: the metadata carries no flicker).
+    """
+    import xarray as xr
+
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
+
+    truth = capture.ground_truth
+    sensor = SensorModel(bit_depth=int(bit_depth))
+    scale = electrons_per_unit_radiance(truth["reference_radiance"].values, sensor=sensor, target_fraction=exposure)
+    images = np.stack([raw_to_linear(simulate_raw(frame, sensor=sensor, scale=scale, seed=[seed, k], mosaic=False),
+                                     sensor=sensor) for k, frame in enumerate(capture.frames)])
+    return xr.Dataset({"image": (("time", "row", "col", "channel"), images)},
+                      coords={"time_s": ("time", capture.times_s),
+                              "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)})
 
 
 def edge_speed(arrival_frame, shadow_class):
