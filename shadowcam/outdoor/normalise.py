@@ -37,7 +37,7 @@ cloud_shade : the sun term's transmittance under a cloud over every lit pixel, p
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array
+from shadowcam._shared.validation import check_array, check_same_shape
 from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
 from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
                                     shift_coarse_to_fine, static_weight)
@@ -333,9 +333,12 @@ def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
     Parameters
     ----------
     gain_median, gain_lit : (T,) ndarray
-        The median ratio of every lit pixel and the lit gain (:data:`GAIN_SOURCES`).
+        The median ratio of every lit pixel (on the frame before registration) and the lit
+        gain.
     gain_source : (T,) int ndarray
+        :data:`GAIN_SOURCES` codes.
     shadow_ratio : float, keyword-only
+        Median shadow-to-lit ratio of the pass (the lit pixels' sky share).
 
     Returns
     -------
@@ -344,7 +347,9 @@ def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
     """
     median = np.asarray(gain_median, dtype=np.float64)
     lit = np.asarray(gain_lit, dtype=np.float64)
-    covered = np.asarray(gain_source) == 1
+    source = np.asarray(gain_source)
+    check_same_shape({"gain_median": median, "gain_lit": lit, "gain_source": source})
+    covered = source == 1
     rho = float(np.clip(shadow_ratio, 0.0, 0.99))
     with np.errstate(divide="ignore", invalid="ignore"):
         shade = (median / lit - rho) / (1.0 - rho)

@@ -33,7 +33,7 @@ coverage : per-pixel lit fraction of a frame from its lit and shadow levels.
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array, check_positive, check_same_shape
+from shadowcam._shared.validation import check_array, check_in_interval, check_positive, check_same_shape
 from shadowcam.io.luminance import channel_mean
 
 
@@ -212,6 +212,7 @@ def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0
     pixels = np.asarray(pixels, dtype=bool)
     check_same_shape({"luma": luma, "reference_luma": ref, "pixels": pixels})
     check_positive(spread, "spread")
+    check_in_interval(min_ratio, "min_ratio", 0.0, 1.0, closed="neither")
     if expected is not None:
         check_positive(expected, "expected")
     use = pixels & (ref > 0)

@@ -283,3 +283,10 @@ def test_lit_gain_on_renders_of_passing_clouds(cloud):
     heavy = covered >= 0.8
     if heavy.any():
         assert np.median(error[heavy]) < 0.1
+
+
+def test_cloud_shade_needs_one_value_per_frame():
+    from shadowcam.outdoor.normalise import cloud_shade
+
+    with pytest.raises(ValueError, match="gain_source"):
+        cloud_shade(np.ones(4), np.ones(4), np.ones(3, int), shadow_ratio=0.15)

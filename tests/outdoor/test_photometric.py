@@ -128,5 +128,7 @@ def test_lit_gain_validates_its_options():
         estimate_lit_gain(frame, reference, pixels=lit, spread=0.0)
     with pytest.raises(ValueError, match="expected"):
         estimate_lit_gain(frame, reference, pixels=lit, expected=-1.0)
+    with pytest.raises(ValueError, match="min_ratio"):
+        estimate_lit_gain(frame, reference, pixels=lit, min_ratio=1.0)
     with pytest.raises(ValueError, match="pixels"):
         estimate_lit_gain(frame, reference, pixels=lit[:10])
