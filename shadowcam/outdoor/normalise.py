@@ -11,10 +11,12 @@ number of frames.
 
 Time parts (one job each): given frame 0, each frame's shift and gains depend
 on the previous frame only through the starting point of their searches (the
-gain prior, the shift's initial value), and the per-pixel minimum merges
-exactly. A part ``start:stop`` therefore first runs over ``overlap`` warm-up
-frames before `start` (searches started from the exposure metadata and zero
-shift; the 3-frame windows need two frames before `start`) and records
+gain prior, the shift's initial value, the lit-to-sky gain ratio where the lit
+gain is searched for; that ratio is also the lit gain's fallback under a cloud
+that covers every lit pixel), and the per-pixel minimum merges exactly. A part
+``start:stop`` therefore first runs over ``overlap`` warm-up frames before
+`start` (searches started from the exposure metadata, zero shift and the
+brightest lit pixels; the 3-frame windows need two frames before `start`) and records
 ``start .. stop - 1``; :func:`merge_parts` concatenates and takes the minimum.
 The parts equal the single job where the searches converge to the same
 solution from both starting points (measured on dev_ridge: see
@@ -29,12 +31,14 @@ part_frames : the frames a time part reads.
 merge_parts : merge the parts' results (concatenation and per-pixel minimum).
 PartMerger : the same, one part at a time (memory independent of the number of parts).
 aligned_luminance : one frame's registered luminance from the pass's results.
+GAIN_SOURCES : where a frame's lit gain comes from (the pass's ``gain_source`` codes).
+cloud_shade : the sun term's transmittance under a cloud over every lit pixel, per frame.
 """
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array
-from shadowcam.outdoor.photometric import estimate_gain, lit_at_start, luminance
+from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
 from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
                                     shift_coarse_to_fine, static_weight)
 from shadowcam.outdoor.sky_mask import auto_sky_mask
@@ -43,7 +47,10 @@ from shadowcam.outdoor.translation import translate
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
 #: per-frame results of the pass, concatenated over time parts
-_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit")
+_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source", "gain_median")
+#: ``gain_source`` codes: where a frame's lit gain comes from
+GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before",
+                2: "median of the lit pixels (no sky-lit pixels)"}
 
 
 class SequenceNormaliser:
@@ -105,9 +112,11 @@ class SequenceNormaliser:
         if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
             raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
                              "0 <= first_index <= record_from - 2 (two warm-up frames), or both 0")
-        self.shifts, self.gain_lit, self.gain_sky, self.kept_lit = [], [], [], []
+        self.shifts, self.gain_lit, self.gain_sky, self.kept_lit, self.gain_source = [], [], [], [], []
+        self.gain_median = []  # median ratio of every lit pixel: follows a cloud (its shade, see result)
         self._recent = []
         self._last = None  # (shift, gain_lit, gain_sky) of the previous frame processed
+        self._lit_to_sky = 1.0  # gain_lit / gain_sky of the previous frame (None: not known yet)
         if self._k > 0:
             if reference is None:
                 raise ValueError("reference (the first frame) is required when first_index > 0")
@@ -116,6 +125,7 @@ class SequenceNormaliser:
                 else np.nan
             seed = float(seed) if np.isfinite(seed) else 1.0
             self._last = (np.zeros(2), seed, seed)
+            self._lit_to_sky = None
 
     def _start(self, frame):
         check_array(frame, "frame", ndim=3)
@@ -142,6 +152,22 @@ class SequenceNormaliser:
                                               if np.isfinite(self._exposure[k - 1]) else 1.0)
         return previous
 
+    def _gains(self, small, rough, last_gain, last_sky):
+        """Sky gain, then the lit gain where the sky gain and the lit-to-sky ratio put it
+        (:func:`shadowcam.outdoor.photometric.estimate_lit_gain`); see :data:`GAIN_SOURCES`."""
+        ref = self._small_reference
+        if not self._small_shadowed.any():
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            return gain_lit, gain_lit, kept, 2
+        gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed, prior=last_sky * rough / last_gain)
+        expected = None if self._lit_to_sky is None else gain_sky * self._lit_to_sky
+        gain_lit, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit, expected=expected)
+        if not np.isfinite(gain_lit):  # too few lit pixels and no ratio yet
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            return gain_lit, gain_sky, kept, 2
+        self._lit_to_sky = gain_lit / gain_sky
+        return gain_lit, gain_sky, kept, 0 if found else 1
+
     def update(self, frame):
         """Process the next frame.
 
@@ -161,7 +187,7 @@ class SequenceNormaliser:
         if k == 0:
             self._start(frame)
             shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
-            kept = int(self._small_lit.sum())
+            kept, source, rough = int(self._small_lit.sum()), 0, 1.0
         else:
             if frame.shape[:2] != self.reference.shape[:2] or frame.shape[2:] not in ((), self.reference.shape[2:]):
                 raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
@@ -178,17 +204,15 @@ class SequenceNormaliser:
             luma = translate(raw, shift, method="opencv_cubic")
             del raw, small
             small = block_mean(luma, factor)
-            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
-            gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed,
-                                        prior=last_sky * gain_lit / last_gain)
-            if not self._small_shadowed.any():
-                gain_sky = gain_lit
+            gain_lit, gain_sky, kept, source = self._gains(small, rough, last_gain, last_sky)
         self._last = (np.asarray(shift, dtype=np.float64), float(gain_lit), float(gain_sky))
         if k >= self.record_from:
             self.shifts.append(self._last[0])
             self.gain_lit.append(self._last[1])
             self.gain_sky.append(self._last[2])
             self.kept_lit.append(int(kept))
+            self.gain_source.append(int(source))
+            self.gain_median.append(float(rough))
         if luma is not self.reference_luma:
             luma /= np.float32(gain_sky)  # a fresh array (translate); in place saves a frame-sized copy
         else:
@@ -211,7 +235,8 @@ class SequenceNormaliser:
         -------
         dict
             ``first_frame`` (index of the first recorded frame), ``shift (T_part, 2)``,
-            ``gain_lit``, ``gain_sky``, ``kept_lit (T_part,)``, ``shadow_min (H, W)``
+            ``gain_lit``, ``gain_sky``, ``kept_lit``, ``gain_source (T_part,)`` (:data:`GAIN_SOURCES`),
+            ``shadow_min (H, W)``
             (running minimum over the part's 3-frame windows), ``sky``, ``lit_at_start``
             ``(H, W)`` and ``reference (H, W, C)`` (frame 0; the same in every part).
         """
@@ -223,6 +248,8 @@ class SequenceNormaliser:
             "gain_lit": np.array(self.gain_lit),
             "gain_sky": np.array(self.gain_sky),
             "kept_lit": np.array(self.kept_lit),
+            "gain_source": np.array(self.gain_source, dtype=np.int8),
+            "gain_median": np.array(self.gain_median),
             "shadow_min": self._shadow_min,
             "sky": self._sky,
             "lit_at_start": self.lit_at_start,
@@ -279,8 +306,11 @@ class PartMerger:
         ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
         lit_level = np.where(lit, ref, shadow_min / ratio)
+        curves = {key: np.concatenate(values) for key, values in self._curves.items()}
         return {
-            **{key: np.concatenate(values) for key, values in self._curves.items()},
+            **curves,
+            "cloud_shade": cloud_shade(curves["gain_median"], curves["gain_lit"], curves["gain_source"],
+                                       shadow_ratio=ratio),
             "sky": sky,
             "lit_at_start": lit,
             "lit_level": lit_level.astype(np.float32),
@@ -288,6 +318,42 @@ class PartMerger:
             "shadow_ratio": ratio,
             "reference": self._reference,
         }
+
+
+def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
+    """Transmittance of the sun term under a cloud that covers every lit pixel, per frame.
+
+    A lit pixel whose sky light is ``rho`` of its lit luminance reads ``rho + T (1 - rho)``
+    of the lit gain under a cloud of transmittance ``T``; the median ratio of the lit
+    pixels over the lit gain, with ``rho`` the pass's shadow-to-lit ratio, gives the median
+    ``T``. Only in frames without an unclouded lit population (``gain_source`` 1): where
+    part of the lit pixels is unclouded the cloud's shade varies over the frame and is
+    measured at the edge by the tracker (:mod:`shadowcam.outdoor.shade`).
+
+    Parameters
+    ----------
+    gain_median, gain_lit : (T,) ndarray
+        The median ratio of every lit pixel (on the frame before registration) and the lit
+        gain.
+    gain_source : (T,) int ndarray
+        :data:`GAIN_SOURCES` codes.
+    shadow_ratio : float, keyword-only
+        Median shadow-to-lit ratio of the pass (the lit pixels' sky share).
+
+    Returns
+    -------
+    (T,) float64 ndarray
+        In (0, 1]; 1 in the other frames.
+    """
+    median = np.asarray(gain_median, dtype=np.float64)
+    lit = np.asarray(gain_lit, dtype=np.float64)
+    source = np.asarray(gain_source)
+    check_same_shape({"gain_median": median, "gain_lit": lit, "gain_source": source})
+    covered = source == 1
+    rho = float(np.clip(shadow_ratio, 0.0, 0.99))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        shade = (median / lit - rho) / (1.0 - rho)
+    return np.where(covered & np.isfinite(shade), np.clip(shade, 0.05, 1.0), 1.0)
 
 
 def merge_parts(parts):
@@ -326,7 +392,9 @@ def normalise_frames(frames, **options):
     -------
     dict
         ``shift (T, 2)`` (row, col; pixels), ``gain_lit (T,)``, ``gain_sky (T,)``,
-        ``kept_lit (T,)`` (pixels used for the lit gain), ``sky``,
+        ``kept_lit (T,)`` (pixels used for the lit gain), ``gain_source (T,)`` (int8, where
+        the lit gain comes from: :data:`GAIN_SOURCES`), ``gain_median (T,)`` (median ratio of
+        every lit pixel), ``cloud_shade (T,)`` (:func:`cloud_shade`), ``sky``,
         ``lit_at_start (H, W)`` bool, ``lit_level``, ``shadow_level (H, W)``
         (luminance of the reference frame's scale: lit in the reference, and
         sky-lit, normalised by ``gain_sky``), ``shadow_ratio`` (median

@@ -7,10 +7,16 @@ sun and the sky. A pixel's value is modelled as
     Y_k(p) = gain_lit_k * b(p)    while the sun reaches p (lit),
     Y_k(p) = gain_sky_k * a(p)    once p is in shadow (sky light only),
 
-with ``Y`` the mean of R, G, B. ``gain_lit`` (exposure x sun + sky) is
-estimated per frame on pixels that stay lit, ``gain_sky`` (exposure x sky) on
-pixels that are shadowed in the first frame; exposure metadata, where present,
-only seeds the search. Dividing by ``gain_lit`` keeps lit pixels at their own
+with ``Y`` the mean of R, G, B. ``gain_sky`` (exposure x sky) is estimated per
+frame on pixels that are shadowed in the first frame, ``gain_lit`` (exposure x
+sun + sky) on pixels that stay lit; exposure metadata, where present, only
+seeds the search. A cloud shadow removes part of the sun term only: it lowers
+the ratio frame / reference of the lit pixels it covers and leaves the sky-lit
+pixels alone. The lit gain is therefore the gain of the *brightest* population
+of lit pixels (those the cloud left unchanged), searched for where the sky gain
+times the previous frame's lit-to-sky ratio puts it; when a cloud covers every
+lit pixel that population is missing and the lit gain is the sky gain times
+that ratio (:func:`estimate_lit_gain`). Dividing by ``gain_lit`` keeps lit pixels at their own
 lit level, so the fading light is never taken for a shadow. The per-pixel
 coverage ``(Y - gain_sky a) / (gain_lit b - gain_sky a)`` is then 1 where
 lit, 0 where shadowed and the lit fraction of the footprint in between.
@@ -21,12 +27,13 @@ luminance : mean of the colour channels, float32 (:func:`shadowcam.io.luminance.
 exposure_gains : per-frame gain relative to the first frame from exposure times.
 lit_at_start : split the first frame into lit and shadowed pixels (Otsu on log Y).
 estimate_gain : robust gain of a frame relative to the reference on given pixels.
+estimate_lit_gain : the gain of the lit pixels a cloud shadow left unchanged.
 coverage : per-pixel lit fraction of a frame from its lit and shadow levels.
 """
 
 import numpy as np
 
-from shadowcam._shared.validation import check_array, check_positive, check_same_shape
+from shadowcam._shared.validation import check_array, check_in_interval, check_positive, check_same_shape
 from shadowcam.io.luminance import channel_mean
 
 
@@ -142,6 +149,94 @@ def estimate_gain(luma, reference_luma, *, pixels, prior=1.0, min_ratio=0.5, ite
         if kept >= max(10, 0.05 * ratio.size):
             return gain, kept
     return float(prior), kept
+
+
+#: lower quartile of a half-normal variable over its scale (``Phi^-1(5 / 8)``)
+HALF_NORMAL_QUARTILE = 0.31863936396437514
+
+
+def _sorted_median(values):
+    """Median of a sorted 1-D array (as :func:`numpy.median`)."""
+    middle = values.size // 2
+    return float(values[middle]) if values.size % 2 else float(0.5 * (values[middle - 1] + values[middle]))
+
+
+def estimate_lit_gain(luma, reference_luma, *, pixels, expected=None, spread=3.0, min_ratio=0.5,
+                      iterations=3):
+    """Gain of the lit pixels a cloud shadow left unchanged: the brightest population of ratios.
+
+    A cloud shadow only removes sunlight, so on pixels lit in the reference the
+    ratios ``luma / reference_luma`` of the pixels it covers lie *below* the
+    gain of the unchanged ones, whatever its size, depth or border; noise and
+    the pixels' own spread are on both sides. The population's scale is
+    measured on the side a cloud cannot reach (above the current estimate: the
+    lower quartile of a half-normal deviation is ``HALF_NORMAL_QUARTILE`` scales;
+    the quartile, not the median, because pixels darker in the reference than
+    now (a cloud or the penumbra over them then) lie above too), the
+    gain is the median of the ratios within `spread` scales of it, repeated
+    with the scale never growing (so that the band cannot widen into the
+    pixels below the population).
+
+    Parameters
+    ----------
+    luma, reference_luma : (H, W) ndarray
+        Luminance of the (registered) frame and of the reference frame.
+    pixels : (H, W) bool ndarray
+        Pixels sunlit in the reference.
+    expected : float, optional
+        Where the unchanged population is expected (the sky gain times the
+        previous frame's lit-to-sky gain ratio: no cloud moves it). None: the
+        90th percentile of the ratios (the unchanged population must then hold
+        more than a tenth of the lit pixels).
+    spread : float, optional
+        Half-width of the population in scales (a Gaussian's 3 keeps 99.7 %).
+    min_ratio : float, optional
+        Ratios below ``min_ratio`` times the starting level (pixels the ridge
+        has shadowed since) or above it divided by ``min_ratio`` (glints, pixels
+        not fully lit in the reference) are left out.
+    iterations : int, optional
+
+    Returns
+    -------
+    gain : float
+        The unchanged population's gain; `expected` when it is missing (fewer
+        than 10 ratios at or above the estimate: a cloud covers every lit
+        pixel), or when `pixels` hold fewer than 10 ratios.
+    kept : int
+        Ratios the gain is the median of (0 when it is missing).
+    found : bool
+        Whether the population was found.
+    """
+    luma = np.asarray(luma, dtype=np.float64)
+    ref = np.asarray(reference_luma, dtype=np.float64)
+    pixels = np.asarray(pixels, dtype=bool)
+    check_same_shape({"luma": luma, "reference_luma": ref, "pixels": pixels})
+    check_positive(spread, "spread")
+    check_in_interval(min_ratio, "min_ratio", 0.0, 1.0, closed="neither")
+    if expected is not None:
+        check_positive(expected, "expected")
+    use = pixels & (ref > 0)
+    ratio = np.sort(luma[use] / ref[use])  # once: every band below is a slice, its median an index
+    if ratio.size < 10:
+        return (np.nan if expected is None else float(expected)), 0, False
+    gain = float(np.percentile(ratio, 90)) if expected is None else float(expected)
+    start, kept, scale = gain, 0, np.inf
+    # ratios beyond min_ratio of the start either way changed state (newly shadowed, glints)
+    bottom = np.searchsorted(ratio, min_ratio * start, side="right")
+    top = np.searchsorted(ratio, start / min_ratio, side="left")
+    for _ in range(iterations):
+        above = ratio[np.searchsorted(ratio, gain, side="left"):top]
+        if above.size < 10:
+            return start, 0, False
+        # the scale never grows: the band slides toward the population's centre, it cannot
+        # widen into the pixels below it (a cloud's, clipped ones)
+        scale = min(scale, (above[(above.size - 1) // 4] - gain) / HALF_NORMAL_QUARTILE)
+        half_width = spread * scale
+        band = ratio[max(np.searchsorted(ratio, gain - half_width, side="left"), bottom):
+                     min(np.searchsorted(ratio, gain + half_width, side="right"), top)]
+        kept = band.size
+        gain = _sorted_median(band)
+    return gain, int(kept), True
 
 
 def coverage(luma, *, lit_level, shadow_level):

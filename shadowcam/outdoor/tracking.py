@@ -57,7 +57,9 @@ class EdgeTracker:
         ``lit_at_start``, ``lit_level``, ``shadow_level`` ``(H, W)`` and, optionally,
         ``shadow_ratio`` (the result of :func:`shadowcam.outdoor.normalise.normalise_frames`):
         with it the final descents keep their exposure-normalised luminance too and the long
-        ramps are timed by their half-level crossing (:mod:`shadowcam.outdoor.half_level`).
+        ramps are timed by their half-level crossing (:mod:`shadowcam.outdoor.half_level`);
+        optionally ``cloud_shade (T,)`` (:func:`shadowcam.outdoor.normalise.cloud_shade`),
+        divided out of the frame's coverage where below 1.
     time_s : (T,) ndarray
         Frame times in seconds.
     half_window : int, optional
@@ -96,6 +98,8 @@ class EdgeTracker:
         self.shift = np.asarray(photometry["shift"], dtype=np.float64)
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
+        shade = photometry.get("cloud_shade")
+        self.cloud_shade = np.ones_like(self.gain_lit) if shade is None else np.asarray(shade, dtype=np.float64)
         self.time_s = np.asarray(time_s, dtype=np.float64)
         n_frames = self.time_s.size
         if not (self.shift.shape == (n_frames, 2) and self.gain_lit.shape == self.gain_sky.shape == (n_frames,)):
@@ -146,6 +150,8 @@ class EdgeTracker:
         luma = translate(luminance(frame), self.shift[k], method="cubic_Keys1981") / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
+        if self.cloud_shade[k] < 1:  # a cloud over every lit pixel: its median shade divided out
+            cover /= np.float32(self.cloud_shade[k])
         if k:  # a passing cloud's shade at the edge (measured above the last edge found)
             shade = shade_above_edge(cover, self._last_edge, valid=self.lit_at_start & self.valid, gap=self._shade_gap)
             cover = remove_shade(cover, shade, self._last_edge, gap=self._shade_gap)

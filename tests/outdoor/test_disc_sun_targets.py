@@ -9,15 +9,13 @@ pixel centre): median <= 0.5, p95 <= 2 intervals, under 1% of the class-3 pixels
 
 import numpy as np
 import pytest
-import xarray as xr
 
 from shadowcam.outdoor.accuracy import PRIMARY_DEFINITION, evaluate_arrivals, map_to_truth_camera
 from shadowcam.outdoor.arrival import arrival_map
 from shadowcam.outdoor.edges import track_edges
 from shadowcam.outdoor.photometry import photometry_from_frames
-from shadowcam.synthetic.outdoor.capture import render_outdoor_capture
+from shadowcam.synthetic.outdoor.capture import noisy_frame_store, render_outdoor_capture
 from shadowcam.synthetic.outdoor.render import SUN_DIAMETER_DEG, make_outdoor_scene
-from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
 
 pytestmark = pytest.mark.slow
 
@@ -28,13 +26,7 @@ def _disc_sun_accuracy(*, height, width, frames, cloud, seed=3, elevations=(20.0
     capture = render_outdoor_capture(scene, frames=frames, supersample=2, seed=seed,
                                      sun_diameter_deg=SUN_DIAMETER_DEG, cloud=cloud)
     truth = capture.ground_truth
-    sensor = SensorModel(bit_depth=14)
-    scale = electrons_per_unit_radiance(truth["reference_radiance"].values, sensor=sensor, target_fraction=0.6)
-    images = np.stack([raw_to_linear(simulate_raw(frame, sensor=sensor, scale=scale, seed=[seed, k], mosaic=False),
-                                     sensor=sensor) for k, frame in enumerate(capture.frames)])
-    store = xr.Dataset({"image": (("time", "row", "col", "channel"), images)},
-                       coords={"time_s": ("time", capture.times_s),
-                               "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)})
+    store = noisy_frame_store(capture, seed=seed)
     photometry = photometry_from_frames(store)
     arrival = arrival_map(photometry, track_edges(store, photometry))
     estimate = map_to_truth_camera(arrival["arrival_time_s"].values, shift_row=float(truth["shake_dy_px"][0]),

@@ -175,3 +175,118 @@ def test_later_frames_as_luminance_give_the_colour_pass_bit_for_bit(make_timelap
                                                                 reference=frames[0])["shift"])
     with pytest.raises(ValueError, match="frame must have 3 dimension"):
         normalise_frames([luminance(frames[0])] + list(frames[1:3]))  # the first frame sets the sky mask: colour
+
+
+def test_lit_gain_is_the_exposure_and_light_change_whatever_a_cloud_covers():
+    # lit rows 0-59, sky-lit rows 60-95 of a textured scene; exposure steps and a fading sun;
+    # a hard-rimmed cloud shadow (transmittance 0.6 of the sun term) over 0, 50, 90, 100 %
+    # of the lit pixels, then gone. Truth: the lit gain is exposure x the median over the
+    # lit pixels of the cloud-free ratio, the sky gain exposure x sky.
+    rng = np.random.default_rng(11)
+    texture = _texture((96, 128), seed=4)
+    sun_term, sky_term = 0.8 * texture, 0.12 * texture
+    lit = np.zeros((96, 128), bool)
+    lit[:60] = True
+    reference = np.where(lit, sun_term + sky_term, sky_term)
+    rows, cols = np.mgrid[:96, :128]
+    order = np.argsort((cols + 0.3 * rows)[lit])  # the cloud advances from the left
+    shares = [0.0, 0.0, 0.5, 0.9, 1.0, 1.0, 0.0, 0.5]
+    exposure = [1.0, 1.0, 1.26, 1.26, 1.26, 1.59, 1.59, 1.59]
+    sun = [1.0, 0.99, 0.98, 0.97, 0.97, 0.97, 0.96, 0.95]
+    frames, true_lit = [], []
+    for share, gain, fade in zip(shares, exposure, sun):
+        transmittance = np.ones(lit.sum())
+        transmittance[order[:int(round(share * lit.sum()))]] = 0.6
+        cloud = np.ones((96, 128))
+        cloud[lit] = transmittance
+        clear = gain * np.where(lit, fade * sun_term + sky_term, sky_term)
+        frame = gain * np.where(lit, cloud * fade * sun_term + sky_term, sky_term)
+        frame *= 1.0 + 0.005 * rng.standard_normal(frame.shape)
+        frames.append(np.repeat(frame[..., None], 3, axis=2).astype(np.float32))
+        true_lit.append(np.median(clear[lit] / reference[lit]))
+    frames[0] = np.repeat(reference[..., None], 3, axis=2).astype(np.float32)
+    result = normalise_frames(frames, sky=np.zeros((96, 128), bool))
+    error = result["gain_lit"] / np.array(true_lit) - 1
+    # with part of the lit pixels unclouded: the median of their ratios (0.5 % noise)
+    found = np.array(shares) < 1
+    assert np.all(np.abs(error[found]) < 0.002), error
+    assert np.all(result["gain_source"][found] == 0)
+    # under a cloud over every lit pixel: the sky gain x the lit-to-sky ratio of frame 3
+    # (the sun has not faded since: exact but for the sky gain's noise)
+    assert np.all(result["gain_source"][~found] == 1)
+    assert np.all(np.abs(error[~found]) < 0.002), error
+    # the cloud's shade there: 0.6 (no lit pixel is shadowed in this sequence, so the pass's
+    # shadow-to-lit ratio is its default 0.1 against the scene's 0.13: T reads 0.613)
+    assert np.all(result["cloud_shade"][found] == 1.0)
+    np.testing.assert_allclose(result["cloud_shade"][~found], 0.6, atol=0.02)
+    np.testing.assert_allclose(result["gain_sky"], exposure, rtol=2e-3)
+
+
+def test_cloud_shade_is_the_median_transmittance_where_a_cloud_covers_every_lit_pixel():
+    from shadowcam.outdoor.normalise import cloud_shade
+
+    gain = np.array([1.0, 1.3, 1.3, 2.0, 2.0])
+    rho, transmittance = 0.15, np.array([1.0, 1.0, 0.55, 0.3, 1.0])
+    median = gain * (rho + transmittance * (1 - rho))  # the median lit pixel's ratio
+    source = np.array([0, 0, 1, 1, 0])
+    shade = cloud_shade(median, gain, source, shadow_ratio=rho)
+    np.testing.assert_allclose(shade, [1.0, 1.0, 0.55, 0.3, 1.0], rtol=1e-12)
+    # where an unclouded population was found the shade stays 1 (the tracker measures it at the edge)
+    assert np.all(cloud_shade(0.5 * gain, gain, np.zeros(5, int), shadow_ratio=rho) == 1.0)
+
+
+def _window_gain_errors(cloud):
+    """The first pass's lit gain against the renderer's on a 48x64 window of the ridge at a
+    photographer's cadence (the strip's scale: a cloud covers much or all of it), per frame,
+    with the share of the lit pixels under the cloud (transmittance < 0.95), the pass's result and
+    the median transmittance over the lit pixels."""
+    from shadowcam.synthetic.outdoor.capture import noisy_frame_store, render_outdoor_capture
+    from shadowcam.synthetic.outdoor.render import SUN_DIAMETER_DEG, make_outdoor_scene
+
+    scene = make_outdoor_scene(seed=3, height=400, width=600, start_elevation_deg=8.0, end_elevation_deg=6.4,
+                               window=(150, 270, 48, 64))
+    capture = render_outdoor_capture(scene, frames=48, supersample=1, seed=3, sun_diameter_deg=SUN_DIAMETER_DEG,
+                                     cloud=cloud)
+    truth = capture.ground_truth
+    result = normalise_frames(noisy_frame_store(capture, seed=3)["image"].values)
+    lit = (truth["shadow_class"].values != 0) & truth["lit_center"].values[0].astype(bool)
+    covered = (truth["cloud_attenuation"].values[:, lit] < 0.95).mean(axis=1)
+    transmittance = np.median(truth["cloud_attenuation"].values[:, lit], axis=1)
+    return np.abs(result["gain_lit"] / truth["lit_gain"].values - 1), covered, result, transmittance
+
+
+def test_lit_gain_on_renders_under_a_cloud_over_the_whole_window():
+    # the drifting soft cloud covers 0 -> 50 -> 100 -> 90 -> 0 % of the window's lit pixels;
+    # the median of the lit ratios followed it (42 % low where it covers every lit pixel)
+    error, covered, result, transmittance = _window_gain_errors(True)
+    assert covered.max() == 1.0 and ((covered > 0.4) & (covered < 0.8)).any()
+    assert np.all(result["gain_source"][covered < 0.8] == 0)
+    assert (result["gain_source"][covered == 1.0] == 1).all()
+    # the lit-to-sky ratio is carried through the covered frames from the cloud's soft arrival,
+    # where a thin shade over every lit pixel reads as the light's change (4 % low)
+    assert np.all(error < 0.05), error
+    # the cloud's shade where it covers every lit pixel: the truth's median transmittance over
+    # the lit pixels, within what the lit gain's error (< 5 %) makes of it over 1 - rho
+    assert np.all(result["cloud_shade"][result["gain_source"] == 0] == 1.0)
+    held = result["gain_source"] == 1
+    np.testing.assert_allclose(result["cloud_shade"][held], transmittance[held], atol=0.06)
+
+
+@pytest.mark.parametrize("cloud", ["small_fast_hard", "dozen_frames", "edge_crossing"])
+def test_lit_gain_on_renders_of_passing_clouds(cloud):
+    # clouds of 60-120 m (hard, soft rims; 5-12 frames over a point) that cover up to 60-100 %
+    # of the window's lit pixels: where they cover 80 % or more the median of the lit ratios
+    # was 54-62 % low; the unclouded rest gives the gain within 10 % (median over those frames;
+    # single frames of their soft arrival reach 44 %, see docs/benchmarks.md)
+    error, covered, _, _ = _window_gain_errors(cloud)
+    assert np.all(error[covered == 0] < 0.02)  # cloud-free frames: 1.3 % at most (the old median 2.2 %)
+    heavy = covered >= 0.8
+    if heavy.any():
+        assert np.median(error[heavy]) < 0.1
+
+
+def test_cloud_shade_needs_one_value_per_frame():
+    from shadowcam.outdoor.normalise import cloud_shade
+
+    with pytest.raises(ValueError, match="gain_source"):
+        cloud_shade(np.ones(4), np.ones(4), np.ones(3, int), shadow_ratio=0.15)

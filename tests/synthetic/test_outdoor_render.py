@@ -274,3 +274,32 @@ def test_render_cli_writes_an_outdoor_capture(tmp_path):
     np.testing.assert_allclose(dn, np.round(expected), atol=1.0)
     assert gt.attrs["step"] == "render" and json.loads(gt.attrs["input_checksums"])
     gt.close()
+
+
+def test_state_gains_are_the_median_ratios_of_whole_sun_and_no_sun_pixels():
+    from shadowcam.synthetic.outdoor.truth import state_gains
+
+    rng = np.random.default_rng(3)
+    first = rng.uniform(0.2, 1.0, (6, 8, 3))
+    seen = np.zeros((3, 6, 8))
+    seen[:, :2] = 1.0      # whole sun in every frame: x 0.8 of the light
+    seen[:, 2] = 0.5       # partly: left out
+    seen[2, 1] = 0.7       # row 1 loses part of the sun in frame 2: left out there
+    sky = np.zeros((6, 8), bool)
+    sky[5] = True
+    clear = np.stack([first, first * np.where(seen[1][..., None] == 1, 0.8, 0.9),
+                      first * np.where(seen[2][..., None] == 1, 0.8, 0.9)])
+    clear[:, 5] = 7.0  # sky pixels: left out
+    lit_gain, sky_gain = state_gains(clear, seen, sky, exposure_gain=np.array([1.0, 2.0, 4.0]))
+    np.testing.assert_allclose(lit_gain, [1.0, 1.6, 3.2], rtol=1e-12)
+    np.testing.assert_allclose(sky_gain, [1.0, 1.8, 3.6], rtol=1e-12)
+    _, none = state_gains(clear, np.ones_like(seen), sky, exposure_gain=np.ones(3))
+    assert np.isnan(none).all()
+
+
+def test_capture_truth_holds_the_lit_and_sky_gains(clean):
+    truth = clean.ground_truth
+    # no nuisance: exposure 1, so the gains are the light's own change (the sun and the sky fading)
+    assert truth["lit_gain"].values[0] == 1.0 and truth["sky_gain"].values[0] == 1.0
+    assert np.all(np.diff(truth["sky_gain"].values) < 0)  # the sky dims as the sun sets
+    assert np.all(truth["lit_gain"].values[1:] < 1)

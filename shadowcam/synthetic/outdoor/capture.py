@@ -14,6 +14,7 @@ NUISANCES : switch -> default (auto_exposure, shake_px, cloud, irregular_timing,
 OutdoorCapture : times, per-frame records, noise-free sensor-plane frames ``E_k`` and the
     ground-truth Dataset.
 render_outdoor_capture : render a capture of an :class:`~shadowcam.synthetic.outdoor.render.OutdoorScene`.
+noisy_frame_store : a capture's frames through the sensor's noise, as an in-memory frame store.
 edge_speed : fraction of vertically adjacent class-3 pixel pairs the edge crosses in under a
     frame (edge faster than 1 px / frame there).
 """
@@ -157,7 +158,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
     if not cloud_on:
         clouds = []
     hit = ~samples.sky
-    radiance, clean, cloud_att = [], [], []
+    radiance, clean, cloud_att, sun_seen = [], [], [], []
     progress = Progress(len(times), "outdoor render: frames")
     for k, t in enumerate(times):
         trans = np.ones(len(samples.sky))
@@ -170,6 +171,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
         radiance.append(L)
         clean.append(L_clear)
         cloud_att.append(_pixel_mean(trans, (rows, cols), s2).astype(np.float32))
+        sun_seen.append(_pixel_mean(np.asarray(lit, dtype=np.float64), (rows, cols), s2))
         progress.update(k + 1)
     log.info("outdoor render: exposure, shake and the pushbroom ground truth")
     radiance = np.stack(radiance)
@@ -177,6 +179,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
     levels = np.array([nz.metered_level(L) for L in radiance])
     gain, ae_ev = nz.auto_exposure(levels, seed=seed, enabled=bool(opts["auto_exposure"]))
     dx, dy = nz.shake_offsets(len(times), seed=seed, max_px=float(opts["shake_px"]))
+    lit_gain, sky_gain = gt.state_gains(clean, np.stack(sun_seen), sky_img, exposure_gain=gain)
     sensor_frames = np.stack([
         (gain[k] * nz.apply_shake(radiance[k], dx[k], dy[k])).astype(np.float32)
         for k in range(len(times))])
@@ -250,6 +253,8 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
         "sun_rgb": var(("time", "channel"), sun_colour(elev, reference_elevation_deg=scene.start_elevation_deg), "1", "sun colour"),
         "sky_rgb": var(("time", "channel"), sky_colour(elev, start_elevation_deg=scene.start_elevation_deg), "1", "radiance of the uniform sky light"),
         "exposure_gain": var(("time",), gain, "1", "true total exposure gain (steps x flicker)"),
+        "lit_gain": var(("time",), lit_gain, "1", gt.DEFINITIONS["lit_gain"]),
+        "sky_gain": var(("time",), sky_gain, "1", gt.DEFINITIONS["sky_gain"]),
         "ae_ev": var(("time",), ae_ev, "EV", "auto-exposure step part"),
         "metered_level": var(("time",), levels, "1", "centre-weighted mean radiance metered by auto-exposure"),
         "shake_dx_px": var(("time",), dx, "pixel", "camera shake: content moves by +dx (columns)"),
@@ -289,6 +294,40 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
         "sun_diameter_deg": float(sun_diameter_deg),
     })
     return OutdoorCapture(frames=sensor_frames, ground_truth=ds)
+
+
+def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6):
+    """A capture's frames with Poisson-Gaussian sensor noise on linear RGB (no mosaic), as a frame store.
+
+    Parameters
+    ----------
+    capture : OutdoorCapture
+    bit_depth : int, keyword-only
+        Of the :class:`shadowcam.synthetic.sensor.SensorModel`.
+    seed : int, keyword-only
+        Frame ``k``'s noise is drawn with seed ``[seed, k]``.
+    exposure : float, keyword-only
+        The reference radiance's share of the sensor's range
+        (:func:`shadowcam.synthetic.sensor.electrons_per_unit_radiance`).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``image (time, row, col, channel)`` float32 in [0, 1], coords ``time_s`` and
+        ``exposure_s`` (4 ms times the auto-exposure steps: the metadata carries no flicker).
+    """
+    import xarray as xr
+
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, raw_to_linear, simulate_raw
+
+    truth = capture.ground_truth
+    sensor = SensorModel(bit_depth=int(bit_depth))
+    scale = electrons_per_unit_radiance(truth["reference_radiance"].values, sensor=sensor, target_fraction=exposure)
+    images = np.stack([raw_to_linear(simulate_raw(frame, sensor=sensor, scale=scale, seed=[seed, k], mosaic=False),
+                                     sensor=sensor) for k, frame in enumerate(capture.frames)])
+    return xr.Dataset({"image": (("time", "row", "col", "channel"), images)},
+                      coords={"time_s": ("time", capture.times_s),
+                              "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)})
 
 
 def edge_speed(arrival_frame, shadow_class):

@@ -8,6 +8,7 @@ Offers
 ------
 SHADOW_CLASSES : class code -> name (0 sky, 1 never shadowed, 2 shadowed at start, 3 arrives).
 DEFINITIONS : variable -> definition (stored as the ``definitions`` attr, JSON).
+state_gains : the true lit and sky gains of each frame.
 arrival_times : per-sample first unlit time (frames scanned, then bisected in time).
 classify : shadow classes and masks of pixel centres from their lit-per-frame table.
 pushbroom_edge : ``pb_edge_y`` and ``pb_n_transitions`` from pixel-centre arrival times.
@@ -76,8 +77,42 @@ DEFINITIONS = {
                          "terrain shadow and does not enter lit / arrival times",
     "exposure_gain": "true total gain of frame k (auto-exposure steps x flicker); the frame's "
                      "ExposureTime metadata carries only the step part (ae_ev)",
+    "lit_gain": "(time) the gain of sunlit pixels: exposure_gain x the median over non-sky pixels "
+                "whose footprint sees the whole sun in frames 0 and k of their cloud-free luminance "
+                "in frame k / in frame 0 (what the first outdoor pass's gain_lit estimates; NaN "
+                "without such pixels)",
+    "sky_gain": "(time) the gain of sky-lit pixels: the same over pixels that see none of the sun "
+                "in frames 0 and k (a cloud shadow does not change it)",
 }
 
+
+
+def state_gains(clear, sun_seen, sky, *, exposure_gain):
+    """The true lit and sky gains of each frame (:data:`DEFINITIONS` ``lit_gain``, ``sky_gain``).
+
+    Parameters
+    ----------
+    clear : (K, H, W, 3) ndarray
+        Cloud-free radiance of every frame (before exposure, shake and noise).
+    sun_seen : (K, H, W) ndarray
+        Visible fraction of the sun over each pixel's footprint.
+    sky : (H, W) bool ndarray
+    exposure_gain : (K,) ndarray
+
+    Returns
+    -------
+    lit_gain, sky_gain : (K,) float64 ndarray
+    """
+    luma = np.asarray(clear, dtype=np.float64).mean(axis=-1)
+    seen = np.asarray(sun_seen, dtype=np.float64)
+    terrain = ~np.asarray(sky, dtype=bool) & (luma[0] > 0)
+    out = np.full((2, len(luma)), np.nan)
+    for k in range(len(luma)):
+        for row, keep in enumerate(((seen[0] == 1) & (seen[k] == 1), (seen[0] == 0) & (seen[k] == 0))):
+            keep &= terrain
+            if keep.any():
+                out[row, k] = exposure_gain[k] * np.median(luma[k][keep] / luma[0][keep])
+    return out[0], out[1]
 
 
 def arrival_times(geometry, sun, frame_times, *, bisect_steps=30, offset_rad=0.0):
