@@ -135,8 +135,8 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0):
                                                        minima.depth))
     ok = reason == OK
     with np.errstate(invalid="ignore", divide="ignore"):
-        level = minima.significance * minima.noise[None]
-        confidence = np.clip((depth - level) / np.maximum(level, 1e-12), 0.0, 1.0)
+        snr = gather(minima.depth_snr)
+        confidence = np.clip(snr / minima.significance - 1.0, 0.0, 1.0)
     return {"time": np.where(ok, est, np.nan), "contrast": contrast, "time_std": std,
             "confidence": np.where(ok, np.nan_to_num(confidence, nan=1.0), 0.0), "reason": reason}
 

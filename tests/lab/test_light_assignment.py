@@ -24,6 +24,7 @@ def _minima(times, *, extra=None):
                   depth=np.where(present, 0.5, np.nan), contrast=np.where(present, 0.5, np.nan),
                   level=np.ones_like(times), width=np.where(present, 2.0, np.nan),
                   time_std=np.where(present, 0.05, np.nan), reason=reason,
+                  depth_snr=np.where(present, 50.0, np.nan),
                   count=present.sum(axis=0), extra_contrast=np.zeros(shape) if extra is None else extra,
                   noise=np.full(shape, 0.01), lit_level=np.ones(shape), n_frames=80, significance=3.0)
 
