@@ -475,11 +475,13 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     # under a steady level the window's ends must reach the level of the frames far from
     # every minimum (within a tenth of the dip's depth, and within what the noise of the
     # two means allows at `false_alarm`): else the dip is wider than the window, or runs
-    # into the next one, and its crossings are not its own
+    # into the next one, and its crossings are not its own. Where that noise allowance
+    # exceeds half the dip's depth the window's closure cannot be established: not timed.
     with np.errstate(invalid="ignore", divide="ignore"):
         end_level = np.minimum(level[:, 0, :], level[:, -1, :])
         end_noise = -ndtri(false_alarm) * noise * np.sqrt(0.5 + 1.0 / np.maximum(passing.lit_count, 1))
-        unlit_ends = ~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest) - end_noise[None])
+        unlit_ends = (~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest) - end_noise[None])
+                      | (end_noise[None] > 0.5 * (lit_level[None] - raw_lowest)))
     open_dip = ~np.isfinite(width) | (unlit_ends if steady_level else False)
     # a cut window whose dip does not close: another minimum closer than their widths
     reason[strong & open_dip & cut_by_other.any(axis=1)] = OVERLAPPING
