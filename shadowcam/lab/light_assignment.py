@@ -101,10 +101,12 @@ def _predict(time, radius, gaps):
     return out
 
 
-def _match(estimate, predicted, tolerance):
+def _match(estimate, predicted, tolerance, gaps, timed):
     """Each light's minimum: the significant minimum nearest its prediction within
-    `tolerance`, taken by no nearer light; -1 where none. `estimate` (K, H, W), NaN = not
-    significant; `predicted` (L, H, W)."""
+    `tolerance`, taken by no nearer light; two matched `timed` minima ((K, H, W) bool) of
+    lights k < j must differ by the median gaps between them (`gaps`, (L - 1,)) within
+    ``(j - k) tolerance``, else the one further from its prediction is dropped; -1 where
+    none. `estimate` (K, H, W), NaN = not significant; `predicted` (L, H, W)."""
     with np.errstate(invalid="ignore"):
         distance = np.abs(estimate[None] - predicted[:, None])  # (L, K, H, W)
     distance = np.where(np.isfinite(distance) & (distance <= tolerance), distance, np.inf)
@@ -118,6 +120,16 @@ def _match(estimate, predicted, tolerance):
             if j != k:
                 lose = (pick[k] >= 0) & (pick[k] == pick[j]) & (best_distance[j] < best_distance[k])
                 pick[k][lose] = -1
+    if np.all(np.isfinite(gaps)):
+        offset = np.concatenate([[0.0], np.cumsum(gaps)])
+        time = np.where(_gather(timed, pick) == 1, _gather(estimate, pick), np.nan)
+        with np.errstate(invalid="ignore"):
+            for k in range(pick.shape[0]):
+                for j in range(k + 1, pick.shape[0]):
+                    off = np.abs(time[j] - time[k] - (offset[j] - offset[k])) > (j - k) * tolerance
+                    drop_k = off & (best_distance[k] >= best_distance[j])
+                    pick[k][drop_k], time[k][drop_k] = -1, np.nan
+                    pick[j][off & ~drop_k], time[j][off & ~drop_k] = -1, np.nan
     return pick
 
 
@@ -128,14 +140,16 @@ def _gather(values, pick):
     return np.where(pick >= 0, out, np.nan)
 
 
-def _propagate(seed, estimate, radius, tolerance, iterations):
+def _propagate(seed, estimate, timed, radius, tolerance, iterations):
     """Seeds grown by continuity: per light, the prediction from the neighbours and the
-    matching of each pixel's minima to it, repeated until nothing changes; (L, H, W)."""
+    matching of each pixel's minima to it (:func:`_match`), repeated until nothing
+    changes; (L, H, W)."""
     pick = seed
     for _ in range(int(iterations)):
         time = _gather(estimate, pick)
-        predicted = _predict(time, radius, _gaps(time))
-        matched = _match(estimate, predicted, tolerance)
+        gaps = _gaps(time)
+        predicted = _predict(time, radius, gaps)
+        matched = _match(estimate, predicted, tolerance, gaps, timed)
         # a seed stands unless its neighbours give one of its minima to another light;
         # a pixel with no prediction at all (isolated) keeps its seed's order
         moved = ((matched >= 0) & (matched != seed)).any(axis=0)
@@ -191,7 +205,7 @@ def _seed_partial(seed, estimate, gaps, n_frames, tolerance, *, informative):
     return out
 
 
-def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
+def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None):
     """Per-light shadow times from each pixel's minima, checked by spatial continuity.
 
     Seeds are the pixels with exactly `n_lights` significant minima whose gaps agree with
@@ -203,7 +217,8 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
     that disagrees with its neighbours by whole inter-light gaps is re-assigned to the
     light the neighbours make unambiguous, or left unassigned. A light with no minimum
     is ``minima_count``; a pixel with no neighbours keeps its seed's order; a time further
-    than `tolerance` from its light's neighbourhood is ``ambiguous_order``.
+    than `tolerance` from its light's neighbourhood, or that no neighbour's time for that
+    light confirms (within `tolerance` along the local slope), is ``ambiguous_order``.
 
     Parameters
     ----------
@@ -214,8 +229,9 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
         Neighbourhood (pixels) of the continuity check.
     tolerance : float
         Frames a time may differ from its light's neighbourhood median.
-    iterations : int
-        Passes of the prediction and matching.
+    iterations : int, optional
+        Most passes of the prediction and matching (each grows the assigned regions by
+        about `radius` pixels); default until nothing changes, at most ``max(H, W)``.
 
     Returns
     -------
@@ -237,6 +253,7 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
                          "find at least one minimum per light")
     check_positive(tolerance, "tolerance", finite=True)
     radius = int(radius)
+    iterations = max(minima.count.shape) if iterations is None else int(iterations)
     significant = (minima.reason != _m.MISSING) & (minima.reason != _m.LOW_CONTRAST)
     estimate = np.where(significant, minima.estimate, np.nan)
     ordered = (minima.count == n_lights) & (minima.extra_contrast == 0)
@@ -248,7 +265,7 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
     with np.errstate(invalid="ignore"):
         off = np.abs(np.diff(seed_time, axis=0) - gaps[:, None, None]) > tolerance
     seed[:, off.any(axis=0)] = -1
-    pick = _propagate(seed, estimate, radius, tolerance, iterations)
+    pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
     # a light seen in most pixels where its shadow falls inside the sweep: its absence
     # there is evidence, and seeds pixels with fewer minima (:func:`_seed_partial`)
     time = _gather(estimate, pick)
@@ -258,7 +275,7 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
     timed = (pick >= 0) & (np.take_along_axis(minima.reason, np.maximum(pick, 0), 0) == _m.OK)
     seen = (inside & timed).sum(axis=(1, 2)) / np.maximum(inside.sum(axis=(1, 2)), 1)
     seed = _seed_partial(seed, estimate, gaps, minima.n_frames, tolerance, informative=seen > 0.5)
-    pick = _propagate(seed, estimate, radius, tolerance, iterations)
+    pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
     time = _gather(estimate, pick)
     total, agree = _agreement(time, tolerance, radius)
     median = _neighbour_median(time, radius)
@@ -267,7 +284,8 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=8):
     reason = np.where(pick >= 0, to_light(own), MINIMA_COUNT).astype(np.int8)
     with np.errstate(invalid="ignore"):
         jump = (pick >= 0) & (np.abs(time - median) > tolerance)
-    reason[jump] = AMBIGUOUS_ORDER
+    # a time no neighbour confirms cannot be checked: flagged, not guessed
+    reason[jump | ((reason == OK) & (agree == 0))] = AMBIGUOUS_ORDER
     contrast, std, snr = (_gather(a, pick) for a in (minima.contrast, minima.time_std, minima.depth_snr))
     ok = reason == OK
     with np.errstate(invalid="ignore"):

@@ -123,7 +123,7 @@ def light_set_errors(views, capture, *, min_level=0.2):
     return out
 
 
-def light_set_accuracy(views, capture, *, min_level=0.2):
+def light_set_accuracy(views, capture, *, min_level=0.2, false_error=1.0):
     """Per-light, per-sweep accuracy against the renderer's per-light times.
 
     Parameters
@@ -134,6 +134,8 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
         As for :func:`light_set_errors`.
     min_level : float
         Pixels darker than this fraction of the median reference are not scored.
+    false_error : float
+        Frames: a timed pixel further than this from the truth is a false time.
 
     Returns
     -------
@@ -141,7 +143,10 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
         ``lights``: one entry per light with, per sweep, ``p95_error``, ``rmse`` and
         ``max_error`` (frames, over its timed scored pixels), ``coverage`` (timed fraction
         of the scored pixels: lit, the light's shadow entirely inside the sweep),
-        ``n_scored``, ``contrast`` (median) and ``reasons`` (name -> count).
+        ``n_scored``, ``contrast`` (median), ``false_rate`` (fraction of the timed scored
+        pixels further than `false_error` from the truth), ``confidence_true`` and
+        ``confidence_false`` (median confidence on the timed pixels within and beyond
+        `false_error`; None where none) and ``reasons`` (name -> count).
     """
     errors = light_set_errors(views, capture, min_level=min_level)
     out = []
@@ -153,6 +158,9 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
             reason = views["reason"].values[s, k]
             timed = np.isfinite(err)
             contrast = views["contrast"].values[s, k][scored]
+            confidence = views["confidence"].values[s, k][scored]
+            false = timed & (np.nan_to_num(err, nan=0.0) > false_error)
+            true = timed & ~false
             entry[name] = {
                 "p95_error": float(np.percentile(err[timed], 95)) if timed.any() else None,
                 "rmse": float(np.sqrt(np.mean(err[timed] ** 2))) if timed.any() else None,
@@ -160,6 +168,9 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
                 "coverage": float(timed.mean()) if scored.any() else 0.0,
                 "n_scored": int(scored.sum()),
                 "contrast": float(np.nanmedian(contrast)) if np.isfinite(contrast).any() else None,
+                "false_rate": float(false.sum() / timed.sum()) if timed.any() else None,
+                "confidence_true": float(np.median(confidence[true])) if true.any() else None,
+                "confidence_false": float(np.median(confidence[false])) if false.any() else None,
                 "reasons": {label: int(np.sum(reason[scored] == code)) for code, label in LIGHT_REASONS.items()},
             }
         out.append(entry)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from shadowcam.lab.light_views import light_set_accuracy, light_set_views
+from shadowcam.lab.light_views import light_set_accuracy, light_set_errors, light_set_views
 from shadowcam.synthetic.lab.light_set_capture import render_light_set_capture
 
 BASE = {"scene": "tabletop", "seed": 2, "height": 32, "width": 32, "frames": 40, "supersample": 2}
@@ -25,6 +25,20 @@ def test_two_point_lights_apart_in_both_sweeps_get_two_shadow_cameras():
             assert figures["contrast"] == pytest.approx(0.5, abs=0.05)
     # each light's dual view is covered where its two time maps are
     assert np.all(views["coverage"].values.mean(axis=(1, 2)) > 0.3)
+    # ten timed pixels moved to the other light's time (+14 frames), confidence 0.25: the
+    # false-time rate rises by exactly 10 / timed, their median confidence is 0.25
+    before = acc["lights"][0]["u"]
+    moved = views.copy(deep=True)
+    error, scored = light_set_errors(views, capture)["u", 0]
+    rows, cols = np.nonzero(scored & (error <= 1.0))
+    moved["time"].values[0, 0, rows[:10], cols[:10]] += 14.0
+    moved["confidence"].values[0, 0, rows[:10], cols[:10]] = 0.25
+    after = light_set_accuracy(moved, capture)["lights"][0]["u"]
+    timed = round(before["coverage"] * before["n_scored"])
+    assert after["false_rate"] == pytest.approx(before["false_rate"] + 10 / timed, abs=1e-12)
+    assert before["confidence_false"] is None or before["false_rate"] > 0
+    if before["false_rate"] == 0:
+        assert after["confidence_false"] == pytest.approx(0.25)
 
 
 def test_a_tube_across_a_sweep_is_flagged_there_when_the_window_is_short():
