@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from shadowcam.lab.light_views import light_set_accuracy, light_set_errors, light_set_views
+from shadowcam.lab.light_views import (
+    check_light_order, light_positions, light_set_accuracy, light_set_errors, light_set_views,
+)
 from shadowcam.synthetic.lab.light_set_capture import render_light_set_capture
 
 BASE = {"scene": "tabletop", "seed": 2, "height": 32, "width": 32, "frames": 40, "supersample": 2}
@@ -73,3 +75,29 @@ def test_an_open_shutter_removes_the_staircase_of_thin_dips():
         assert all(entry[s]["coverage"] > 0.98 for entry in acc["lights"] for s in ("u", "v"))
     assert min(p95[0.0]) > 0.2
     assert max(p95[1.0]) < 0.15
+
+
+def test_the_lights_positions_come_from_the_gaps_between_their_shadows():
+    y, x = np.indices((20, 30))
+    base = 5.0 + 0.4 * x + 0.1 * y
+    times = np.stack([base, base + 10.0, base + 30.0])
+    position, spread = light_positions(times)
+    np.testing.assert_allclose(position, [0.0, 10.0, 30.0], atol=1e-12)
+    np.testing.assert_allclose(spread, 0.0, atol=1e-12)
+    # described in metres, in any light order: scaled to frames and sorted along the sweep
+    np.testing.assert_allclose(check_light_order(position, spread, [0.02, -0.01, 0.0], sweep="u"),
+                               [0.0, 10.0, 30.0], atol=1e-9)
+    # a description with the middle light elsewhere: the error names the key
+    with pytest.raises(ValueError, match="light_along_v"):
+        check_light_order(position, spread, [0.0, 0.015, 0.03], sweep="v")
+    # two lights: one gap, any description fits it
+    np.testing.assert_allclose(check_light_order(position[:2], spread[:1], [0.0, -0.01], sweep="u"),
+                               [0.0, 10.0], atol=1e-9)
+    # a gap measured from scattered noise minima (spread above tolerance) is not checked
+    rng = np.random.default_rng(0)
+    noisy = times.copy()
+    noisy[0] = times[1] - rng.uniform(2.0, 14.0, times[1].shape)
+    position, spread = light_positions(noisy)
+    assert spread[0] > 2.0 and spread[1] == 0.0
+    expected = check_light_order(position, spread, [0.0, 0.015, 0.03], sweep="u")
+    np.testing.assert_allclose(expected, [0.0, 20.0, 40.0], atol=1e-9)  # scaled on the one consistent gap
