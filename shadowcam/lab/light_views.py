@@ -19,11 +19,14 @@ light_set_errors : per-light, per-sweep absolute time errors on the scored pixel
 light_set_accuracy : per-light, per-sweep error and coverage against the renderer.
 """
 
+from dataclasses import fields, replace
+
 import numpy as np
 import xarray as xr
 
 from shadowcam.cameras.dual_view import resample_dual_view
-from shadowcam.lab.light_assignment import LIGHT_REASONS, assign_minima
+from shadowcam.lab.light_assignment import LIGHT_REASONS, OK, assign_minima
+from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS
 from shadowcam.lab.minima import find_minima
 
 SWEEPS = ("u", "v")
@@ -116,7 +119,34 @@ def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0):
     return np.concatenate([[0.0], np.cumsum(scale * described)])
 
 
-def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, tolerance=2.0):
+def _edge_fit_per_light(minima, assigned):
+    """Each light's ok times re-timed by ``edge_fit`` over that light's own time map.
+
+    ``edge_fit`` (:func:`shadowcam.lab.shadow_time.time_edge_fit`) weighs each pixel's
+    dip centroid against its neighbours' local plane by their variances; given the
+    windows of one light's minima (:attr:`shadowcam.lab.minima.Minima.summary`, gathered
+    at ``assigned["minimum"]``) its neighbours are that light's, never another light's.
+    Flagged pixels neither get a time nor take part.
+    """
+    summary = minima.summary
+    out = dict(assigned)
+    out["time"], out["time_std"] = assigned["time"].copy(), assigned["time_std"].copy()
+    for k, pick in enumerate(assigned["minimum"]):
+        ok = assigned["reason"][k] == OK
+        index = np.maximum(pick, 0)[None]
+        gathered = {f.name: np.take_along_axis(getattr(summary, f.name), index, 0)[0]
+                    for f in fields(summary)
+                    if f.name != "window" and isinstance(getattr(summary, f.name), np.ndarray)}
+        window = np.take_along_axis(summary.window, index[None], 1)[:, 0]
+        light = replace(summary, window=np.where(ok[None], window, np.nan), **gathered)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            time, _, _, std = SHADOW_TIME_METHODS["edge_fit"](light)
+        out["time"][k] = np.where(ok, time, np.nan)
+        out["time_std"][k] = np.where(ok, std, assigned["time_std"][k])
+    return out
+
+
+def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tolerance=2.0):
     """Per-light shadow times and dual views.
 
     Parameters
@@ -129,7 +159,9 @@ def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, 
         Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
         across the wire spreads its shadow over its projection).
     method : str
-        Timing method of each minimum (:func:`~shadowcam.lab.minima.find_minima`).
+        Timing method of each minimum (:func:`~shadowcam.lab.minima.find_minima`), or
+        ``edge_fit``: dip centroids refined over each light's own time map
+        (:func:`_edge_fit_per_light`).
     radius, tolerance
         Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
 
@@ -157,8 +189,10 @@ def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, 
     for name in SWEEPS:
         frames = capture[f"frames_{name}"].values
         minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
-                             method=method)
+                             method="dip_centroid" if method == "edge_fit" else method)
         in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
+        if method == "edge_fit":
+            in_order = _edge_fit_per_light(minima, in_order)
         positions[name], spread = light_positions(in_order["time"])
         check_light_order(positions[name], spread, capture[f"light_along_{name}"].values, sweep=name,
                           tolerance=tolerance)

@@ -31,7 +31,7 @@ select_minima : the K deepest separated minima among candidate lists.
 find_minima : two streaming passes over a sweep's frames -> :class:`Minima`.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from scipy.special import ndtri
@@ -98,6 +98,9 @@ class Minima:
         with probability ``false_alarm`` somewhere in the sweep.
     noise_model : (float, float)
         ``(gain, floor)`` of the sweep's Poisson-Gaussian noise (fitted or given).
+    summary : DipSummary
+        Each minimum's window (normalised by its lit level) and statistics, the timing
+        methods' input: ``window`` (4 half_window + 1, K, H, W), the others (K, H, W).
     """
 
     time: np.ndarray
@@ -117,6 +120,7 @@ class Minima:
     n_frames: int
     significance: float
     noise_model: tuple = (float("nan"), float("nan"))
+    summary: DipSummary = None
 
 
 def select_minima(values, frames, count, *, separation):
@@ -503,9 +507,17 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         a = np.broadcast_to(np.asarray(a), (k_all, p))[:count]
         return np.take_along_axis(a, perm, 0).reshape(count, rows, cols)
 
+    def slots(a):  # (W, K + 1, P) -> (W, K, H, W)
+        return np.take_along_axis(a[:, :count], perm[None], 1).reshape(a.shape[0], count, rows, cols)
+
+    per_minimum = replace(summary, **{
+        f.name: (slots(getattr(summary, f.name)) if f.name == "window" else image(getattr(summary, f.name)))
+        for f in fields(summary) if isinstance(getattr(summary, f.name), np.ndarray)})
+
     return Minima(time=image(time), estimate=image(estimate), frame=image(centres),
                   depth=image(depth), contrast=image(contrast), level=image(centre_level),
                   width=image(width), time_std=image(std), reason=image(reason),
                   depth_snr=image(depth_snr), count=found.reshape(rows, cols), extra_contrast=extra_contrast.reshape(rows, cols),
                   noise=noise.reshape(rows, cols), lit_level=lit_level.reshape(rows, cols),
-                  n_frames=n_frames, significance=significance, noise_model=tuple(map(float, noise_model)))
+                  n_frames=n_frames, significance=significance, noise_model=tuple(map(float, noise_model)),
+                  summary=per_minimum)

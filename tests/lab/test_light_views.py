@@ -14,7 +14,7 @@ BASE = {"scene": "tabletop", "seed": 2, "height": 32, "width": 32, "frames": 40,
 def test_two_point_lights_apart_in_both_sweeps_get_two_shadow_cameras():
     lights = [{"kind": "point"}, {"kind": "point", "offset": [0.01, 0.01, 0.0]}]
     capture = render_light_set_capture({**BASE, "lights": lights})
-    views = light_set_views(capture)
+    views = light_set_views(capture, method="dip_centroid")
     acc = light_set_accuracy(views, capture)
     assert views["dual_view"].dims == ("light", "v", "u", "channel")
     for entry in acc["lights"]:
@@ -101,3 +101,22 @@ def test_the_lights_positions_come_from_the_gaps_between_their_shadows():
     assert spread[0] > 2.0 and spread[1] == 0.0
     expected = check_light_order(position, spread, [0.0, 0.015, 0.03], sweep="u")
     np.testing.assert_allclose(expected, [0.0, 20.0, 40.0], atol=1e-9)  # scaled on the one consistent gap
+
+
+def test_edge_fit_over_each_lights_map_lowers_the_noisy_tail():
+    """12-bit sensor noise, open shutter: each light's centroids weighed against its own
+    neighbours' plane; the same pixels are timed, and the p95 error pooled over the lights
+    and sweeps falls (per light and sweep it need not: 3 of 4 fall on this render)."""
+    lights = [{"kind": "point"}, {"kind": "point", "offset": [0.01, 0.01, 0.0]}]
+    capture = render_light_set_capture({**BASE, "lights": lights, "noise": True, "bit_depth": 12,
+                                        "shutter": 1})
+    centroid = light_set_views(capture, method="dip_centroid")
+    refined = light_set_views(capture, method="edge_fit")
+    np.testing.assert_array_equal(np.isfinite(refined["time"].values), np.isfinite(centroid["time"].values))
+
+    def pooled(views):
+        errors = [e[s] for e, s in light_set_errors(views, capture).values()]
+        errors = np.concatenate(errors)
+        return np.percentile(errors[np.isfinite(errors)], 95)
+
+    assert pooled(refined) < pooled(centroid)  # 0.477 -> 0.464 frame on this render
