@@ -217,8 +217,9 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
     that disagrees with its neighbours by whole inter-light gaps is re-assigned to the
     light the neighbours make unambiguous, or left unassigned. A light with no minimum
     is ``minima_count``; a pixel with no neighbours keeps its seed's order; a time further
-    than `tolerance` from its light's neighbourhood, or that no neighbour's time for that
-    light confirms (within `tolerance` along the local slope), is ``ambiguous_order``.
+    than `tolerance` from its light's neighbourhood, or that at most half of the
+    neighbours with a time for that light confirm (within `tolerance` along the local
+    slope; an isolated time included), is ``ambiguous_order``.
 
     Parameters
     ----------
@@ -285,8 +286,9 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
     reason = np.where(pick >= 0, to_light(own), MINIMA_COUNT).astype(np.int8)
     with np.errstate(invalid="ignore"):
         jump = (pick >= 0) & (np.abs(time - median) > tolerance)
-    # a time no neighbour confirms cannot be checked: flagged, not guessed
-    reason[jump | ((reason == OK) & (agree == 0))] = AMBIGUOUS_ORDER
+    # a time most of its light's neighbours do not confirm is not checked by continuity
+    # (an isolated time included): flagged, not guessed
+    reason[jump | ((reason == OK) & (2 * agree <= total))] = AMBIGUOUS_ORDER
     contrast, std, snr = (_gather(a, pick) for a in (minima.contrast, minima.time_std, minima.depth_snr))
     ok = reason == OK
     with np.errstate(invalid="ignore"):
