@@ -1,8 +1,10 @@
 """``shadowcam light-views``: one shadow camera per light of a several-lights capture.
 
 Each sweep's minima are assigned to the lights by their order along the sweep, checked
-by spatial continuity (:func:`shadowcam.lab.light_views.light_set_views`). Writes the
-per-light shadow times, reasons, contrast, confidence and dual views.
+by spatial continuity, and timed by ``edge_fit`` over each light's own map
+(:func:`shadowcam.lab.light_views.light_set_views`); the lights' positions along the sweep
+measured from the data must agree with the capture's ``light_along_*``. Writes the
+per-light shadow times, reasons, contrast, confidence, positions and dual views.
 
 Example::
 
