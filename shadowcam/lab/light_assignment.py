@@ -240,7 +240,9 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
         ``time`` (L, H, W): NaN where the reason is not ok; ``contrast`` (L, H, W): the
         minimum's depth over the lit level; ``time_std`` (L, H, W); ``reason`` (L, H, W)
         int8 (:data:`LIGHT_REASONS`); ``minimum`` (L, H, W) int64: the index of the
-        light's minimum in `minima` (-1 where none); ``confidence`` (L, H, W) in [0, 1], 0 where
+        light's minimum in `minima` (-1 where none); ``seen`` (L,): the fraction of the
+        pixels where the light's shadow is predicted inside the sweep in which its minimum
+        is timed (before the partial seeds); ``confidence`` (L, H, W) in [0, 1], 0 where
         flagged: the probability that the time is light k's shadow, as the product of
         ``Phi(depth_snr - significance)`` (the dip is real: its depth over the depth's
         noise against the detection level) and ``(a + 1) / (n + 2)`` (the neighbours
@@ -295,7 +297,8 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
         real = ndtr(np.where(np.isfinite(snr), snr - minima.significance, np.inf))
     confidence = real * (agree + 1.0) / (total + 2.0)
     return {"time": np.where(ok, time, np.nan), "contrast": contrast, "time_std": std,
-            "confidence": np.where(ok, confidence, 0.0), "reason": reason, "minimum": pick}
+            "confidence": np.where(ok, confidence, 0.0), "reason": reason, "minimum": pick,
+            "seen": seen}
 
 
 def light_summary(assigned, *, valid=None):

@@ -61,14 +61,15 @@ def light_positions(time, *, min_pixels=20):
     return np.concatenate([[0.0], np.cumsum(gaps)]), np.array(spread)
 
 
-def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0):
+def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0, seen=None):
     """Check the lights' positions along a sweep from the data against the capture description.
 
     Shadows of lights at one height move with the wire in proportion to the lights'
     offsets along the sweep, so the measured gaps between consecutive lights (frames) are
     a scaled copy of the described ones (metres, sorted along the sweep). The scale is
     the least-squares fit over the gaps measured consistently (spread across the pixels
-    within `tolerance`: a gap from noise minima is not); a gap further than `tolerance`
+    within `tolerance`, between two lights each `seen` in most pixels its shadow crosses: a
+    gap from noise minima is not); a gap further than `tolerance`
     frames from its scaled description means the description's positions (or their order)
     are not the capture's. Needs three lights or more (two give one gap, which any scale
     fits); lights swapped between equally spaced positions are not seen.
@@ -85,6 +86,9 @@ def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0):
         ``"u"`` or ``"v"`` (for the message).
     tolerance : float
         Frames.
+    seen : (L,) array_like, optional
+        Per light in the order along the sweep, the fraction of its pixels where it is
+        timed (``assign_minima``'s ``seen``); a gap counts only between lights above 1/2.
 
     Returns
     -------
@@ -103,6 +107,9 @@ def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0):
         raise ValueError(f"light_along_{sweep}: {along.size} lights described, {gaps.size + 1} measured")
     described = np.diff(along)
     use = np.isfinite(gaps) & (np.asarray(spread, dtype=np.float64) <= tolerance)
+    if seen is not None:
+        seen = np.asarray(seen, dtype=np.float64) > 0.5
+        use &= seen[:-1] & seen[1:]
     norm = float(np.sum(described[use] ** 2))
     if not use.any() or norm == 0:
         return np.full(along.size, np.nan)
@@ -195,7 +202,7 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
             in_order = _edge_fit_per_light(minima, in_order)
         positions[name], spread = light_positions(in_order["time"])
         check_light_order(positions[name], spread, capture[f"light_along_{name}"].values, sweep=name,
-                          tolerance=tolerance)
+                          tolerance=tolerance, seen=in_order.pop("seen"))
         # the k-th shadow along the sweep is the light k-th along the wire's motion
         order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
         per_sweep[name] = {key: value[np.argsort(order)] for key, value in in_order.items()}
