@@ -166,7 +166,8 @@ def _seed_partial(seed, estimate, gaps, n_frames, tolerance, *, informative):
     giving them to consecutive lights puts every other light's shadow outside the sweep.
 
     With ``m < L`` minima, shift ``s`` gives minimum ``i`` (along the sweep) to light
-    ``s + i``; the missing lights' times follow from the minima by the median gaps. A
+    ``s + i``; the missing lights' times follow from the nearest of the minima by the
+    median gaps. A
     shift is excluded when a missing light whose absence is `informative` ((L,) bool: the
     light is seen in most pixels its shadow crosses) has its time inside the sweep by more
     than `tolerance` (its shadow would have been seen there). A light hidden from the
@@ -184,7 +185,7 @@ def _seed_partial(seed, estimate, gaps, n_frames, tolerance, *, informative):
         at = (m == count) & (seed < 0).all(axis=0)
         if not at.any():
             continue
-        first = times[0]  # the earliest minimum
+        first, last = times[0], times[count - 1]  # the earliest and latest minima
         feasible = []
         for shift in range(n_lights - count + 1):
             inside = np.zeros(at.shape, bool)
@@ -192,7 +193,11 @@ def _seed_partial(seed, estimate, gaps, n_frames, tolerance, *, informative):
                 if not informative[k]:
                     continue
                 with np.errstate(invalid="ignore"):
-                    t = first + offset[k] - offset[shift]
+                    # from the nearest assigned minimum: the shortest extrapolation
+                    if k < shift:
+                        t = first - (offset[shift] - offset[k])
+                    else:
+                        t = last + offset[k] - offset[shift + count - 1]
                     inside |= (t > tolerance) & (t < n_frames - 1 - tolerance)
             feasible.append(~inside)
         feasible = np.stack(feasible)
