@@ -140,6 +140,15 @@ def _gather(values, pick):
     return np.where(pick >= 0, out, np.nan)
 
 
+def _confirmed(seed, estimate, tolerance, radius):
+    """Seeds whose every assigned time a neighbouring seed confirms (:func:`_agreement`):
+    a lone seed (a spurious dip that happens to sit one gap from a real one) is dropped."""
+    time = _gather(estimate, seed)
+    _, agree = _agreement(time, tolerance, radius)
+    lone = ((seed >= 0) & (agree == 0)).any(axis=0)
+    return np.where(lone[None], -1, seed)
+
+
 def _propagate(seed, estimate, timed, radius, tolerance, iterations):
     """Seeds grown by continuity: per light, the prediction from the neighbours and the
     matching of each pixel's minima to it (:func:`_match`), repeated until nothing
@@ -274,6 +283,7 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
     with np.errstate(invalid="ignore"):
         off = np.abs(np.diff(seed_time, axis=0) - gaps[:, None, None]) > tolerance
     seed[:, off.any(axis=0)] = -1
+    seed = _confirmed(seed, estimate, tolerance, radius)
     pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
     # a light seen in most pixels where its shadow falls inside the sweep: its absence
     # there is evidence, and seeds pixels with fewer minima (:func:`_seed_partial`)
@@ -284,6 +294,7 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
     timed = (pick >= 0) & (np.take_along_axis(minima.reason, np.maximum(pick, 0), 0) == _m.OK)
     seen = (inside & timed).sum(axis=(1, 2)) / np.maximum(inside.sum(axis=(1, 2)), 1)
     seed = _seed_partial(seed, estimate, gaps, minima.n_frames, tolerance, informative=seen > 0.5)
+    seed = _confirmed(seed, estimate, tolerance, radius)
     pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
     time = _gather(estimate, pick)
     total, agree = _agreement(time, tolerance, radius)

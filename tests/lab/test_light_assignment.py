@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from shadowcam.lab.light_assignment import (
     AMBIGUOUS_ORDER, MINIMA_COUNT, OK, assign_minima, light_summary,
@@ -179,3 +180,30 @@ def test_tube_across_the_wire_has_lower_contrast_and_confidence_than_along(scene
     # noise-free, smooth maps: the dip far above the detection level and all 24 neighbours
     # agreeing, (24 + 1) / (24 + 2)
     assert along[2] == pytest.approx(25 / 26) and across[2] == pytest.approx(25 / 26)
+
+
+@settings(max_examples=20, deadline=None)
+@given(n_lights=st.integers(2, 3), gap=st.floats(9.0, 16.0), slope=st.floats(0.3, 0.9),
+       start=st.floats(-20.0, 10.0), spurious=st.floats(0.0, 0.05), seed=st.integers(0, 2**16))
+def test_no_time_is_given_to_the_wrong_light(n_lights, gap, slope, start, spurious, seed):
+    """Lights `gap` frames apart over a 48-frame sweep, time maps sloping across the image
+    (lights leave the sweep at either end), and a fraction `spurious` of pixels with a
+    significant dip at a random time: every time marked ok is its light's (a spurious dip
+    within `tolerance` of the true one may stand in for it), never another light's."""
+    rng = np.random.default_rng(seed)
+    y, x = np.indices((16, 32))
+    truth = np.stack([start + slope * x + 0.1 * y + gap * k for k in range(n_lights)])
+    inside = (truth >= 0) & (truth <= 47)
+    times = np.full((n_lights + 1, *truth.shape[1:]), np.nan)
+    times[:n_lights] = np.where(inside, truth, np.nan)
+    extra = rng.random(truth.shape[1:]) < spurious
+    times[n_lights][extra] = rng.uniform(0, 47, extra.sum())
+    times = np.sort(times, axis=0)[:n_lights + 1]  # along the sweep, missing last
+    a = assign_minima(_minima(times, n_frames=48), n_lights)
+    ok = a["reason"] == OK
+    assert np.all(np.abs(a["time"][ok] - truth[ok]) <= 2.0)
+    assert not ok.any() or np.mean(np.abs(a["time"][ok] - truth[ok]) < 1e-9) > 0.95
+    # where a tenth of the image sees every light (the gaps are measured), most times
+    # inside the sweep are kept; else none may be
+    if inside.all(axis=0).mean() > 0.1:
+        assert np.mean(ok[inside]) > 0.8

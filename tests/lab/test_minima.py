@@ -184,3 +184,23 @@ def test_poisson_gaussian_noise_makes_no_minimum_and_hides_no_dip():
     noise_minima = ~real & (m.reason != LOW_CONTRAST) & (m.reason != MISSING)
     assert noise_minima.sum() <= 8
     assert np.all(m.count <= 1 + noise_minima.any(axis=0))
+
+
+@settings(max_examples=15, deadline=None)
+@given(first=st.floats(20.0, 40.0), fraction=st.floats(0.3, 1.0), width=st.floats(2.5, 4.0),
+       snr=st.floats(8.0, 30.0), seed=st.integers(0, 2**16))
+def test_close_dips_under_poisson_gaussian_noise_are_flagged_or_near_a_dip(first, fraction, width, snr,
+                                                                         seed):
+    """Two one-third-deep dips closer than their widths, shot and read noise with the dip
+    `snr` noise sigma deep (per sample, at the lit level): a confident time always lies
+    within its dip's half width (plus a frame of noise) of a true centre."""
+    rng = np.random.default_rng(seed)
+    centres = [first, first + fraction * width]
+    clean = box_dips(64, centres, [width, width], [1 / 3, 1 / 3], shape=(6, 6))
+    sigma_lit = (1 / 3) / snr
+    gain, floor = 0.8 * sigma_lit ** 2, 0.2 * sigma_lit ** 2  # variance at level 1: sigma_lit ** 2
+    frames = clean + np.sqrt(gain * clean + floor) * rng.standard_normal(clean.shape).astype(np.float32)
+    m = find_minima(frames, frames.shape[1:], count=2, half_window=3)
+    ok = m.reason == OK
+    distance = np.min(np.abs(m.time[..., None] - np.array(centres)), axis=-1)
+    assert np.all(distance[ok] <= width / 2 + 1.0)
