@@ -122,7 +122,8 @@ def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0, se
             f"{np.round(expected, 1).tolist()} frames along the {sweep} sweep, the data at "
             f"{np.round(position, 1).tolist()} (median gaps between the minima; off by "
             f"{off.max():.1f} > tolerance {tolerance}): check the lights' offsets (synthetic.lights "
-            "in the manifest) against the capture")
+            "in the manifest) against the capture; lights at different heights break the "
+            "proportion this check assumes (light-views --skip-order-check)")
     return np.concatenate([[0.0], np.cumsum(scale * described)])
 
 
@@ -153,7 +154,7 @@ def _edge_fit_per_light(minima, assigned):
     return out
 
 
-def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tolerance=2.0):
+def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tolerance=2.0, check_order=True):
     """Per-light shadow times and dual views.
 
     Parameters
@@ -171,6 +172,10 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         (:func:`_edge_fit_per_light`).
     radius, tolerance
         Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
+    check_order : bool
+        Check the measured positions against ``light_along_<sweep>``
+        (:func:`check_light_order`, which assumes the lights at one height); False: only
+        measure them.
 
     Returns
     -------
@@ -201,8 +206,10 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         if method == "edge_fit":
             in_order = _edge_fit_per_light(minima, in_order)
         positions[name], spread = light_positions(in_order["time"])
-        check_light_order(positions[name], spread, capture[f"light_along_{name}"].values, sweep=name,
-                          tolerance=tolerance, seen=in_order.pop("seen"))
+        seen = in_order.pop("seen")
+        if check_order:
+            check_light_order(positions[name], spread, capture[f"light_along_{name}"].values, sweep=name,
+                              tolerance=tolerance, seen=seen)
         # the k-th shadow along the sweep is the light k-th along the wire's motion
         order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
         per_sweep[name] = {key: value[np.argsort(order)] for key, value in in_order.items()}
@@ -228,7 +235,7 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         coords={"sweep": list(SWEEPS), "light": capture["light"].values, "channel": capture["channel"].values},
         attrs={"reasons": str(LIGHT_REASONS), "half_window": int(half_window), "method": method,
                "radius": int(radius),
-               "tolerance": float(tolerance)})
+               "tolerance": float(tolerance), "order_checked": int(bool(check_order))})
 
 
 def light_set_errors(views, capture, *, min_level=0.2):

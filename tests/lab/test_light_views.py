@@ -123,3 +123,21 @@ def test_edge_fit_over_each_lights_map_lowers_the_noisy_tail():
         return np.percentile(errors[np.isfinite(errors)], 95)
 
     assert pooled(refined) < pooled(centroid)  # 0.477 -> 0.464 frame on this render
+
+
+def test_a_description_whose_spacing_the_shadows_contradict_is_an_error_naming_the_key():
+    lights = [{"kind": "point"}, {"kind": "point", "offset": [0.008, 0.008, 0.0]},
+              {"kind": "point", "offset": [-0.008, -0.008, 0.0]}]
+    capture = render_light_set_capture({**BASE, "lights": lights, "frames": 48})
+    views = light_set_views(capture, method="dip_centroid")
+    # equally spaced lights: equal gaps along both sweeps (frames from the first light)
+    for s in range(2):
+        position = views["position"].values[s][np.argsort(capture[f"light_along_{'uv'[s]}"].values)]
+        assert abs((position[2] - position[1]) - (position[1] - position[0])) < 1.0
+    wrong = capture.copy()
+    along = capture["light_along_u"].values
+    wrong["light_along_u"] = ("light", np.array([along[0], along[1], along[0] - 3 * (along[1] - along[0])]))
+    with pytest.raises(ValueError, match="light_along_u"):
+        light_set_views(wrong, method="dip_centroid")
+    unchecked = light_set_views(wrong, method="dip_centroid", check_order=False)
+    assert unchecked.attrs["order_checked"] == 0
