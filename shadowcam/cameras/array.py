@@ -24,10 +24,13 @@ Offers
 ------
 ARRAY_REASONS : reason code -> meaning, per pixel and experiment.
 assign_wires : minima of one experiment -> per-wire times and reasons.
+estimate_spacing : the wire spacing in frames, from an experiment's evenly spaced dips.
 camera_array : both experiments and the crossing images -> the array dataset over
-    (camera_row, camera_col, v, u, channel).
+    (camera_row, camera_col, v, u, channel) (of a capture's files:
+    :func:`shadowcam.cameras.array_files.camera_array_of_plan`).
 array_accuracy : coordinate RMSE per camera, rectification and disparity against the
     renderer's wire times, and the views against the reciprocal renders.
+capture_accuracy : :func:`array_accuracy` against a capture's ``ground_truth.nc``.
 """
 
 import warnings
@@ -105,6 +108,42 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     _place_partial(times, reason, estimate, found, minima.n_frames, int(n_wires), spacing_frames,
                    tolerance, extra)
     return times, reason, minima
+
+
+def estimate_spacing(frames, n_wires, *, tolerance=0.5):
+    """The wires' spacing in frames of the light's motion, from one experiment's dips.
+
+    The dips of neighbouring wires at a point at depth ``d`` beyond the mask are
+    ``s (1 + g / d)`` frames apart, at least the spacing ``s`` and nearest it for the
+    farthest points. The dips are found at the finest resolution (half window 1: dips at
+    least two frames apart) and the spacing is the smallest mean gap of a pixel whose
+    `n_wires` dips are evenly spaced. It bounds ``s`` from above by the ``g / d`` of the
+    farthest point; :func:`assign_wires` uses it as the shortest gap a pixel may have and
+    for its minima's half window.
+
+    Parameters
+    ----------
+    frames : (T, H, W[, C]) array_like
+        One experiment's frames.
+    n_wires : int
+        Wires of the family whose shadows pass (>= 2).
+    tolerance : float
+        Frames by which a pixel's gaps may differ from each other.
+
+    Returns
+    -------
+    float
+    """
+    if int(n_wires) != n_wires or n_wires < 2:
+        raise ValueError(f"n_wires: the spacing is estimated from the gaps between two or more wires' dips; "
+                         f"got {n_wires!r}: give the spacing (camera_array.spacing_frames) instead")
+    times, reason, _ = assign_wires(frames, n_wires, spacing_frames=2.0, tolerance=tolerance, half_window=1)
+    every = (reason == OK) & np.all(np.isfinite(times), axis=0)  # all wires' dips inside the sweep
+    gaps = np.diff(times, axis=0).mean(axis=0)[every]
+    if not gaps.size:
+        raise ValueError(f"frames: no pixel shows {n_wires} evenly spaced dips, so the wire spacing cannot be "
+                         "estimated; give it (camera_array.spacing_frames)")
+    return float(gaps.min())
 
 
 def _place_partial(times, reason, est, found, n_frames, n_wires, spacing_frames, tolerance, extra):
@@ -272,30 +311,6 @@ def array_accuracy(array, t_vertical_wire, t_horizontal_wire, *, reciprocal=None
     return out
 
 
-def camera_array_of_capture(capture, *, tolerance=0.5, method="mesh"):
-    """:func:`camera_array` of a capture dataset (:func:`shadowcam.synthetic.lab.array_capture.render_array_capture`).
-
-    Parameters
-    ----------
-    capture : xarray.Dataset
-        With ``frames_horizontal``, ``frames_vertical``, ``crossing_images`` and attr
-        ``spacing_frames``.
-    tolerance, method
-        See :func:`camera_array`.
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    missing = {"frames_horizontal", "frames_vertical", "crossing_images"} - set(capture)
-    if missing or "spacing_frames" not in capture.attrs:
-        raise ValueError(f"capture: not a camera-array capture (missing {sorted(missing) or 'spacing_frames'}); "
-                         "render it with the render-array step")
-    return camera_array(capture["frames_horizontal"].values, capture["frames_vertical"].values,
-                        capture["crossing_images"].values, spacing_frames=float(capture.attrs["spacing_frames"]),
-                        tolerance=tolerance, method=method)
-
-
 def capture_accuracy(array, capture):
     """:func:`array_accuracy` against a rendered capture's ground truth.
 
@@ -304,8 +319,9 @@ def capture_accuracy(array, capture):
     array : xarray.Dataset
         From :func:`camera_array`.
     capture : xarray.Dataset
-        The rendered capture (exact wire times, ``reciprocal``, ``depth``, attrs
-        ``spacing_frames`` and ``light_mask_distance``).
+        The capture's ``ground_truth.nc`` (exact wire times ``t_vertical_wire``,
+        ``t_horizontal_wire``, ``reciprocal``, ``depth``, attrs ``spacing_frames`` and
+        ``light_mask_distance``; :func:`shadowcam.synthetic.lab.array_capture.write_array_capture`).
 
     Returns
     -------
