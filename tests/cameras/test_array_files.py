@@ -160,3 +160,25 @@ def test_spacing_is_the_smallest_even_gap():
         estimate_spacing(frames, 1)
     with pytest.raises(ValueError, match="spacing_frames"):
         estimate_spacing(np.ones((40, 1, 2), np.float32), 3)
+
+
+def test_noisy_raw_capture_meets_the_tolerances(tmp_path):
+    # the 48 x 48 capture as 12-bit RGGB DNGs with shot and read noise, decoded as
+    # the lab sweeps are, its spacing estimated
+    manifest = tmp_path / "noisy_array.yaml"
+    synthetic = {**SYNTHETIC, "height": 48, "width": 48, "format": "dng", "bit_depth": 12, "noise": True}
+    manifest.write_text(yaml.safe_dump({"name": "noisy_array", "kind": "lab", "light": "point",
+                                        "synthetic": synthetic}))
+    capture = write_array_capture(capture_options(manifest), tmp_path / "capture")
+    described = json.loads((capture / "capture.json").read_text())
+    assert described["camera_array"]["crossings"] == "crossings/r{row}_c{col}.dng"
+    del described["camera_array"]["spacing_frames"]
+    (capture / "capture.json").write_text(json.dumps(described))
+    array = camera_array_of_plan(capture_plan(capture / "capture.json"))
+    assert SPACING <= array.attrs["spacing_frames"] <= SPACING * 1.1
+    with xr.open_dataset(capture / "ground_truth.nc") as opened:
+        acc = capture_accuracy(array, opened.load())
+    assert np.all(np.array(acc["coordinate_rmse"]) <= 0.3)
+    assert max(acc["u_rmse_per_column"] + acc["v_rmse_per_row"]) <= 0.3
+    assert acc["disparity_rmse"] <= 0.3
+    assert np.all(np.array(acc["coverage"]) > 0.75)
