@@ -590,7 +590,10 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         light, duplicate sweep names), an outdoor capture has several sweeps and
         none named ``timelapse``, `dual_model` is ``calibration`` without
         calibration sweeps, or the first frames of the sweeps and the reference
-        differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`).
+        differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`); a captured
+        camera array without sweep ``horizontal`` or ``vertical``, with crossing images
+        missing or other than ``rows x cols`` of them, or with crossing images of another
+        format or size than the frames (``rows``/``cols`` < 1 fail the schema).
     """
     manifest = load_manifest(manifest_path)
     if manifest["kind"] == "lightfield":
