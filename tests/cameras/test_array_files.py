@@ -182,3 +182,25 @@ def test_noisy_raw_capture_meets_the_tolerances(tmp_path):
     assert max(acc["u_rmse_per_column"] + acc["v_rmse_per_row"]) <= 0.3
     assert acc["disparity_rmse"] <= 0.3
     assert np.all(np.array(acc["coverage"]) > 0.75)
+
+
+def test_an_experiment_of_another_frame_size_is_named(rendered, tmp_path):
+    from shadowcam.io.manifest import checksums_for
+    from shadowcam.io.raw_writer import write_tiff16
+
+    capture = tmp_path / "capture"
+    shutil.copytree(rendered, capture)
+    for frame in sorted((capture / "vertical").glob("*.tiff")):
+        write_tiff16(frame, np.zeros((32, 30, 3), np.uint16))
+    path = _user_manifest(tmp_path, capture)
+    path.write_text(yaml.safe_dump({**yaml.safe_load(path.read_text()), "checksums": checksums_for(path)}))
+    with pytest.raises(ValueError, match=r"(?s)my_array.yaml.*vertical/000000.tiff is 32x30.*frame size"):
+        capture_plan(path)
+
+
+def test_a_rendered_manifest_is_not_read_as_files(tmp_path):
+    manifest = tmp_path / "to_render.yaml"
+    manifest.write_text(yaml.safe_dump({"name": "to_render", "kind": "lab", "light": "point",
+                                        "synthetic": SYNTHETIC}))
+    with pytest.raises(ValueError, match="to_render.yaml is not a captured camera array.*render-array"):
+        camera_array_of_plan(capture_plan(manifest))
