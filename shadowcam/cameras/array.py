@@ -28,6 +28,7 @@ estimate_spacing : the wire spacing in frames, from an experiment's evenly space
 camera_array : both experiments and the crossing images -> the array dataset over
     (camera_row, camera_col, v, u, channel) (of a capture's files:
     :func:`shadowcam.cameras.array_files.camera_array_of_plan`).
+array_views : each family's wire times and the crossing images -> that dataset.
 array_accuracy : coordinate RMSE per camera, rectification and disparity against the
     renderer's wire times, and the views against the reciprocal renders.
 capture_accuracy : :func:`array_accuracy` against a capture's ``ground_truth.nc``.
@@ -213,10 +214,45 @@ def camera_array(frames_horizontal, frames_vertical, crossing_images, *, spacing
     n, m = crossing.shape[:2]
     u, reason_u, _ = assign_wires(frames_horizontal, m, spacing_frames=spacing_frames, tolerance=tolerance)
     v, reason_v, _ = assign_wires(frames_vertical, n, spacing_frames=spacing_frames, tolerance=tolerance)
+    shape = (np.shape(frames_vertical)[0], np.shape(frames_horizontal)[0])
+    out = array_views(crossing, u, v, reason_u=reason_u, reason_v=reason_v, shape=shape, method=method)
+    return out.assign_attrs(spacing_frames=float(spacing_frames), tolerance=float(tolerance))
+
+
+def array_views(crossing_images, u, v, *, reason_u, reason_v, shape, method="mesh"):
+    """The array dataset from each family's wire times and the crossing images.
+
+    Parameters
+    ----------
+    crossing_images : (n, m, H, W, C) array_like
+        The camera's image lit from each crossing.
+    u : (m, H, W) array_like
+        Time of each vertical wire (:func:`assign_wires` of the horizontal experiment).
+    v : (n, H, W) array_like
+        Time of each horizontal wire (of the vertical experiment).
+    reason_u, reason_v : (H, W) array_like of int8
+        :data:`ARRAY_REASONS` of each experiment.
+    shape : (2,) tuple of int
+        ``(T_v, T_u)``: the dual grid, the vertical and horizontal experiments' frames.
+    method : str
+        Resampler of :func:`shadowcam.cameras.dual_view.resample_dual_view`.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`camera_array` (without its ``spacing_frames`` and ``tolerance`` attrs).
+    """
+    crossing = np.asarray(crossing_images, dtype=np.float32)
+    check_array(crossing, "crossing_images", ndim=5)
+    u, v = np.asarray(u), np.asarray(v)
+    n, m = crossing.shape[:2]
+    if u.shape[0] != m or v.shape[0] != n:
+        raise ValueError(f"crossing_images: {n} x {m} crossings but times of {v.shape[0]} horizontal and "
+                         f"{u.shape[0]} vertical wires")
     if u.shape[1:] != crossing.shape[2:4] or v.shape[1:] != crossing.shape[2:4]:
         raise ValueError(f"crossing_images: image size {crossing.shape[2:4]} differs from the frames' "
                          f"{u.shape[1:]}")
-    shape = (np.shape(frames_vertical)[0], np.shape(frames_horizontal)[0])
+    shape = tuple(int(k) for k in shape)
     views = np.full((n, m, *shape, crossing.shape[4]), np.nan, np.float32)
     coverage = np.zeros((n, m, *shape), bool)
     for i in range(n):
@@ -229,10 +265,10 @@ def camera_array(frames_horizontal, frames_vertical, crossing_images, *, spacing
          "coverage": (("camera_row", "camera_col", "v", "u"), coverage),
          "u": (("camera_col", "y", "x"), u.astype(np.float32)),
          "v": (("camera_row", "y", "x"), v.astype(np.float32)),
-         "reason_u": (("y", "x"), reason_u), "reason_v": (("y", "x"), reason_v)},
+         "reason_u": (("y", "x"), np.asarray(reason_u, np.int8)),
+         "reason_v": (("y", "x"), np.asarray(reason_v, np.int8))},
         coords={"camera_row": np.arange(n), "camera_col": np.arange(m), "channel": channels},
-        attrs={"spacing_frames": float(spacing_frames), "tolerance": float(tolerance), "method": method,
-               "reasons": str(ARRAY_REASONS),
+        attrs={"method": method, "reasons": str(ARRAY_REASONS),
                "definitions": "view[i, j] at (v, u): the colour of crossing (i, j)'s image at the camera "
                               "pixel whose times of horizontal wire i and vertical wire j are (v, u)"})
 

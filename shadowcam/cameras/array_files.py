@@ -5,8 +5,8 @@ A camera-array capture (docs/contracts.md) holds two sweeps of frame files, ``ho
 each wire crossing; its plan (:func:`shadowcam.io.capture_plan.capture_plan`) lists them.
 The frames and images are decoded one at a time by the lab sweeps' decoder
 (:func:`shadowcam.io.decode.iter_frames`: camera RAW, TIFF, PNG, EXR to linear RGB) into
-one float32 stack per experiment, which :func:`shadowcam.cameras.array.camera_array`
-reads whole (every pixel's minima span the sweep).
+one float32 stack per experiment, whose wires :func:`shadowcam.cameras.array.assign_wires`
+times whole (every pixel's minima span the sweep) before the next is read.
 
 Offers
 ------
@@ -16,7 +16,7 @@ camera_array_of_plan : a camera-array capture plan -> the array dataset.
 
 import numpy as np
 
-from shadowcam.cameras.array import camera_array, estimate_spacing
+from shadowcam.cameras.array import array_views, assign_wires, estimate_spacing
 from shadowcam.io.decode import iter_frames
 
 
@@ -58,6 +58,9 @@ def read_stack(paths, *, shape=None):
 def camera_array_of_plan(plan, *, tolerance=0.5, method="mesh"):
     """The virtual camera array of a captured (or rendered and written) camera-array capture.
 
+    The experiments are decoded one after the other, each freed once its wires are timed,
+    then the crossing images.
+
     Parameters
     ----------
     plan : shadowcam.io.capture_plan.CapturePlan
@@ -69,27 +72,39 @@ def camera_array_of_plan(plan, *, tolerance=0.5, method="mesh"):
     Returns
     -------
     xarray.Dataset
-        :func:`shadowcam.cameras.array.camera_array`'s dataset; attr ``spacing_source``:
-        ``manifest``, or ``estimated`` (:func:`shadowcam.cameras.array.estimate_spacing`,
-        the smaller of the two experiments' estimates) when the manifest gives no spacing.
+        :func:`shadowcam.cameras.array.camera_array`'s dataset; attrs ``spacing_frames``
+        (horizontal, vertical experiment) and ``spacing_source``: ``manifest``, or
+        ``estimated`` when the manifest gives no spacing: each experiment's own
+        (:func:`shadowcam.cameras.array.estimate_spacing`), or for a single wire the other
+        family's.
     """
     array = plan.camera_array
     if array is None or "crossings" not in array:
         raise ValueError(f"plan: manifest {plan.manifest_path} is not a captured camera array (no top-level "
                          "camera_array block with crossings); render a synthetic one with render-array")
-    shape = plan.frame_shape
-    horizontal = read_stack(plan.sweep("horizontal").files, shape=shape)
-    vertical = read_stack(plan.sweep("vertical").files, shape=shape)
-    crossings = read_stack(array["crossings"], shape=shape)
     rows, cols = int(array["rows"]), int(array["cols"])
-    spacing, source = array["spacing_frames"], "manifest"
-    if spacing is None:
-        if max(rows, cols) < 2:
-            raise ValueError(f"manifest {plan.manifest_path}: key 'camera_array.spacing_frames' is missing and "
-                             "one wire per family gives no gap to estimate it from; give the spacing in frames")
-        spacing = min(estimate_spacing(frames, n, tolerance=tolerance)
-                      for frames, n in ((horizontal, cols), (vertical, rows)) if n >= 2)
-        source = "estimated"
-    out = camera_array(horizontal, vertical, crossings.reshape(rows, cols, *crossings.shape[1:]),
-                       spacing_frames=float(spacing), tolerance=tolerance, method=method)
-    return out.assign_attrs(spacing_source=source)
+    given = array["spacing_frames"]
+    if given is None and max(rows, cols) < 2:
+        raise ValueError(f"manifest {plan.manifest_path}: key 'camera_array.spacing_frames' is missing and "
+                         "one wire per family gives no gap to estimate it from; give the spacing in frames")
+    experiments = {"horizontal": cols, "vertical": rows}  # wires whose shadows pass
+    order = sorted(experiments, key=lambda name: experiments[name] < 2)  # an estimable family first
+    times, spacing = {}, {}
+    for name in order:
+        frames = read_stack(plan.sweep(name).files, shape=plan.frame_shape)
+        if given is not None:
+            spacing[name] = float(given)
+        elif experiments[name] >= 2:
+            spacing[name] = estimate_spacing(frames, experiments[name], tolerance=tolerance)
+        else:
+            spacing[name] = next(iter(spacing.values()))
+        times[name] = assign_wires(frames, experiments[name], spacing_frames=spacing[name],
+                                   tolerance=tolerance)[:2] + (len(frames),)
+        del frames
+    crossings = read_stack(array["crossings"], shape=plan.frame_shape)
+    (u, reason_u, t_u), (v, reason_v, t_v) = times["horizontal"], times["vertical"]
+    out = array_views(crossings.reshape(rows, cols, *crossings.shape[1:]), u, v, reason_u=reason_u,
+                      reason_v=reason_v, shape=(t_v, t_u), method=method)
+    return out.assign_attrs(spacing_frames=[spacing["horizontal"], spacing["vertical"]],
+                            spacing_source="manifest" if given is not None else "estimated",
+                            tolerance=float(tolerance))

@@ -61,7 +61,8 @@ def test_user_manifest_gives_the_renderers_array_within_the_tolerances(user_arra
     assert user_array["view"].shape[:2] == (2, 3)
     assert user_array.attrs["spacing_source"] == "estimated"
     # the farthest point's dips bound the spacing from above (gaps are s (1 + g / d) >= s)
-    assert SPACING <= user_array.attrs["spacing_frames"] <= SPACING * 1.1
+    assert np.all((SPACING <= np.array(user_array.attrs["spacing_frames"]))
+                  & (np.array(user_array.attrs["spacing_frames"]) <= SPACING * 1.1))
     acc = capture_accuracy(user_array, truth)
     assert np.all(np.array(acc["coordinate_rmse"]) <= 0.3)      # dual px per camera
     assert max(acc["u_rmse_per_column"] + acc["v_rmse_per_row"]) <= 0.3  # rectified
@@ -89,6 +90,8 @@ def test_the_rendered_capture_json_takes_the_same_path(rendered, user_array):
         f"r{i}_c{j}.tiff" for i in range(2) for j in range(3)]
     array = camera_array_of_plan(plan)
     assert array.attrs["spacing_source"] == "manifest"
+    assert list(array.attrs["spacing_frames"]) == [SPACING, SPACING]
+    # its own spacing or the estimated one: the same wires timed (the estimates bound it closely)
     np.testing.assert_array_equal(array["u"].values, user_array["u"].values)
     np.testing.assert_array_equal(array["view"].values, user_array["view"].values)
 
@@ -116,7 +119,8 @@ def test_a_missing_crossing_image_names_the_file_and_key(rendered, tmp_path):
 @pytest.mark.parametrize("key", ["rows", "cols"])
 def test_rows_or_cols_below_one_are_refused(rendered, tmp_path, key):
     path = _user_manifest(tmp_path, rendered, **{key: 0})
-    with pytest.raises(ValueError, match=rf"(?s)my_array.yaml.*key camera_array.{key}: 0 is less than the minimum of 1"):
+    message = rf"(?s)my_array.yaml.*key camera_array.{key}: 0 is less than the minimum of 1"
+    with pytest.raises(ValueError, match=message):
         capture_plan(path)
 
 
@@ -175,7 +179,8 @@ def test_noisy_raw_capture_meets_the_tolerances(tmp_path):
     del described["camera_array"]["spacing_frames"]
     (capture / "capture.json").write_text(json.dumps(described))
     array = camera_array_of_plan(capture_plan(capture / "capture.json"))
-    assert SPACING <= array.attrs["spacing_frames"] <= SPACING * 1.1
+    spacing = np.array(array.attrs["spacing_frames"])
+    assert np.all((SPACING <= spacing) & (spacing <= SPACING * 1.1))
     with xr.open_dataset(capture / "ground_truth.nc") as opened:
         acc = capture_accuracy(array, opened.load())
     assert np.all(np.array(acc["coordinate_rmse"]) <= 0.3)
@@ -204,3 +209,21 @@ def test_a_rendered_manifest_is_not_read_as_files(tmp_path):
                                         "synthetic": SYNTHETIC}))
     with pytest.raises(ValueError, match="to_render.yaml is not a captured camera array.*render-array"):
         camera_array_of_plan(capture_plan(manifest))
+
+
+def test_one_horizontal_wire_takes_the_vertical_wires_spacing(tmp_path):
+    manifest = tmp_path / "row_array.yaml"
+    synthetic = {**SYNTHETIC, "camera_array": {"rows": 1, "cols": 3, "spacing_frames": SPACING}}
+    manifest.write_text(yaml.safe_dump({"name": "row_array", "kind": "lab", "light": "point",
+                                        "synthetic": synthetic}))
+    capture = write_array_capture(capture_options(manifest), tmp_path / "capture")
+    described = json.loads((capture / "capture.json").read_text())
+    del described["camera_array"]["spacing_frames"]
+    (capture / "capture.json").write_text(json.dumps(described))
+    array = camera_array_of_plan(capture_plan(capture / "capture.json"))
+    horizontal, vertical = array.attrs["spacing_frames"]
+    assert vertical == horizontal and SPACING <= horizontal <= SPACING * 1.1
+    assert array["view"].shape[:2] == (1, 3)
+    with xr.open_dataset(capture / "ground_truth.nc") as opened:
+        acc = capture_accuracy(array, opened.load())
+    assert np.all(np.array(acc["coordinate_rmse"]) <= 0.3)
