@@ -227,3 +227,12 @@ def test_one_horizontal_wire_takes_the_vertical_wires_spacing(tmp_path):
     with xr.open_dataset(capture / "ground_truth.nc") as opened:
         acc = capture_accuracy(array, opened.load())
     assert np.all(np.array(acc["coordinate_rmse"]) <= 0.3)
+
+
+def test_crossing_images_are_checksummed_like_the_sweeps(rendered, tmp_path):
+    path = _user_manifest(tmp_path, rendered)
+    doc = yaml.safe_load(path.read_text())
+    del doc["checksums"]["crossings/r1_c2.tiff"]
+    path.write_text(yaml.safe_dump(doc))
+    with pytest.raises(ValueError, match=r"not listed in checksums: crossings/r1_c2.tiff; run `shadowcam checksum"):
+        capture_plan(path)
