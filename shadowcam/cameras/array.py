@@ -24,10 +24,14 @@ Offers
 ------
 ARRAY_REASONS : reason code -> meaning, per pixel and experiment.
 assign_wires : minima of one experiment -> per-wire times and reasons.
+estimate_spacing : the wire spacing in frames, from an experiment's evenly spaced dips.
 camera_array : both experiments and the crossing images -> the array dataset over
-    (camera_row, camera_col, v, u, channel).
+    (camera_row, camera_col, v, u, channel) (of a capture's files:
+    :func:`shadowcam.cameras.array_files.camera_array_of_plan`).
+array_views : each family's wire times and the crossing images -> that dataset.
 array_accuracy : coordinate RMSE per camera, rectification and disparity against the
     renderer's wire times, and the views against the reciprocal renders.
+capture_accuracy : :func:`array_accuracy` against a capture's ``ground_truth.nc``.
 """
 
 import warnings
@@ -107,6 +111,42 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     return times, reason, minima
 
 
+def estimate_spacing(frames, n_wires, *, tolerance=0.5):
+    """The wires' spacing in frames of the light's motion, from one experiment's dips.
+
+    The dips of neighbouring wires at a point at depth ``d`` beyond the mask are
+    ``s (1 + g / d)`` frames apart, at least the spacing ``s`` and nearest it for the
+    farthest points. The dips are found at the finest resolution (half window 1: dips at
+    least two frames apart) and the spacing is the smallest mean gap of a pixel whose
+    `n_wires` dips are evenly spaced. It bounds ``s`` from above by the ``g / d`` of the
+    farthest point; :func:`assign_wires` uses it as the shortest gap a pixel may have and
+    for its minima's half window.
+
+    Parameters
+    ----------
+    frames : (T, H, W[, C]) array_like
+        One experiment's frames.
+    n_wires : int
+        Wires of the family whose shadows pass (>= 2).
+    tolerance : float
+        Frames by which a pixel's gaps may differ from each other.
+
+    Returns
+    -------
+    float
+    """
+    if int(n_wires) != n_wires or n_wires < 2:
+        raise ValueError(f"n_wires: the spacing is estimated from the gaps between two or more wires' dips; "
+                         f"got {n_wires!r}: give the spacing (camera_array.spacing_frames) instead")
+    times, reason, _ = assign_wires(frames, n_wires, spacing_frames=2.0, tolerance=tolerance, half_window=1)
+    every = (reason == OK) & np.all(np.isfinite(times), axis=0)  # all wires' dips inside the sweep
+    gaps = np.diff(times, axis=0).mean(axis=0)[every]
+    if not gaps.size:
+        raise ValueError(f"frames: no pixel shows {n_wires} evenly spaced dips, so the wire spacing cannot be "
+                         "estimated; give it (camera_array.spacing_frames)")
+    return float(gaps.min())
+
+
 def _place_partial(times, reason, est, found, n_frames, n_wires, spacing_frames, tolerance, extra):
     """Pixels with 2 <= c < n_wires reliable, evenly spaced minima: the missing wires' dips
     fall outside the sweep (one gap before the first or after the last dip would be inside
@@ -174,10 +214,45 @@ def camera_array(frames_horizontal, frames_vertical, crossing_images, *, spacing
     n, m = crossing.shape[:2]
     u, reason_u, _ = assign_wires(frames_horizontal, m, spacing_frames=spacing_frames, tolerance=tolerance)
     v, reason_v, _ = assign_wires(frames_vertical, n, spacing_frames=spacing_frames, tolerance=tolerance)
+    shape = (np.shape(frames_vertical)[0], np.shape(frames_horizontal)[0])
+    out = array_views(crossing, u, v, reason_u=reason_u, reason_v=reason_v, shape=shape, method=method)
+    return out.assign_attrs(spacing_frames=float(spacing_frames), tolerance=float(tolerance))
+
+
+def array_views(crossing_images, u, v, *, reason_u, reason_v, shape, method="mesh"):
+    """The array dataset from each family's wire times and the crossing images.
+
+    Parameters
+    ----------
+    crossing_images : (n, m, H, W, C) array_like
+        The camera's image lit from each crossing.
+    u : (m, H, W) array_like
+        Time of each vertical wire (:func:`assign_wires` of the horizontal experiment).
+    v : (n, H, W) array_like
+        Time of each horizontal wire (of the vertical experiment).
+    reason_u, reason_v : (H, W) array_like of int8
+        :data:`ARRAY_REASONS` of each experiment.
+    shape : (2,) tuple of int
+        ``(T_v, T_u)``: the dual grid, the vertical and horizontal experiments' frames.
+    method : str
+        Resampler of :func:`shadowcam.cameras.dual_view.resample_dual_view`.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`camera_array` (without its ``spacing_frames`` and ``tolerance`` attrs).
+    """
+    crossing = np.asarray(crossing_images, dtype=np.float32)
+    check_array(crossing, "crossing_images", ndim=5)
+    u, v = np.asarray(u), np.asarray(v)
+    n, m = crossing.shape[:2]
+    if u.shape[0] != m or v.shape[0] != n:
+        raise ValueError(f"crossing_images: {n} x {m} crossings but times of {v.shape[0]} horizontal and "
+                         f"{u.shape[0]} vertical wires")
     if u.shape[1:] != crossing.shape[2:4] or v.shape[1:] != crossing.shape[2:4]:
         raise ValueError(f"crossing_images: image size {crossing.shape[2:4]} differs from the frames' "
                          f"{u.shape[1:]}")
-    shape = (np.shape(frames_vertical)[0], np.shape(frames_horizontal)[0])
+    shape = tuple(int(k) for k in shape)
     views = np.full((n, m, *shape, crossing.shape[4]), np.nan, np.float32)
     coverage = np.zeros((n, m, *shape), bool)
     for i in range(n):
@@ -190,10 +265,10 @@ def camera_array(frames_horizontal, frames_vertical, crossing_images, *, spacing
          "coverage": (("camera_row", "camera_col", "v", "u"), coverage),
          "u": (("camera_col", "y", "x"), u.astype(np.float32)),
          "v": (("camera_row", "y", "x"), v.astype(np.float32)),
-         "reason_u": (("y", "x"), reason_u), "reason_v": (("y", "x"), reason_v)},
+         "reason_u": (("y", "x"), np.asarray(reason_u, np.int8)),
+         "reason_v": (("y", "x"), np.asarray(reason_v, np.int8))},
         coords={"camera_row": np.arange(n), "camera_col": np.arange(m), "channel": channels},
-        attrs={"spacing_frames": float(spacing_frames), "tolerance": float(tolerance), "method": method,
-               "reasons": str(ARRAY_REASONS),
+        attrs={"method": method, "reasons": str(ARRAY_REASONS),
                "definitions": "view[i, j] at (v, u): the colour of crossing (i, j)'s image at the camera "
                               "pixel whose times of horizontal wire i and vertical wire j are (v, u)"})
 
@@ -272,30 +347,6 @@ def array_accuracy(array, t_vertical_wire, t_horizontal_wire, *, reciprocal=None
     return out
 
 
-def camera_array_of_capture(capture, *, tolerance=0.5, method="mesh"):
-    """:func:`camera_array` of a capture dataset (:func:`shadowcam.synthetic.lab.array_capture.render_array_capture`).
-
-    Parameters
-    ----------
-    capture : xarray.Dataset
-        With ``frames_horizontal``, ``frames_vertical``, ``crossing_images`` and attr
-        ``spacing_frames``.
-    tolerance, method
-        See :func:`camera_array`.
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    missing = {"frames_horizontal", "frames_vertical", "crossing_images"} - set(capture)
-    if missing or "spacing_frames" not in capture.attrs:
-        raise ValueError(f"capture: not a camera-array capture (missing {sorted(missing) or 'spacing_frames'}); "
-                         "render it with the render-array step")
-    return camera_array(capture["frames_horizontal"].values, capture["frames_vertical"].values,
-                        capture["crossing_images"].values, spacing_frames=float(capture.attrs["spacing_frames"]),
-                        tolerance=tolerance, method=method)
-
-
 def capture_accuracy(array, capture):
     """:func:`array_accuracy` against a rendered capture's ground truth.
 
@@ -304,8 +355,9 @@ def capture_accuracy(array, capture):
     array : xarray.Dataset
         From :func:`camera_array`.
     capture : xarray.Dataset
-        The rendered capture (exact wire times, ``reciprocal``, ``depth``, attrs
-        ``spacing_frames`` and ``light_mask_distance``).
+        The capture's ``ground_truth.nc`` (exact wire times ``t_vertical_wire``,
+        ``t_horizontal_wire``, ``reciprocal``, ``depth``, attrs ``spacing_frames`` and
+        ``light_mask_distance``; :func:`shadowcam.synthetic.lab.array_capture.write_array_capture`).
 
     Returns
     -------

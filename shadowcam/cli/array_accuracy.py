@@ -8,7 +8,7 @@ array's views beside the reciprocal renders
 
 Example::
 
-    shadowcam array-accuracy --capture results/synthetic_array/array/capture.nc \\
+    shadowcam array-accuracy --ground-truth results/synthetic_array/array/capture/ground_truth.nc \\
         --array results/synthetic_array/array/camera_array.nc \\
         --out-json results/synthetic_array/array/accuracy.json \\
         --out-png results/synthetic_array/array/views.png
@@ -32,7 +32,8 @@ from shadowcam.report.array_figure import array_mosaic
 def add_parser(subparsers, name):
     """Register ``array-accuracy`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="score a camera array against its ground truth")
-    parser.add_argument("--capture", required=True, help="capture.nc written by render-array")
+    parser.add_argument("--ground-truth", required=True,
+                        help="ground_truth.nc of the capture (render-array writes it beside capture.json)")
     parser.add_argument("--array", required=True, help="camera_array.nc written by camera-array")
     parser.add_argument("--out-json", required=True, help="results/<ds>/array/accuracy.json")
     parser.add_argument("--out-png", required=True, help="results/<ds>/array/views.png")
@@ -41,10 +42,10 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Write the accuracy JSON and the figure."""
-    with xr.open_dataset(args.capture) as a, xr.open_dataset(args.array) as b:
-        capture, array = a.load(), b.load()
-    report = capture_accuracy(array, capture)
+    with xr.open_dataset(args.ground_truth) as a, xr.open_dataset(args.array) as b:
+        truth, array = a.load(), b.load()
+    report = capture_accuracy(array, truth)
     with atomic_path(args.out_json) as tmp:
         tmp.write_text(json.dumps(report, indent=2, allow_nan=True))
     with atomic_path(args.out_png) as tmp:
-        write_png(tmp, array_mosaic(array["view"].values, capture["reciprocal"].values))
+        write_png(tmp, array_mosaic(array["view"].values, truth["reciprocal"].values))

@@ -1,8 +1,10 @@
 """``shadowcam light-views``: one shadow camera per light of a several-lights capture.
 
 Each sweep's minima are assigned to the lights by their order along the sweep, checked
-by spatial continuity (:func:`shadowcam.lab.light_views.light_set_views`). Writes the
-per-light shadow times, reasons, contrast, confidence and dual views.
+by spatial continuity, and timed by ``edge_fit`` over each light's own map
+(:func:`shadowcam.lab.light_views.light_set_views`); the lights' positions along the sweep
+measured from the data must agree with the capture's ``light_along_*``. Writes the
+per-light shadow times, reasons, contrast, confidence, positions and dual views.
 
 Example::
 
@@ -27,6 +29,9 @@ def add_parser(subparsers, name):
     parser.add_argument("--capture", required=True, help="capture.nc written by render-lights")
     parser.add_argument("--half-window", type=int, default=4,
                         help="frames: at least half the widest dip (a tube across the wire is wide); default 4")
+    parser.add_argument("--skip-order-check", action="store_true",
+                        help="do not check the lights' measured positions against the capture's "
+                             "light_along_* (lights at different heights)")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/lights/light_views.nc")
     return parser
 
@@ -35,6 +40,7 @@ def run(args):
     """Write the per-light views."""
     with xr.open_dataset(args.capture) as opened:
         capture = opened.load()
-    views = light_set_views(capture, half_window=args.half_window)
-    write_dataset(views, args.out, config={"half_window": args.half_window}, inputs=(capture,),
+    views = light_set_views(capture, half_window=args.half_window, check_order=not args.skip_order_check)
+    write_dataset(views, args.out, config={"half_window": args.half_window,
+                                           "check_order": not args.skip_order_check}, inputs=(capture,),
                   step="light-views")

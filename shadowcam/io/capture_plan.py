@@ -29,6 +29,7 @@ Offers
 SCENE_SWEEPS : the two perpendicular scene sweeps of a lab capture.
 CALIBRATION_SWEEPS : the calibration-plane sweeps of a lab capture.
 OUTDOOR_SWEEP : preferred name of the time-lapse sweep of an outdoor capture.
+ARRAY_SWEEPS : the two experiments of a captured camera array.
 PLANNED_SHIFT_COLUMNS : camera shake (columns) the planned strip halo allows for.
 SweepPlan : one sweep: name, files, frame count, frame times, axis, geometry.
 CapturePlan : the plan of one capture (frozen dataclass).
@@ -40,12 +41,13 @@ footprint_variance : a lab capture's declared pixel footprint variance (``sensor
 
 import inspect
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import MappingProxyType
 
 import numpy as np
 
 from shadowcam.cameras.dual_coords import choose_dual_model
-from shadowcam.io.frame_files import check_capture_frames
+from shadowcam.io.frame_files import check_capture_frames, check_frame_files
 from shadowcam.io.manifest import load_manifest
 
 #: scene sweeps of a lab capture (perpendicular, measuring dual u and v)
@@ -156,10 +158,14 @@ class CapturePlan:
     lightfield : mapping or None
         :func:`lightfield_facts` of a ``kind: lightfield`` capture (else None).
     camera_array : mapping or None
-        The ``synthetic.camera_array`` block of a rendered virtual camera array (``rows``,
-        ``cols``, ``spacing_frames``, ``radius_frames``) and the scene's ``frames`` (the
-        light's steps across the mask plane), else None; such a capture has
-        no wire sweeps to decode: its stages are ``camera_array`` only.
+        A virtual camera array, else None; its stages are ``camera_array`` only. Rendered:
+        the ``synthetic.camera_array`` block (``rows``, ``cols``, ``spacing_frames``,
+        ``radius_frames``) and the scene's ``frames`` (the light's steps across the mask
+        plane). Captured (top-level ``camera_array``, sweeps :data:`ARRAY_SWEEPS`):
+        ``rows``, ``cols``, ``spacing_frames`` (None = estimated from the frames),
+        ``crossings`` (paths, row-major) and ``ground_truth`` (path or None). Both:
+        ``images``, the frames and crossing images the array reads (rendered: at most,
+        both experiments taken as long as the wider family's).
     light_set : mapping or None
         ``lights`` (the ``synthetic.lights`` entries) and ``frames`` of a rendered capture
         lit by several lights, else None; its stages are ``light_views`` only (one shadow
@@ -500,13 +506,49 @@ def _rendered_lab_plan(manifest, stage, **facts):
     )
 
 
+#: sweeps of a captured camera array: light moving along e_u, along e_v
+ARRAY_SWEEPS = ("horizontal", "vertical")
+
+
 def _camera_array_plan(manifest):
-    synthetic = manifest["synthetic"]
+    path = manifest["manifest_path"]
+    rendered = "synthetic" in manifest and "camera_array" in manifest["synthetic"]
+    key = "synthetic.camera_array" if rendered else "camera_array"
     if manifest["kind"] != "lab":
-        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.camera_array' needs "
-                         f"kind: lab; got kind: {manifest['kind']}")
-    array = {"radius_frames": 0.6, **synthetic["camera_array"], "frames": int(synthetic["frames"])}
-    return _rendered_lab_plan(manifest, "camera_array", camera_array=array)
+        raise ValueError(f"manifest {path}: key '{key}' needs kind: lab; got kind: {manifest['kind']}")
+    if rendered:
+        synthetic = manifest["synthetic"]
+        array = {"radius_frames": 0.6, **synthetic["camera_array"], "frames": int(synthetic["frames"])}
+        spread = float(array["spacing_frames"]) * (max(array["rows"], array["cols"]) - 1) + 1
+        array["images"] = int(2 * (array["frames"] + spread) + array["rows"] * array["cols"])
+        return _rendered_lab_plan(manifest, "camera_array", camera_array=array)
+    block = manifest["camera_array"]
+    missing = [name for name in ARRAY_SWEEPS if name not in manifest["sweeps"]]
+    if missing:
+        raise ValueError(f"manifest {path}: key 'sweeps' has no sweep {missing[0]!r}; a camera array needs "
+                         "sweep horizontal (light moving along e_u) and sweep vertical (along e_v), each "
+                         "{files: <glob>}")
+    rows, cols, crossings = int(block["rows"]), int(block["cols"]), tuple(block["paths"])
+    if len(crossings) != rows * cols:
+        raise ValueError(f"manifest {path}: key 'camera_array.crossings' gives {len(crossings)} images but "
+                         f"rows x cols = {rows} x {cols} wire crossings need {rows * cols}; give one image "
+                         "per crossing (row-major over wire row, wire column) or fix rows/cols")
+    shape = check_capture_frames(manifest)
+    first = manifest["sweeps"][ARRAY_SWEEPS[0]]["paths"][0]
+    check_frame_files(crossings, what=f"manifest {path}, key 'camera_array.crossings'", first=first)
+    sweeps = {name: SweepPlan(name=name, files=tuple(manifest["sweeps"][name]["paths"]),
+                              n_frames=len(manifest["sweeps"][name]["paths"]),
+                              times_s=tuple(float(t) for t in manifest["sweeps"][name]["times_s"]))
+              for name in ARRAY_SWEEPS}
+    truth = manifest.get("ground_truth")
+    array = {"rows": rows, "cols": cols, "spacing_frames": block.get("spacing_frames"),
+             "crossings": crossings, "images": sum(s.n_frames for s in sweeps.values()) + len(crossings),
+             "ground_truth": None if truth is None else str(Path(manifest["root"]) / truth["file"])}
+    return CapturePlan(name=manifest["name"], manifest_path=path, kind="lab", rendered=False,
+                       sweeps=MappingProxyType(sweeps), frame_shape=shape,
+                       timing=MappingProxyType(dict(manifest.get("timing") or {})),
+                       has_ground_truth=truth is not None, stages=("camera_array",),
+                       camera_array=MappingProxyType(array))
 
 
 def _light_set_plan(manifest):
@@ -548,12 +590,15 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         light, duplicate sweep names), an outdoor capture has several sweeps and
         none named ``timelapse``, `dual_model` is ``calibration`` without
         calibration sweeps, or the first frames of the sweeps and the reference
-        differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`).
+        differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`); a captured
+        camera array without sweep ``horizontal`` or ``vertical``, with crossing images
+        missing or other than ``rows x cols`` of them, or with crossing images of another
+        format or size than the frames (``rows``/``cols`` < 1 fail the schema).
     """
     manifest = load_manifest(manifest_path)
     if manifest["kind"] == "lightfield":
         return _lightfield_plan(manifest)
-    if "camera_array" in manifest.get("synthetic", {}):
+    if "camera_array" in manifest or "camera_array" in manifest.get("synthetic", {}):
         return _camera_array_plan(manifest)
     if "lights" in manifest.get("synthetic", {}):
         return _light_set_plan(manifest)

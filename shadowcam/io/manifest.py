@@ -12,6 +12,7 @@ known, and provenance. Its structure is fixed by
 * ``sweeps[name]["paths"]`` -- natural-sorted absolute paths of the sweep's files;
 * ``sweeps[name]["times_s"]`` -- frame times in seconds (float list, one per file);
 * ``reference_paths`` -- absolute paths of the reference frame(s) (empty if none);
+* ``camera_array["paths"]`` -- absolute paths of a camera array's crossing images, row-major;
 * ``files`` -- group -> list of paths relative to root of every referenced file;
   groups are the sweep names, ``reference``, ``timing`` (sidecar), ``ground_truth``,
   ``calibration_plane`` (mask) and ``sky_mask`` (outdoor mask image).
@@ -118,6 +119,21 @@ def _existing(root, name, *, what, manifest_path):
     if not path.is_file():
         raise ValueError(f"manifest {manifest_path}: {what} file {path} does not exist (key {what})")
     return path
+
+
+def _crossing_paths(root, block, *, manifest_path):
+    """The crossing images of a camera array, row-major (a {row}/{col} pattern or a glob)."""
+    pattern = block["crossings"]
+    if "{row" not in pattern and "{col" not in pattern:
+        return _expand(root, pattern, what="camera_array.crossings", manifest_path=manifest_path)
+    try:
+        names = [pattern.format(row=i, col=j) for i in range(block["rows"]) for j in range(block["cols"])]
+    except (KeyError, IndexError, ValueError) as exc:
+        raise ValueError(f"manifest {manifest_path}: key 'camera_array.crossings' pattern {pattern!r} "
+                         f"cannot be filled ({exc!r}); use the fields {{row}} and {{col}} only, e.g. "
+                         "'crossings/r{row}_c{col}.png'") from None
+    return [_existing(root, name, what="camera_array.crossings", manifest_path=manifest_path)
+            for name in names]
 
 
 def _epoch_seconds(iso_text):
@@ -402,6 +418,10 @@ def _resolve(path, *, strict):
         refs = _expand(root, manifest["reference"], what="reference", manifest_path=path)
         manifest["reference_paths"] = [str(p) for p in refs]
         files["reference"] = [_rel(root, p) for p in refs]
+    if "camera_array" in manifest:
+        crossings = _crossing_paths(root, manifest["camera_array"], manifest_path=path)
+        manifest["camera_array"] = dict(manifest["camera_array"], paths=[str(p) for p in crossings])
+        files["crossings"] = [_rel(root, p) for p in crossings]
     timing = manifest.get("timing", {})
     if timing.get("source") == "sidecar" or (timing.get("source") == "auto" and "file" in timing):
         files["timing"] = [_rel(root, _existing(root, timing["file"], what="timing.file", manifest_path=path))]

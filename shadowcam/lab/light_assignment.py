@@ -22,6 +22,7 @@ light_summary : per-light contrast, coverage and reason counts.
 import warnings
 
 import numpy as np
+from scipy.special import ndtr
 
 from shadowcam._shared.validation import check_positive
 from shadowcam.lab import minima as _m
@@ -54,8 +55,185 @@ def _neighbour_median(time, radius):
         return np.nanmedian(stack, axis=0)
 
 
-def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0):
-    """Per-light shadow times from each pixel's minima.
+def _agreement(time, tolerance, radius):
+    """Neighbours with a time for the same light, and those within `tolerance` of the pixel's
+    time carried to them along the local slope (median differences of adjacent pixels), (L, H, W)."""
+    step_x = np.concatenate([np.diff(time, axis=2), np.full(time[:, :, :1].shape, np.nan)], axis=2)
+    step_y = np.concatenate([np.diff(time, axis=1), np.full(time[:, :1].shape, np.nan)], axis=1)
+    slope_x, slope_y = (np.nan_to_num(_neighbour_median(d, radius)) for d in (step_x, step_y))
+    pad = np.pad(time, ((0, 0), (radius, radius), (radius, radius)), constant_values=np.nan)
+    rows, cols = time.shape[1:]
+    total = np.zeros(time.shape)
+    agree = np.zeros(time.shape)
+    with np.errstate(invalid="ignore"):
+        for dy in range(-radius, radius + 1):
+            for dx in range(-radius, radius + 1):
+                if dy or dx:
+                    other = pad[:, radius + dy:radius + dy + rows, radius + dx:radius + dx + cols]
+                    total += np.isfinite(other)
+                    agree += np.abs(other - time - slope_x * dx - slope_y * dy) <= tolerance
+    return total, agree
+
+
+def _gaps(time):
+    """Median time from light k to light k + 1 over the pixels with both, (L - 1,) (NaN where none)."""
+    out = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        for k in range(time.shape[0] - 1):
+            out.append(float(np.nanmedian(time[k + 1] - time[k])))
+    return np.array(out)
+
+
+def _predict(time, radius, gaps):
+    """Each light's expected time at each pixel: its neighbours' median, else the nearest
+    light's neighbours' median shifted by the median gaps between the lights, (L, H, W)."""
+    median = _neighbour_median(time, radius)
+    offset = np.concatenate([[0.0], np.cumsum(gaps)])
+    out = median.copy()
+    n = time.shape[0]
+    for k in range(n):
+        for distance in range(1, n):
+            for j in (k - distance, k + distance):
+                if 0 <= j < n and np.isfinite(offset[k] - offset[j]):
+                    fill = ~np.isfinite(out[k]) & np.isfinite(median[j])
+                    out[k][fill] = median[j][fill] + offset[k] - offset[j]
+    return out
+
+
+def _match(estimate, predicted, tolerance, gaps, timed):
+    """Each light's minimum: the significant minimum nearest its prediction within
+    `tolerance`, taken by no nearer light; two matched `timed` minima ((K, H, W) bool) of
+    lights k < j must differ by the median gaps between them (`gaps`, (L - 1,)) within
+    ``(j - k) tolerance``, else the one further from its prediction is dropped; -1 where
+    none. `estimate` (K, H, W), NaN = not significant; `predicted` (L, H, W)."""
+    with np.errstate(invalid="ignore"):
+        distance = np.abs(estimate[None] - predicted[:, None])  # (L, K, H, W)
+    distance = np.where(np.isfinite(distance) & (distance <= tolerance), distance, np.inf)
+    best = np.argmin(distance, axis=1)  # (L, H, W)
+    best_distance = np.min(distance, axis=1)
+    pick = np.where(np.isfinite(best_distance), best, -1)
+    # a minimum claimed by two lights goes to the nearer one (lights are more than
+    # 2 tolerance apart wherever both predictions hold, so this is rare)
+    for k in range(pick.shape[0]):
+        for j in range(pick.shape[0]):
+            if j != k:
+                lose = (pick[k] >= 0) & (pick[k] == pick[j]) & (best_distance[j] < best_distance[k])
+                pick[k][lose] = -1
+    if np.all(np.isfinite(gaps)):
+        offset = np.concatenate([[0.0], np.cumsum(gaps)])
+        time = np.where(_gather(timed, pick) == 1, _gather(estimate, pick), np.nan)
+        with np.errstate(invalid="ignore"):
+            for k in range(pick.shape[0]):
+                for j in range(k + 1, pick.shape[0]):
+                    off = np.abs(time[j] - time[k] - (offset[j] - offset[k])) > (j - k) * tolerance
+                    drop_k = off & (best_distance[k] >= best_distance[j])
+                    pick[k][drop_k], time[k][drop_k] = -1, np.nan
+                    pick[j][off & ~drop_k], time[j][off & ~drop_k] = -1, np.nan
+    return pick
+
+
+def _gather(values, pick):
+    """``values[pick[k], y, x]`` per light, NaN where ``pick < 0``; (L, H, W)."""
+    index = np.maximum(pick, 0)
+    out = np.take_along_axis(values, index, 0).astype(np.float64)
+    return np.where(pick >= 0, out, np.nan)
+
+
+def _confirmed(seed, estimate, tolerance, radius):
+    """Seeds whose every assigned time a neighbouring seed confirms (:func:`_agreement`):
+    a lone seed (a spurious dip that happens to sit one gap from a real one) is dropped."""
+    time = _gather(estimate, seed)
+    _, agree = _agreement(time, tolerance, radius)
+    lone = ((seed >= 0) & (agree == 0)).any(axis=0)
+    return np.where(lone[None], -1, seed)
+
+
+def _propagate(seed, estimate, timed, radius, tolerance, iterations):
+    """Seeds grown by continuity: per light, the prediction from the neighbours and the
+    matching of each pixel's minima to it (:func:`_match`), repeated until nothing
+    changes; (L, H, W)."""
+    pick = seed
+    for _ in range(int(iterations)):
+        time = _gather(estimate, pick)
+        gaps = _gaps(time)
+        predicted = _predict(time, radius, gaps)
+        matched = _match(estimate, predicted, tolerance, gaps, timed)
+        # a seed stands unless its neighbours give one of its minima to another light;
+        # a pixel with no prediction at all (isolated) keeps its seed's order
+        moved = ((matched >= 0) & (matched != seed)).any(axis=0)
+        keep = (seed >= 0).all(axis=0) & ~moved | ~np.isfinite(predicted).any(axis=0)
+        new = np.where(keep[None], seed, matched)
+        if np.array_equal(new, pick):
+            break
+        pick = new
+    return pick
+
+
+def _seed_partial(seed, estimate, gaps, n_frames, tolerance, *, informative):
+    """Seeds also where fewer than L significant minima lie in order and exactly one way of
+    giving them to consecutive lights puts every other light's shadow outside the sweep.
+
+    With ``m < L`` minima, shift ``s`` gives minimum ``i`` (along the sweep) to light
+    ``s + i``; the missing lights' times follow from the nearest of the minima by the
+    median gaps. A
+    shift is excluded when a missing light whose absence is `informative` ((L,) bool: the
+    light is seen in most pixels its shadow crosses) has its time inside the sweep by more
+    than `tolerance` (its shadow would have been seen there). A light hidden from the
+    point (a missing minimum between two others) leaves no shift or several: no seed.
+    """
+    n_lights = seed.shape[0]
+    if n_lights < 2 or not np.all(np.isfinite(gaps)):
+        return seed
+    offset = np.concatenate([[0.0], np.cumsum(gaps)])
+    order = np.argsort(np.where(np.isfinite(estimate), estimate, np.inf), axis=0, kind="stable")
+    times = np.take_along_axis(estimate, order, 0)  # finite first, along the sweep
+    m = np.isfinite(times).sum(axis=0)
+    out = seed.copy()
+    for count in range(1, n_lights):
+        at = (m == count) & (seed < 0).all(axis=0)
+        if not at.any():
+            continue
+        first, last = times[0], times[count - 1]  # the earliest and latest minima
+        feasible = []
+        for shift in range(n_lights - count + 1):
+            inside = np.zeros(at.shape, bool)
+            for k in list(range(shift)) + list(range(shift + count, n_lights)):
+                if not informative[k]:
+                    continue
+                with np.errstate(invalid="ignore"):
+                    # from the nearest assigned minimum: the shortest extrapolation
+                    if k < shift:
+                        t = first - (offset[shift] - offset[k])
+                    else:
+                        t = last + offset[k] - offset[shift + count - 1]
+                    inside |= (t > tolerance) & (t < n_frames - 1 - tolerance)
+            feasible.append(~inside)
+        feasible = np.stack(feasible)
+        unique = at & (feasible.sum(axis=0) == 1)
+        shift = np.argmax(feasible, axis=0)
+        for k in range(n_lights):
+            i = k - shift
+            take = unique & (i >= 0) & (i < count)
+            out[k][take] = np.take_along_axis(order, np.clip(i, 0, count - 1)[None], 0)[0][take]
+    return out
+
+
+def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None):
+    """Per-light shadow times from each pixel's minima, checked by spatial continuity.
+
+    Seeds are the pixels with exactly `n_lights` significant minima whose gaps agree with
+    the image's median gaps between the lights (within `tolerance`): minimum k is light
+    k's. Then, `iterations` times, each light's time is predicted at every pixel from its
+    neighbours (median within `radius`; where light k has no neighbours, another light's
+    median shifted by the median gap between them) and each pixel's significant minima
+    go to the light whose prediction lies within `tolerance` (the nearest): a minimum
+    that disagrees with its neighbours by whole inter-light gaps is re-assigned to the
+    light the neighbours make unambiguous, or left unassigned. A light with no minimum
+    is ``minima_count``; a pixel with no neighbours keeps its seed's order; a time further
+    than `tolerance` from its light's neighbourhood, or that at most half of the
+    neighbours with a time for that light confirm (within `tolerance` along the local
+    slope; an isolated time included), is ``ambiguous_order``.
 
     Parameters
     ----------
@@ -66,14 +244,24 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0):
         Neighbourhood (pixels) of the continuity check.
     tolerance : float
         Frames a time may differ from its light's neighbourhood median.
+    iterations : int, optional
+        Most passes of the prediction and matching (each grows the assigned regions by
+        about `radius` pixels); default until nothing changes, at most ``max(H, W)``.
 
     Returns
     -------
     dict of str to ndarray
         ``time`` (L, H, W): NaN where the reason is not ok; ``contrast`` (L, H, W): the
-        minimum's depth over the lit level; ``time_std`` (L, H, W); ``confidence`` (L, H, W)
-        in [0, 1]: how far the dip's depth exceeds the detection level (0 where flagged);
-        ``reason`` (L, H, W) int8 (:data:`LIGHT_REASONS`).
+        minimum's depth over the lit level; ``time_std`` (L, H, W); ``reason`` (L, H, W)
+        int8 (:data:`LIGHT_REASONS`); ``minimum`` (L, H, W) int64: the index of the
+        light's minimum in `minima` (-1 where none); ``seen`` (L,): the fraction of the
+        pixels where the light's shadow is predicted inside the sweep in which its minimum
+        is timed (before the partial seeds); ``confidence`` (L, H, W) in [0, 1], 0 where
+        flagged: the probability that the time is light k's shadow, as the product of
+        ``Phi(depth_snr - significance)`` (the dip is real: its depth over the depth's
+        noise against the detection level) and ``(a + 1) / (n + 2)`` (the neighbours
+        agree: ``a`` of the ``n`` neighbours with a time for light k lie within
+        `tolerance` of it; the posterior mean under a uniform prior).
     """
     if int(n_lights) != n_lights or n_lights < 1:
         raise ValueError(f"n_lights must be an integer >= 1; got {n_lights!r}")
@@ -82,63 +270,51 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0):
         raise ValueError(f"minima: found with count={minima.time.shape[0]} < n_lights={n_lights}; "
                          "find at least one minimum per light")
     check_positive(tolerance, "tolerance", finite=True)
-    shape = minima.count.shape
+    radius = int(radius)
+    iterations = max(minima.count.shape) if iterations is None else int(iterations)
     significant = (minima.reason != _m.MISSING) & (minima.reason != _m.LOW_CONTRAST)
+    estimate = np.where(significant, minima.estimate, np.nan)
     ordered = (minima.count == n_lights) & (minima.extra_contrast == 0)
-    # the k-th significant minimum along the sweep is light k's
-    rank = np.argsort(~significant, axis=0, kind="stable")
-    time = np.full((n_lights, *shape), np.nan)
-    reason = np.full((n_lights, *shape), MINIMA_COUNT, np.int8)
-    pick = np.full((n_lights, *shape), -1, np.int64)
-    to_light = np.vectorize(_FROM_MINIMUM.get, otypes=[np.int8])
-    for k in range(n_lights):
-        index = rank[k]
-        own = np.take_along_axis(minima.reason, index[None], 0)[0]
-        reason[k] = np.where(ordered, to_light(own), MINIMA_COUNT)
-        pick[k] = np.where(ordered, index, -1)
-        time[k] = np.where(ordered & (reason[k] == OK),
-                           np.take_along_axis(minima.time, index[None], 0)[0], np.nan)
-    median = _neighbour_median(time, int(radius))
-    # continuity: a time further than `tolerance` from its light's neighbourhood
+    # seeds: the k-th significant minimum along the sweep is light k's
+    rank = np.argsort(~significant, axis=0, kind="stable")[:n_lights]
+    seed = np.where(ordered[None], rank, -1)
+    seed_time = _gather(estimate, seed)
+    gaps = _gaps(seed_time)
     with np.errstate(invalid="ignore"):
-        jump = np.abs(time - median) > tolerance
-    reason[jump] = AMBIGUOUS_ORDER
-    time[jump] = np.nan
-    # pixels with another number of minima: keep a minimum matching exactly one light's
-    # neighbourhood, growing from the ordered pixels until nothing changes
-    for _ in range(max(shape)):
-        median = _neighbour_median(time, int(radius))
-        changed = False
-        with np.errstate(invalid="ignore"):
-            for m in range(minima.time.shape[0]):
-                t = minima.time[m]
-                near = np.abs(t[None] - median) <= tolerance
-                unique = (near.sum(axis=0) == 1) & ~ordered & np.isfinite(t)
-                light = np.argmax(near, axis=0)
-                for k in range(n_lights):
-                    take = unique & (light == k) & (reason[k] == MINIMA_COUNT)
-                    if take.any():
-                        reason[k][take], pick[k][take], time[k][take] = OK, m, t[take]
-                        changed = True
-        if not changed:
-            break
-    rows, cols = np.indices(shape)
-
-    def gather(values):
-        out = np.full((n_lights, *shape), np.nan)
-        for k in range(n_lights):
-            has = pick[k] >= 0
-            out[k][has] = values[pick[k][has], rows[has], cols[has]]
-        return out
-
-    est, contrast, std, depth = (gather(a) for a in (minima.time, minima.contrast, minima.time_std,
-                                                       minima.depth))
+        off = np.abs(np.diff(seed_time, axis=0) - gaps[:, None, None]) > tolerance
+    seed[:, off.any(axis=0)] = -1
+    seed = _confirmed(seed, estimate, tolerance, radius)
+    pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
+    # a light seen in most pixels where its shadow falls inside the sweep: its absence
+    # there is evidence, and seeds pixels with fewer minima (:func:`_seed_partial`)
+    time = _gather(estimate, pick)
+    predicted = _predict(time, radius, _gaps(time))
+    with np.errstate(invalid="ignore"):
+        inside = (predicted > tolerance) & (predicted < minima.n_frames - 1 - tolerance)
+    timed = (pick >= 0) & (np.take_along_axis(minima.reason, np.maximum(pick, 0), 0) == _m.OK)
+    seen = (inside & timed).sum(axis=(1, 2)) / np.maximum(inside.sum(axis=(1, 2)), 1)
+    seed = _seed_partial(seed, estimate, gaps, minima.n_frames, tolerance, informative=seen > 0.5)
+    seed = _confirmed(seed, estimate, tolerance, radius)
+    pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
+    time = _gather(estimate, pick)
+    total, agree = _agreement(time, tolerance, radius)
+    median = _neighbour_median(time, radius)
+    to_light = np.vectorize(_FROM_MINIMUM.get, otypes=[np.int8])
+    own = np.take_along_axis(minima.reason, np.maximum(pick, 0), 0)
+    reason = np.where(pick >= 0, to_light(own), MINIMA_COUNT).astype(np.int8)
+    with np.errstate(invalid="ignore"):
+        jump = (pick >= 0) & (np.abs(time - median) > tolerance)
+    # a time most of its light's neighbours do not confirm is not checked by continuity
+    # (an isolated time included): flagged, not guessed
+    reason[jump | ((reason == OK) & (2 * agree <= total))] = AMBIGUOUS_ORDER
+    contrast, std, snr = (_gather(a, pick) for a in (minima.contrast, minima.time_std, minima.depth_snr))
     ok = reason == OK
-    with np.errstate(invalid="ignore", divide="ignore"):
-        level = minima.significance * minima.noise[None]
-        confidence = np.clip((depth - level) / np.maximum(level, 1e-12), 0.0, 1.0)
-    return {"time": np.where(ok, est, np.nan), "contrast": contrast, "time_std": std,
-            "confidence": np.where(ok, np.nan_to_num(confidence, nan=1.0), 0.0), "reason": reason}
+    with np.errstate(invalid="ignore"):
+        real = ndtr(np.where(np.isfinite(snr), snr - minima.significance, np.inf))
+    confidence = real * (agree + 1.0) / (total + 2.0)
+    return {"time": np.where(ok, time, np.nan), "contrast": contrast, "time_std": std,
+            "confidence": np.where(ok, confidence, 0.0), "reason": reason, "minimum": pick,
+            "seen": seen}
 
 
 def light_summary(assigned, *, valid=None):

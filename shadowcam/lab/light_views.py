@@ -3,30 +3,158 @@
 Each sweep's minima are found (:func:`shadowcam.lab.minima.find_minima`) and assigned to
 the lights (:func:`shadowcam.lab.light_assignment.assign_minima`) in the order the lights
 sit along the wire's motion (the capture's ``light_along_*``: a light further along the
-motion needs the wire further along to shadow a point, so later); light k's shadow
+motion needs the wire further along to shadow a point, so later), checked against the
+lights' positions measured from the median gaps between their shadows; light k's shadow
 times of the u and v sweeps are its dual coordinates (uniform wire motion: the frame is
 the dual coordinate), and the reference image resampled there is the dual view from
 light k.
 
 Offers
 ------
+light_positions : the lights' positions along a sweep from the gaps between their shadows.
+check_light_order : those positions against the capture's ``light_along_<sweep>``.
 light_set_views : a several-lights capture -> per-light shadow times, reasons, contrast,
     confidence and dual views.
 light_set_errors : per-light, per-sweep absolute time errors on the scored pixels.
 light_set_accuracy : per-light, per-sweep error and coverage against the renderer.
 """
 
+from dataclasses import fields, replace
+
 import numpy as np
 import xarray as xr
 
 from shadowcam.cameras.dual_view import resample_dual_view
-from shadowcam.lab.light_assignment import LIGHT_REASONS, assign_minima
+from shadowcam.lab.light_assignment import LIGHT_REASONS, OK, assign_minima
+from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS
 from shadowcam.lab.minima import find_minima
 
 SWEEPS = ("u", "v")
 
 
-def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, tolerance=2.0):
+def light_positions(time, *, min_pixels=20):
+    """The lights' positions along a sweep, in frames, measured from their shadows.
+
+    Parameters
+    ----------
+    time : (L, H, W) array_like
+        Per-light shadow times in the order of the shadows along the sweep (NaN = untimed),
+        as :func:`shadowcam.lab.light_assignment.assign_minima` gives them.
+    min_pixels : int
+        Pixels with both lights timed below which a gap is not measured.
+
+    Returns
+    -------
+    position : (L,) float64 ndarray
+        0 for the first light, then the running sum of the median gaps between
+        consecutive lights (NaN after a gap that is not measured).
+    spread : (L - 1,) float64 ndarray
+        Median absolute deviation of each gap over the pixels (frames).
+    """
+    time = np.asarray(time, dtype=np.float64)
+    gaps, spread = [], []
+    for k in range(time.shape[0] - 1):
+        gap = (time[k + 1] - time[k])[np.isfinite(time[k + 1]) & np.isfinite(time[k])]
+        enough = gap.size >= int(min_pixels)
+        gaps.append(float(np.median(gap)) if enough else np.nan)
+        spread.append(float(np.median(np.abs(gap - np.median(gap)))) if enough else np.nan)
+    return np.concatenate([[0.0], np.cumsum(gaps)]), np.array(spread)
+
+
+def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0, seen=None):
+    """Check the lights' positions along a sweep from the data against the capture description.
+
+    Shadows of lights at one height move with the wire in proportion to the lights'
+    offsets along the sweep, so the measured gaps between consecutive lights (frames) are
+    a scaled copy of the described ones (metres, sorted along the sweep). The scale is
+    the least-squares fit over the gaps measured consistently (spread across the pixels
+    within `tolerance`, between two lights each `seen` in most pixels its shadow crosses: a
+    gap from noise minima is not); a gap further than `tolerance`
+    frames from its scaled description means the description's positions (or their order)
+    are not the capture's. Needs three lights or more (two give one gap, which any scale
+    fits); lights swapped between equally spaced positions are not seen.
+
+    Parameters
+    ----------
+    position : (L,) array_like
+        From :func:`light_positions`.
+    spread : (L - 1,) array_like
+        From :func:`light_positions`.
+    light_along : (L,) array_like
+        The capture's ``light_along_<sweep>``, per light.
+    sweep : str
+        ``"u"`` or ``"v"`` (for the message).
+    tolerance : float
+        Frames.
+    seen : (L,) array_like, optional
+        Per light in the order along the sweep, the fraction of its pixels where it is
+        timed (``assign_minima``'s ``seen``); a gap counts only between lights above 1/2.
+
+    Returns
+    -------
+    (L,) float64 ndarray
+        The described positions scaled to frames, in the order along the sweep (all NaN
+        where no gap is measured consistently).
+
+    Raises
+    ------
+    ValueError
+        Naming ``light_along_<sweep>`` when they disagree.
+    """
+    gaps = np.diff(np.asarray(position, dtype=np.float64))
+    along = np.sort(np.asarray(light_along, dtype=np.float64))
+    if along.size != gaps.size + 1:
+        raise ValueError(f"light_along_{sweep}: {along.size} lights described, {gaps.size + 1} measured")
+    described = np.diff(along)
+    use = np.isfinite(gaps) & (np.asarray(spread, dtype=np.float64) <= tolerance)
+    if seen is not None:
+        seen = np.asarray(seen, dtype=np.float64) > 0.5
+        use &= seen[:-1] & seen[1:]
+    norm = float(np.sum(described[use] ** 2))
+    if not use.any() or norm == 0:
+        return np.full(along.size, np.nan)
+    scale = float(np.sum(described[use] * gaps[use]) / norm)
+    off = np.abs(gaps - scale * described)[use]
+    if off.max() > tolerance:
+        expected = np.concatenate([[0.0], np.cumsum(scale * described)])
+        raise ValueError(
+            f"light_along_{sweep}: the capture description puts the lights' shadows at "
+            f"{np.round(expected, 1).tolist()} frames along the {sweep} sweep, the data at "
+            f"{np.round(position, 1).tolist()} (median gaps between the minima; off by "
+            f"{off.max():.1f} > tolerance {tolerance}): check the lights' offsets (synthetic.lights "
+            "in the manifest) against the capture; lights at different heights break the "
+            "proportion this check assumes (light-views --skip-order-check)")
+    return np.concatenate([[0.0], np.cumsum(scale * described)])
+
+
+def _edge_fit_per_light(minima, assigned):
+    """Each light's ok times re-timed by ``edge_fit`` over that light's own time map.
+
+    ``edge_fit`` (:func:`shadowcam.lab.shadow_time.time_edge_fit`) weighs each pixel's
+    dip centroid against its neighbours' local plane by their variances; given the
+    windows of one light's minima (:attr:`shadowcam.lab.minima.Minima.summary`, gathered
+    at ``assigned["minimum"]``) its neighbours are that light's, never another light's.
+    Flagged pixels neither get a time nor take part.
+    """
+    summary = minima.summary
+    out = dict(assigned)
+    out["time"], out["time_std"] = assigned["time"].copy(), assigned["time_std"].copy()
+    for k, pick in enumerate(assigned["minimum"]):
+        ok = assigned["reason"][k] == OK
+        index = np.maximum(pick, 0)[None]
+        gathered = {f.name: np.take_along_axis(getattr(summary, f.name), index, 0)[0]
+                    for f in fields(summary)
+                    if f.name != "window" and isinstance(getattr(summary, f.name), np.ndarray)}
+        window = np.take_along_axis(summary.window, index[None], 1)[:, 0]
+        light = replace(summary, window=np.where(ok[None], window, np.nan), **gathered)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            time, _, _, std = SHADOW_TIME_METHODS["edge_fit"](light)
+        out["time"][k] = np.where(ok, time, np.nan)
+        out["time_std"][k] = np.where(ok, std, assigned["time_std"][k])
+    return out
+
+
+def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tolerance=2.0, check_order=True):
     """Per-light shadow times and dual views.
 
     Parameters
@@ -39,31 +167,53 @@ def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, 
         Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
         across the wire spreads its shadow over its projection).
     method : str
-        Timing method of each minimum (:func:`~shadowcam.lab.minima.find_minima`).
+        Timing method of each minimum (:func:`~shadowcam.lab.minima.find_minima`), or
+        ``edge_fit``: dip centroids refined over each light's own time map
+        (:func:`_edge_fit_per_light`).
     radius, tolerance
         Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
+    check_order : bool
+        Check the measured positions against ``light_along_<sweep>``
+        (:func:`check_light_order`, which assumes the lights at one height); False: only
+        measure them.
 
     Returns
     -------
     xarray.Dataset
         ``time``, ``contrast``, ``confidence``, ``time_std`` (sweep, light, y, x) float32,
         ``reason`` (sweep, light, y, x) int8 (:data:`~shadowcam.lab.light_assignment.LIGHT_REASONS`),
-        ``dual_view`` (light, v, u, channel) and ``coverage`` (light, v, u).
+        ``dual_view`` (light, v, u, channel), ``coverage`` (light, v, u) and ``position``
+        (sweep, light): each light's position along the sweep measured from its shadows
+        (frames from the first light's, :func:`light_positions`).
+
+    Raises
+    ------
+    ValueError
+        When the measured positions disagree with ``light_along_<sweep>``
+        (:func:`check_light_order`).
     """
     missing = {"frames_u", "frames_v", "reference", "light_along_u", "light_along_v"} - set(capture)
     if missing or "light" not in capture.coords:
         raise ValueError(f"capture: not a several-lights capture (missing {sorted(missing) or 'light'}); "
                          "render it with the render-lights step")
     n_lights = capture.sizes["light"]
-    per_sweep = {}
+    per_sweep, positions = {}, {}
     for name in SWEEPS:
         frames = capture[f"frames_{name}"].values
         minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
-                             method=method)
+                             method="dip_centroid" if method == "edge_fit" else method)
         in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
+        if method == "edge_fit":
+            in_order = _edge_fit_per_light(minima, in_order)
+        positions[name], spread = light_positions(in_order["time"])
+        seen = in_order.pop("seen")
+        if check_order:
+            check_light_order(positions[name], spread, capture[f"light_along_{name}"].values, sweep=name,
+                              tolerance=tolerance, seen=seen)
         # the k-th shadow along the sweep is the light k-th along the wire's motion
         order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
         per_sweep[name] = {key: value[np.argsort(order)] for key, value in in_order.items()}
+        positions[name] = positions[name][np.argsort(order)]
     reference = capture["reference"].values
     shape = (capture.sizes["t_v"], capture.sizes["t_u"])
     views = np.full((n_lights, *shape, reference.shape[2]), np.nan, np.float32)
@@ -80,11 +230,12 @@ def light_set_views(capture, *, half_window=4, method="dip_centroid", radius=2, 
         {"time": stacked("time", np.float32), "contrast": stacked("contrast", np.float32),
          "confidence": stacked("confidence", np.float32), "time_std": stacked("time_std", np.float32),
          "reason": stacked("reason", np.int8),
-         "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage)},
+         "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage),
+         "position": (("sweep", "light"), np.stack([positions[s] for s in SWEEPS]))},
         coords={"sweep": list(SWEEPS), "light": capture["light"].values, "channel": capture["channel"].values},
         attrs={"reasons": str(LIGHT_REASONS), "half_window": int(half_window), "method": method,
                "radius": int(radius),
-               "tolerance": float(tolerance)})
+               "tolerance": float(tolerance), "order_checked": int(bool(check_order))})
 
 
 def light_set_errors(views, capture, *, min_level=0.2):
@@ -123,7 +274,7 @@ def light_set_errors(views, capture, *, min_level=0.2):
     return out
 
 
-def light_set_accuracy(views, capture, *, min_level=0.2):
+def light_set_accuracy(views, capture, *, min_level=0.2, false_error=1.0):
     """Per-light, per-sweep accuracy against the renderer's per-light times.
 
     Parameters
@@ -134,6 +285,8 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
         As for :func:`light_set_errors`.
     min_level : float
         Pixels darker than this fraction of the median reference are not scored.
+    false_error : float
+        Frames: a timed pixel further than this from the truth is a false time.
 
     Returns
     -------
@@ -141,7 +294,10 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
         ``lights``: one entry per light with, per sweep, ``p95_error``, ``rmse`` and
         ``max_error`` (frames, over its timed scored pixels), ``coverage`` (timed fraction
         of the scored pixels: lit, the light's shadow entirely inside the sweep),
-        ``n_scored``, ``contrast`` (median) and ``reasons`` (name -> count).
+        ``n_scored``, ``contrast`` (median), ``false_rate`` (fraction of the timed scored
+        pixels further than `false_error` from the truth), ``confidence_true`` and
+        ``confidence_false`` (median confidence on the timed pixels within and beyond
+        `false_error`; None where none) and ``reasons`` (name -> count).
     """
     errors = light_set_errors(views, capture, min_level=min_level)
     out = []
@@ -153,6 +309,9 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
             reason = views["reason"].values[s, k]
             timed = np.isfinite(err)
             contrast = views["contrast"].values[s, k][scored]
+            confidence = views["confidence"].values[s, k][scored]
+            false = timed & (np.nan_to_num(err, nan=0.0) > false_error)
+            true = timed & ~false
             entry[name] = {
                 "p95_error": float(np.percentile(err[timed], 95)) if timed.any() else None,
                 "rmse": float(np.sqrt(np.mean(err[timed] ** 2))) if timed.any() else None,
@@ -160,6 +319,9 @@ def light_set_accuracy(views, capture, *, min_level=0.2):
                 "coverage": float(timed.mean()) if scored.any() else 0.0,
                 "n_scored": int(scored.sum()),
                 "contrast": float(np.nanmedian(contrast)) if np.isfinite(contrast).any() else None,
+                "false_rate": float(false.sum() / timed.sum()) if timed.any() else None,
+                "confidence_true": float(np.median(confidence[true])) if true.any() else None,
+                "confidence_false": float(np.median(confidence[false])) if false.any() else None,
                 "reasons": {label: int(np.sum(reason[scored] == code)) for code, label in LIGHT_REASONS.items()},
             }
         out.append(entry)

@@ -14,7 +14,9 @@ passes over the frames, memory independent of their number:
 2. a second pass keeps the raw samples within ``2 * half_window`` frames of each minimum, and the level and
    noise of the frames more than ``half_window`` frames from every minimum (noise
    from first differences, so that a slowly varying lit level, as under a moving
-   light, does not count).
+   light, does not count). The pixels' noise estimates are pooled into the sensor's
+   Poisson-Gaussian model (:mod:`shadowcam.lab.sensor_noise`), and a minimum counts
+   only where its depth is significant against the noise of that depth (``depth_snr``).
 
 Each minimum is then timed like a single dip: its window is cut where it meets
 the next minimum's (each sample belongs to the nearest minimum), normalised by
@@ -29,12 +31,14 @@ select_minima : the K deepest separated minima among candidate lists.
 find_minima : two streaming passes over a sweep's frames -> :class:`Minima`.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
+from scipy.special import ndtri
 
 from shadowcam._shared.validation import check_in, check_positive
 from shadowcam.lab.dip_tracker import DipSummary, DipTracker
+from shadowcam.lab.sensor_noise import fit_noise_model, pixel_noise
 from shadowcam.lab.shadow_time import _SMOOTHED_NOISE, SHADOW_TIME_METHODS, detection_threshold
 
 #: reason code -> meaning, per minimum (0 = a reliable time)
@@ -79,14 +83,24 @@ class Minima:
     extra_contrast : (H, W) float64
         Contrast of the deepest further minimum (the (K+1)-th; 0 where none): a
         significant one means the pixel has more dips than K.
+    depth_snr : (K, H, W) float64
+        Depth of the smoothed minimum below its window's level over that depth's noise
+        standard deviation (noise of the level and of the smoothed bottom, the bottom's
+        scaled to its level by `noise_model`).
     noise : (H, W) float64
-        Temporal noise of one raw sample.
+        Temporal noise of one raw sample at the lit level
+        (:func:`shadowcam.lab.sensor_noise.pixel_noise`).
     lit_level : (H, W) float64
         Mean signal more than ``half_window`` frames from every minimum.
     n_frames : int
     significance : float
-        Contrast, in units of the smoothed-sample noise relative to the level,
-        below which a minimum is ``low_contrast``.
+        `depth_snr` below which a minimum is ``low_contrast``: the depth pure noise reaches
+        with probability ``false_alarm`` somewhere in the sweep.
+    noise_model : (float, float)
+        ``(gain, floor)`` of the sweep's Poisson-Gaussian noise (fitted or given).
+    summary : DipSummary
+        Each minimum's window (normalised by its lit level) and statistics, the timing
+        methods' input: ``window`` (4 half_window + 1, K, H, W), the others (K, H, W).
     """
 
     time: np.ndarray
@@ -98,12 +112,15 @@ class Minima:
     width: np.ndarray
     time_std: np.ndarray
     reason: np.ndarray
+    depth_snr: np.ndarray
     count: np.ndarray
     extra_contrast: np.ndarray
     noise: np.ndarray
     lit_level: np.ndarray
     n_frames: int
     significance: float
+    noise_model: tuple = (float("nan"), float("nan"))
+    summary: DipSummary = None
 
 
 def select_minima(values, frames, count, *, separation):
@@ -329,8 +346,26 @@ def _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence, 
     return present, dip
 
 
+def _depth_snr(level, smoothed, noise, model, outside_sequence):
+    """Depth of each smoothed minimum below its window's level over the depth's noise, (K, P).
+
+    The depth is the level at the centre (the line through the means of two samples at each
+    window end, or at one end where the window runs past the sequence) minus the [1, 2, 1] / 4
+    smoothed minimum; their variances add. The pixel's variance `noise` ** 2 (at its lit
+    level) scales to the dip's bottom by the Poisson-Gaussian `model` (shot noise follows
+    the signal).
+    """
+    gain, floor = model
+    with np.errstate(invalid="ignore", divide="ignore"):
+        at_lit = gain * level + floor
+        scale = np.where(np.isfinite(at_lit) & (at_lit > 0), (gain * np.maximum(smoothed, 0) + floor) / at_lit, 1.0)
+        level_share = np.where(outside_sequence.any(axis=1), 0.5, 0.25)
+        sigma = noise[None] * np.sqrt(_SMOOTHED_NOISE ** 2 * scale + level_share)
+        return (level - smoothed) / sigma
+
+
 def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3,
-                steady_level=True):
+                steady_level=True, noise_model=None):
     """The `count` deepest separated minima of each pixel, timed and classified.
 
     Parameters
@@ -349,7 +384,8 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         A key of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS` other than
         ``edge_fit`` (which mixes neighbours' times, possibly of other minima).
     false_alarm : float
-        Probability that pure noise makes a minimum (sets ``significance``).
+        Probability that pure noise makes a minimum (sets ``significance``), and that a
+        pixel following the noise model is taken for a noisier one.
     steady_level : bool
         The lit level is the same all along the sweep (a static light): a window whose
         ends stay more than a tenth of the dip's depth below the level of the frames far
@@ -364,6 +400,10 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     if int(count) != count:
         raise ValueError(f"count must be an integer >= 1; got {count!r}")
     check_in(method, "method", tuple(m for m in SHADOW_TIME_METHODS if m != "edge_fit"))
+    if noise_model is not None:
+        noise_model = tuple(float(v) for v in noise_model)
+        if len(noise_model) != 2 or not all(np.isfinite(v) and v >= 0 for v in noise_model):
+            raise ValueError(f"noise_model must be (gain, floor), two finite numbers >= 0; got {noise_model!r}")
     blocks = _as_blocks(frames)
     count, h = int(count), int(half_window)
     tracker = DipTracker(tuple(shape), half_window=h)
@@ -390,11 +430,15 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     slot_frame = centres[:, None, :] - w + np.arange(2 * w + 1)[None, :, None]  # (K+1, W, P)
     outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
     with np.errstate(invalid="ignore", divide="ignore"):
-        noise = np.sqrt(passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0)
-        noise = np.where(passing.diff_count > 0, noise, np.nan)
-    significance = detection_threshold(n_frames, false_alarm=false_alarm) * _SMOOTHED_NOISE
-    present, dip = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence,
-                                      significance * noise)
+        own_variance = passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0
+        far_level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
+    if noise_model is None:
+        noise_model = fit_noise_model(far_level, own_variance, passing.diff_count)
+    noise = pixel_noise(far_level, own_variance, passing.diff_count, model=noise_model,
+                        false_alarm=false_alarm)
+    significance = detection_threshold(n_frames, false_alarm=false_alarm)
+    detectable = significance * _SMOOTHED_NOISE * noise
+    present, dip = _merge_within_dips(window, centres, smoothed, slot_frame, outside_sequence, detectable)
     # each sample belongs to its nearest dip: cut the windows where they meet
     own = np.abs(slot_frame - centres[:, None, :])  # (K+1, W, P)
     nearest = np.ones(own.shape, bool)
@@ -403,12 +447,12 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         nearest &= ~cuts[None, None] | (own <= np.abs(slot_frame - centres[other][None, None]))
     cut = np.where(nearest, window, np.nan)
     if steady_level:
-        cut = _own_dip(cut, significance * noise, ~outside_sequence)
+        cut = _own_dip(cut, detectable, ~outside_sequence)
     cut_by_other = ~nearest & np.isfinite(window)
     level = _line_level(cut, ~outside_sequence[:, 0], ~outside_sequence[:, -1]).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
         normalised = cut / level
-        lit_level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
+    lit_level = far_level
     k_all = count + 1
     centre_level = level[:, w, :]
     lowest = np.nanmin(np.where(np.isfinite(normalised), normalised, np.inf), axis=1)
@@ -426,18 +470,22 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         invalid_count=passing.invalid, n_frames=n_frames)
     with np.errstate(invalid="ignore", divide="ignore"):
         estimate, entry, exit_, std = (np.asarray(a, np.float64) for a in SHADOW_TIME_METHODS[method](summary))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        # the smoothed minimum's depth against the smoothed-sample noise
-        strong = centre_level - smoothed > significance * noise[None]
+    depth_snr = _depth_snr(centre_level, smoothed, noise, noise_model, outside_sequence)
+    with np.errstate(invalid="ignore"):
+        strong = depth_snr > significance
     width = exit_ - entry
     reason = np.full((k_all, p), OK, np.int8)
     reason[~strong] = LOW_CONTRAST
     # under a steady level the window's ends must reach the level of the frames far from
-    # every minimum (within a tenth of the dip's depth): else the dip is wider than the
-    # window, or runs into the next one, and its crossings are not its own
-    with np.errstate(invalid="ignore"):
+    # every minimum (within a tenth of the dip's depth, and within what the noise of the
+    # two means allows at `false_alarm`): else the dip is wider than the window, or runs
+    # into the next one, and its crossings are not its own. Where that noise allowance
+    # exceeds half the dip's depth the window's closure cannot be established: not timed.
+    with np.errstate(invalid="ignore", divide="ignore"):
         end_level = np.minimum(level[:, 0, :], level[:, -1, :])
-        unlit_ends = ~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest))
+        end_noise = -ndtri(false_alarm) * noise * np.sqrt(0.5 + 1.0 / np.maximum(passing.lit_count, 1))
+        unlit_ends = (~(end_level - raw_lowest >= 0.9 * (lit_level[None] - raw_lowest) - end_noise[None])
+                      | (end_noise[None] > 0.5 * (lit_level[None] - raw_lowest)))
     open_dip = ~np.isfinite(width) | (unlit_ends if steady_level else False)
     # a cut window whose dip does not close: another minimum closer than their widths
     reason[strong & open_dip & cut_by_other.any(axis=1)] = OVERLAPPING
@@ -459,9 +507,17 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         a = np.broadcast_to(np.asarray(a), (k_all, p))[:count]
         return np.take_along_axis(a, perm, 0).reshape(count, rows, cols)
 
+    def slots(a):  # (W, K + 1, P) -> (W, K, H, W)
+        return np.take_along_axis(a[:, :count], perm[None], 1).reshape(a.shape[0], count, rows, cols)
+
+    per_minimum = replace(summary, **{
+        f.name: (slots(getattr(summary, f.name)) if f.name == "window" else image(getattr(summary, f.name)))
+        for f in fields(summary) if isinstance(getattr(summary, f.name), np.ndarray)})
+
     return Minima(time=image(time), estimate=image(estimate), frame=image(centres),
                   depth=image(depth), contrast=image(contrast), level=image(centre_level),
                   width=image(width), time_std=image(std), reason=image(reason),
-                  count=found.reshape(rows, cols), extra_contrast=extra_contrast.reshape(rows, cols),
+                  depth_snr=image(depth_snr), count=found.reshape(rows, cols), extra_contrast=extra_contrast.reshape(rows, cols),
                   noise=noise.reshape(rows, cols), lit_level=lit_level.reshape(rows, cols),
-                  n_frames=n_frames, significance=significance)
+                  n_frames=n_frames, significance=significance, noise_model=tuple(map(float, noise_model)),
+                  summary=per_minimum)

@@ -410,8 +410,9 @@ def _array_manifest(tmp_path, **array):
 def test_camera_array_plan_has_only_its_stage(tmp_path):
     plan = capture_plan(_array_manifest(tmp_path, rows=2, cols=3, spacing_frames=5))
     assert plan.stages == ("camera_array",) and plan.rendered and plan.has_ground_truth
+    # images: both experiments at most frames + spacing x (3 - 1) + 1 each, and 6 crossings
     assert dict(plan.camera_array) == {"rows": 2, "cols": 3, "spacing_frames": 5, "radius_frames": 0.6,
-                                       "frames": 12}
+                                       "frames": 12, "images": 2 * (12 + 11) + 6}
     assert plan.frame_shape == (16, 20) and plan.sweeps == {}
 
 

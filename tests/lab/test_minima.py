@@ -163,3 +163,44 @@ def test_another_shadow_inside_the_window_does_not_move_a_dip(centre, width, gap
     assert np.all(m_both.reason[k_both] == OK)
     np.testing.assert_allclose(m_both.time[k_both], m_alone.time[k_alone], atol=1e-6)
     np.testing.assert_allclose(m_both.contrast[k_both], m_alone.contrast[k_alone], atol=1e-6)
+
+
+def test_poisson_gaussian_noise_makes_no_minimum_and_hides_no_dip():
+    """One one-third-deep dip per pixel under shot and read noise (sigma 1 % - 4 % of the
+    level, the dip 8 - 33 sigma): the second minimum asked for is pure noise."""
+    rng = np.random.default_rng(5)
+    gain, floor = 4e-5, 3e-7
+    shape = (40, 50)
+    level = rng.uniform(0.03, 0.2, shape).astype(np.float32)
+    clean = box_dips(48, [24.0], [1.5], [1 / 3], shape=shape) * level[None]
+    frames = clean + np.sqrt(gain * clean + floor) * rng.standard_normal(clean.shape).astype(np.float32)
+    m = find_minima(frames, shape, count=2, half_window=4)
+    assert m.noise_model[0] == pytest.approx(gain, rel=0.1)
+    real = np.abs(m.frame - 24) <= 1
+    assert np.mean(real.any(axis=0)) == 1.0
+    # the dip: found and timed in every pixel
+    assert np.mean(m.reason[real] == OK) > 0.995
+    # noise minima: at most a few in 2000 pixels at false_alarm 1e-3 (expected about 2)
+    noise_minima = ~real & (m.reason != LOW_CONTRAST) & (m.reason != MISSING)
+    assert noise_minima.sum() <= 8
+    assert np.all(m.count <= 1 + noise_minima.any(axis=0))
+
+
+@settings(max_examples=15, deadline=None)
+@given(first=st.floats(20.0, 40.0), fraction=st.floats(0.3, 1.0), width=st.floats(2.5, 4.0),
+       snr=st.floats(8.0, 30.0), seed=st.integers(0, 2**16))
+def test_close_dips_under_poisson_gaussian_noise_are_flagged_or_near_a_dip(first, fraction, width, snr,
+                                                                         seed):
+    """Two one-third-deep dips closer than their widths, shot and read noise with the dip
+    `snr` noise sigma deep (per sample, at the lit level): a confident time always lies
+    within its dip's half width (plus a frame of noise) of a true centre."""
+    rng = np.random.default_rng(seed)
+    centres = [first, first + fraction * width]
+    clean = box_dips(64, centres, [width, width], [1 / 3, 1 / 3], shape=(6, 6))
+    sigma_lit = (1 / 3) / snr
+    gain, floor = 0.8 * sigma_lit ** 2, 0.2 * sigma_lit ** 2  # variance at level 1: sigma_lit ** 2
+    frames = clean + np.sqrt(gain * clean + floor) * rng.standard_normal(clean.shape).astype(np.float32)
+    m = find_minima(frames, frames.shape[1:], count=2, half_window=3)
+    ok = m.reason == OK
+    distance = np.min(np.abs(m.time[..., None] - np.array(centres)), axis=-1)
+    assert np.all(distance[ok] <= width / 2 + 1.0)

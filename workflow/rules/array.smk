@@ -1,14 +1,17 @@
-# Stage: the virtual camera array (datasets whose manifest has synthetic.camera_array):
-# render the grid-mask capture, assign each pixel's dips to the wires and build one view
-# per wire crossing, then score it against the renderer's ground truth (accuracy.json)
-# and draw the views beside their reciprocal renders (views.png, the paper's Fig. 6).
+# Stage: the virtual camera array (datasets whose manifest has camera_array, captured, or
+# synthetic.camera_array, rendered): a rendered array is written as a capture folder
+# (frame files, crossing images, capture.json, ground_truth.nc); each pixel's dips are
+# assigned to the wires and one view is built per wire crossing from the capture's files,
+# then scored against the ground truth (accuracy.json) and drawn beside the reciprocal
+# renders (views.png, the paper's Fig. 6).
 
 
 rule array_render:
     input:
         "data_manifest/{ds}.yaml",
     output:
-        "results/{ds}/array/capture.nc",
+        capture="results/{ds}/array/capture/capture.json",
+        truth="results/{ds}/array/capture/ground_truth.nc",
     log:
         "logs/{ds}/array_render.log",
     benchmark:
@@ -19,12 +22,13 @@ rule array_render:
         mem_mb=get_array_mem_mb,
         runtime=30,
     shell:
-        "shadowcam render-array --manifest {input} --out {output} > {log} 2>&1"
+        "shadowcam render-array --manifest {input} --out results/{wildcards.ds}/array/capture"
+        " > {log} 2>&1"
 
 
 rule camera_array:
     input:
-        "results/{ds}/array/capture.nc",
+        array_manifest,
     output:
         "results/{ds}/array/camera_array.nc",
     log:
@@ -37,12 +41,12 @@ rule camera_array:
         mem_mb=get_array_mem_mb,
         runtime=30,
     shell:
-        "shadowcam camera-array --capture {input} --out {output} > {log} 2>&1"
+        "shadowcam camera-array --manifest {input} --out {output} > {log} 2>&1"
 
 
 rule array_accuracy:
     input:
-        capture="results/{ds}/array/capture.nc",
+        truth=array_ground_truth,
         array="results/{ds}/array/camera_array.nc",
     output:
         json="results/{ds}/array/accuracy.json",
@@ -61,5 +65,5 @@ rule array_accuracy:
         mem_mb=get_array_mem_mb,
         runtime=15,
     shell:
-        "shadowcam array-accuracy --capture {input.capture} --array {input.array}"
+        "shadowcam array-accuracy --ground-truth {input.truth} --array {input.array}"
         " --out-json {output.json} --out-png {output.png} > {log} 2>&1"

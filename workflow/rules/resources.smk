@@ -213,12 +213,7 @@ def get_lightfield_export_mem_mb(wildcards, attempt):
 
 def get_array_mem_mb(wildcards, attempt):
     """A camera-array step: both experiments' float32 RGB frames and the crossing images."""
-    plan = capture(wildcards.ds)
-    array = plan.camera_array
-    spread = (
-        float(array["spacing_frames"]) * (max(array["rows"], array["cols"]) - 1) + 1
-    )
-    images = 2 * (array["frames"] + spread) + array["rows"] * array["cols"]
+    images = capture(wildcards.ds).camera_array["images"]
     return get_image_mem_mb(wildcards, attempt) + attempt * math.ceil(
         3 * images * _frame_mb(wildcards.ds)
     )

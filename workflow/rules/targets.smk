@@ -12,10 +12,10 @@ def dataset_targets(ds):
     if plan.is_lightfield:
         return lightfield_targets(ds)  # workflow/rules/lightfield.smk
     if plan.camera_array is not None:  # workflow/rules/array.smk
-        return [
-            f"results/{ds}/array/{name}"
-            for name in ("camera_array.nc", "accuracy.json", "views.png")
-        ]
+        names = ("camera_array.nc",)
+        if plan.has_ground_truth:
+            names += ("accuracy.json", "views.png")
+        return [f"results/{ds}/array/{name}" for name in names]
     if plan.light_set is not None:  # workflow/rules/lights.smk
         return [
             f"results/{ds}/lights/{name}"
