@@ -1,17 +1,27 @@
-# Input functions of the camera-array stage (workflow/rules/array.smk), from the capture
-# plan of a camera-array manifest (captured, or rendered into results/<ds>/array/capture).
+# Input functions of the stages that read a capture's files through its manifest: the
+# camera array (workflow/rules/array.smk: folder "array", plan.camera_array) and several
+# lights (workflow/rules/lights.smk: folder "lights", plan.light_set). The capture is a
+# user's (data_manifest/<ds>.yaml) or rendered into results/<ds>/<folder>/capture.
 
 
-def array_manifest(wildcards):
-    """The camera-array manifest: the rendered capture.json, or the dataset's own manifest."""
-    if capture(wildcards.ds).rendered:
-        return f"results/{wildcards.ds}/array/capture/capture.json"
-    return f"data_manifest/{wildcards.ds}.yaml"
+def capture_manifest(folder):
+    """Input function: the rendered capture.json under `folder`, or the dataset's manifest."""
+
+    def manifest(wildcards):
+        if capture(wildcards.ds).rendered:
+            return f"results/{wildcards.ds}/{folder}/capture/capture.json"
+        return f"data_manifest/{wildcards.ds}.yaml"
+
+    return manifest
 
 
-def array_ground_truth(wildcards):
-    """ground_truth.nc of a camera-array capture (rendered, or the manifest's ground_truth)."""
-    plan = capture(wildcards.ds)
-    if plan.rendered:
-        return f"results/{wildcards.ds}/array/capture/ground_truth.nc"
-    return plan.camera_array["ground_truth"]
+def capture_ground_truth(folder, block):
+    """Input function: ground_truth.nc, rendered under `folder` or the plan's `block` names."""
+
+    def ground_truth(wildcards):
+        plan = capture(wildcards.ds)
+        if plan.rendered:
+            return f"results/{wildcards.ds}/{folder}/capture/ground_truth.nc"
+        return getattr(plan, block)["ground_truth"]
+
+    return ground_truth
