@@ -55,8 +55,7 @@ def _user_doc(capture, *, lights=None, sweeps=("u", "v"), reference=True):
 
 @pytest.fixture(scope="module")
 def truth(rendered):
-    with xr.open_dataset(rendered / "ground_truth.nc") as opened:
-        return opened.load()
+    return xr.load_dataset(rendered / "ground_truth.nc")
 
 
 @pytest.fixture(scope="module")
@@ -123,8 +122,7 @@ def test_a_noisy_12_bit_dng_capture_is_a_mosaic_read_through_the_files(tmp_path)
     described = json.loads((capture / "capture.json").read_text())
     assert described["ground_truth"]["noise"] == "raw12" and described["reference"] == "reference.dng"
     views = light_set_views_of_plan(capture_plan(capture / "capture.json"))
-    with xr.open_dataset(capture / "ground_truth.nc") as opened:
-        acc = light_set_accuracy(views, opened.load())["lights"]
+    acc = light_set_accuracy(views, xr.load_dataset(capture / "ground_truth.nc"))["lights"]
     for k, sweep in POINT_SWEEPS:
         entry = acc[k][sweep]
         assert entry["coverage"] > 0.97 and entry["false_rate"] < 0.03
