@@ -4,7 +4,7 @@ Writes ``accuracy.json`` (per-camera coordinate RMSE and coverage, rectification
 disparity against depth, views against the reciprocal renders after one gain;
 :func:`shadowcam.cameras.array.capture_accuracy`) and the Fig. 6 layout figure: the
 array's views beside the reciprocal renders
-(:func:`shadowcam.report.array_figure.array_mosaic`).
+(:func:`shadowcam.report.array_figure.array_figure`).
 
 Example::
 
@@ -25,8 +25,8 @@ import xarray as xr
 
 from shadowcam._shared.atomic import atomic_path
 from shadowcam.cameras.array import capture_accuracy
-from shadowcam.io.images import write_png
-from shadowcam.report.array_figure import array_mosaic
+from shadowcam.report.array_figure import array_figure
+from shadowcam.report.figures import save_png
 
 
 def add_parser(subparsers, name):
@@ -48,4 +48,4 @@ def run(args):
     with atomic_path(args.out_json) as tmp:
         tmp.write_text(json.dumps(report, indent=2, allow_nan=True))
     with atomic_path(args.out_png) as tmp:
-        write_png(tmp, array_mosaic(array["view"].values, truth["reciprocal"].values))
+        save_png(array_figure(array["view"].values, truth["reciprocal"].values), tmp)

@@ -1,13 +1,15 @@
-"""``shadowcam light-accuracy``: score per-light shadow times against the renderer and draw them.
+"""``shadowcam light-accuracy``: score per-light shadow times against the ground truth and draw them.
 
-Writes ``accuracy.json`` (per light and sweep: p95 error, RMSE, coverage, contrast,
+Reads the capture's per-light truth (``ground_truth.nc``: ``t_center_<sweep>``,
+``t_first_<sweep>``, ``t_last_<sweep>``, ``reference``) and the views. Writes
+``accuracy.json`` (per light and sweep: p95 error, RMSE, coverage, contrast,
 reason counts; :func:`shadowcam.lab.light_views.light_set_accuracy`) and a figure with
 a row per light: estimated and exact times of each sweep and the light's dual view
 (:func:`shadowcam.report.light_set_figure.light_set_mosaic`).
 
 Example::
 
-    shadowcam light-accuracy --capture results/synthetic_lights/lights/capture.nc \\
+    shadowcam light-accuracy --ground-truth results/synthetic_lights/lights/capture/ground_truth.nc \\
         --views results/synthetic_lights/lights/light_views.nc \\
         --out-json results/synthetic_lights/lights/accuracy.json \\
         --out-png results/synthetic_lights/lights/lights.png
@@ -32,7 +34,8 @@ from shadowcam.report.light_set_figure import light_set_mosaic
 def add_parser(subparsers, name):
     """Register ``light-accuracy`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="score and draw per-light shadow times")
-    parser.add_argument("--capture", required=True, help="capture.nc written by render-lights")
+    parser.add_argument("--ground-truth", required=True,
+                        help="ground_truth.nc of the capture (render-lights writes it beside capture.json)")
     parser.add_argument("--views", required=True, help="light_views.nc written by light-views")
     parser.add_argument("--out-json", required=True, help="results/<ds>/lights/accuracy.json")
     parser.add_argument("--out-png", required=True, help="results/<ds>/lights/lights.png")
@@ -41,10 +44,10 @@ def add_parser(subparsers, name):
 
 def run(args):
     """Write the accuracy JSON and the figure."""
-    with xr.open_dataset(args.capture) as a, xr.open_dataset(args.views) as b:
-        capture, views = a.load(), b.load()
+    with xr.open_dataset(args.ground_truth) as a, xr.open_dataset(args.views) as b:
+        truth, views = a.load(), b.load()
     with atomic_path(args.out_json) as tmp:
-        tmp.write_text(json.dumps(light_set_accuracy(views, capture), indent=2))
-    truths = np.stack([capture[f"t_center_{s}"].values for s in SWEEPS])
+        tmp.write_text(json.dumps(light_set_accuracy(views, truth), indent=2))
+    truths = np.stack([truth[f"t_center_{s}"].values for s in SWEEPS])
     with atomic_path(args.out_png) as tmp:
         write_png(tmp, light_set_mosaic(views["time"].values, truths, views["dual_view"].values))

@@ -167,9 +167,13 @@ class CapturePlan:
         ``images``, the frames and crossing images the array reads (rendered: at most,
         both experiments taken as long as the wider family's).
     light_set : mapping or None
-        ``lights`` (the ``synthetic.lights`` entries) and ``frames`` of a rendered capture
-        lit by several lights, else None; its stages are ``light_views`` only (one shadow
-        camera per light).
+        A capture lit by several lights, else None; its stages are ``light_views`` only (one
+        shadow camera per light). Both: ``kinds`` (point or tube, per light), ``count`` and
+        ``frames`` (the longer sweep's). Rendered: ``lights`` (the ``synthetic.lights``
+        entries). Captured (top-level ``lights``, sweeps u and v, a reference frame):
+        ``light_along_u``, ``light_along_v`` (the described positions, tuples, or None when
+        the lights are numbered in the order of their shadows) and ``ground_truth`` (path or
+        None).
     """
 
     name: str
@@ -551,13 +555,75 @@ def _camera_array_plan(manifest):
                        camera_array=MappingProxyType(array))
 
 
+def _light_positions(block, count, path):
+    """The lights' described positions along the u and v sweeps (None, None when not given)."""
+    along = {name: block.get(f"light_along_{name}") for name in SCENE_SWEEPS}
+    given = [name for name, value in along.items() if value is not None]
+    if len(given) == 1:
+        other = next(name for name in SCENE_SWEEPS if name not in given)
+        raise ValueError(f"manifest {path}: key 'lights.light_along_{given[0]}' is given but "
+                         f"'lights.light_along_{other}' is not; the positions pair each light's shadows "
+                         "of the two sweeps, so give both (one number per light) or neither (light k = "
+                         "the k-th shadow to pass in both sweeps)")
+    for name in given:
+        values = [float(x) for x in along[name]]
+        if len(values) != count:
+            raise ValueError(f"manifest {path}: key 'lights.light_along_{name}' has {len(values)} positions "
+                             f"but 'lights.kinds' declares {count} lights; give one position per light, "
+                             "in the order of 'kinds'")
+        if len(set(values)) != len(values):
+            raise ValueError(f"manifest {path}: key 'lights.light_along_{name}' puts two lights at one "
+                             f"position {values}: their shadows would pass together and cannot be told "
+                             "apart; check the positions (lights level along a sweep need a sweep across)")
+        along[name] = tuple(values)
+    return along["u"], along["v"]
+
+
 def _light_set_plan(manifest):
-    synthetic = manifest["synthetic"]
-    if manifest["kind"] != "lab" or "camera" in synthetic:
-        raise ValueError(f"manifest {manifest['manifest_path']}: key 'synthetic.lights' needs kind: lab "
-                         "and the standard u, v sweeps (no synthetic.camera block)")
-    lights = {"lights": tuple(synthetic["lights"]), "frames": int(synthetic["frames"])}
-    return _rendered_lab_plan(manifest, "light_views", light_set=lights)
+    path = manifest["manifest_path"]
+    rendered = "lights" in manifest.get("synthetic", {})
+    key = "synthetic.lights" if rendered else "lights"
+    if manifest["kind"] != "lab" or (rendered and "camera" in manifest["synthetic"]):
+        raise ValueError(f"manifest {path}: key '{key}' needs kind: lab and the standard u, v sweeps "
+                         "(no synthetic.camera block)")
+    if rendered:
+        synthetic = manifest["synthetic"]
+        entries = tuple(synthetic["lights"])
+        lights = {"lights": entries, "kinds": tuple(e["kind"] for e in entries), "count": len(entries),
+                  "frames": int(synthetic["frames"])}
+        return _rendered_lab_plan(manifest, "light_views", light_set=lights)
+    kinds = tuple(manifest["lights"]["kinds"])
+    if len(kinds) < 2:
+        said = "no light" if not kinds else "one light"
+        raise ValueError(f"manifest {path}: key 'lights.kinds' declares {said}; the several-lights stage "
+                         "needs two lights or more. A capture under one light is the standard lab capture: "
+                         "remove the 'lights' block and its u, v sweeps run shadow_time, dual_coords and "
+                         "dual_view")
+    missing = [name for name in SCENE_SWEEPS if name not in manifest["sweeps"]]
+    if missing:
+        raise ValueError(f"manifest {path}: key 'sweeps' has no sweep {missing[0]!r}; a several-lights capture "
+                         "needs the u and v sweeps (each {files: <glob>}) to give each light both dual "
+                         "coordinates")
+    if not manifest["reference_paths"]:
+        raise ValueError(f"manifest {path}: key 'reference' is missing; the several-lights stage colours each "
+                         "light's dual view from the unshadowed frame: add reference: <file> (all lights on, "
+                         "no wire)")
+    along_u, along_v = _light_positions(manifest["lights"], len(kinds), path)
+    shape = check_capture_frames(manifest)
+    sweeps = {name: SweepPlan(name=name, files=tuple(manifest["sweeps"][name]["paths"]),
+                              n_frames=len(manifest["sweeps"][name]["paths"]),
+                              times_s=tuple(float(t) for t in manifest["sweeps"][name]["times_s"]), axis=name)
+              for name in SCENE_SWEEPS}
+    truth = manifest.get("ground_truth")
+    lights = {"kinds": kinds, "count": len(kinds), "light_along_u": along_u, "light_along_v": along_v,
+              "frames": max(s.n_frames for s in sweeps.values()),
+              "ground_truth": None if truth is None else str(Path(manifest["root"]) / truth["file"])}
+    return CapturePlan(name=manifest["name"], manifest_path=path, kind="lab", rendered=False,
+                       sweeps=MappingProxyType(sweeps), frame_shape=shape,
+                       timing=MappingProxyType(dict(manifest.get("timing") or {})),
+                       reference=tuple(manifest["reference_paths"]), has_reference=True,
+                       has_ground_truth=truth is not None, stages=("light_views",),
+                       light_set=MappingProxyType(lights))
 
 
 def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
@@ -593,14 +659,17 @@ def capture_plan(manifest_path, *, dual_model="auto", edge_margin=None):
         differ in size (:func:`shadowcam.io.frame_files.check_capture_frames`); a captured
         camera array without sweep ``horizontal`` or ``vertical``, with crossing images
         missing or other than ``rows x cols`` of them, or with crossing images of another
-        format or size than the frames (``rows``/``cols`` < 1 fail the schema).
+        format or size than the frames (``rows``/``cols`` < 1 fail the schema); a captured
+        several-lights capture (top-level ``lights``) with fewer than two lights, without
+        sweep u or v or a reference frame, or with ``light_along_u``/``_v`` given for one
+        sweep only, not one per light, or two lights at one position.
     """
     manifest = load_manifest(manifest_path)
     if manifest["kind"] == "lightfield":
         return _lightfield_plan(manifest)
     if "camera_array" in manifest or "camera_array" in manifest.get("synthetic", {}):
         return _camera_array_plan(manifest)
-    if "lights" in manifest.get("synthetic", {}):
+    if "lights" in manifest or "lights" in manifest.get("synthetic", {}):
         return _light_set_plan(manifest)
     path = manifest["manifest_path"]
     rendered = "synthetic" in manifest

@@ -13,8 +13,11 @@ Offers
 ------
 light_positions : the lights' positions along a sweep from the gaps between their shadows.
 check_light_order : those positions against the capture's ``light_along_<sweep>``.
-light_set_views : a several-lights capture -> per-light shadow times, reasons, contrast,
-    confidence and dual views.
+sweep_light_times : one sweep's frames -> its minima assigned to the lights, their positions.
+light_views_dataset : per-light shadow times of both sweeps -> the dataset with the dual views.
+light_set_views : a several-lights capture in memory -> per-light shadow times, reasons,
+    contrast, confidence and dual views.
+view_attrs : the options of the views as the dataset's attrs.
 light_set_errors : per-light, per-sweep absolute time errors on the scored pixels.
 light_set_accuracy : per-light, per-sweep error and coverage against the renderer.
 """
@@ -24,6 +27,7 @@ from dataclasses import fields, replace
 import numpy as np
 import xarray as xr
 
+from shadowcam._shared.validation import check_array, check_positive
 from shadowcam.cameras.dual_view import resample_dual_view
 from shadowcam.lab.light_assignment import LIGHT_REASONS, OK, assign_minima
 from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS
@@ -154,15 +158,117 @@ def _edge_fit_per_light(minima, assigned):
     return out
 
 
+def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=4, method="edge_fit", radius=2,
+                      tolerance=2.0, check_order=True):
+    """One sweep's minima assigned to the lights, with the lights' positions along it.
+
+    Parameters
+    ----------
+    frames : (T, H, W, C) array_like
+        The sweep's frames (any linear scale: radiance, or decoded files with white 1).
+    n_lights : int
+        Lights (>= 1).
+    sweep : str
+        ``"u"`` or ``"v"`` (for messages).
+    light_along : (L,) array_like, optional
+        Each light's described position along the sweep's wire motion, which orders its
+        shadows (a light further along needs the wire further along to shadow a point, so
+        later). None: light k is the k-th shadow to pass (nothing to check).
+    half_window, method, radius, tolerance, check_order
+        See :func:`light_set_views`.
+
+    Returns
+    -------
+    times : dict of str to (L, H, W) ndarray
+        ``time``, ``contrast``, ``confidence``, ``time_std``, ``reason``, ``minimum``
+        (:func:`~shadowcam.lab.light_assignment.assign_minima`, re-timed by ``edge_fit``)
+        with light k at index k.
+    position : (L,) float64 ndarray
+        Each light's position along the sweep measured from its shadows (frames from the
+        first shadow's, :func:`light_positions`), light k at index k.
+
+    Raises
+    ------
+    ValueError
+        Naming the parameter, or ``light_along_<sweep>`` when the measured positions
+        disagree with it (:func:`check_light_order`).
+    """
+    frames = check_array(frames, "frames", ndim=4)
+    n_lights = int(check_positive(n_lights, "n_lights"))
+    if light_along is not None:
+        light_along = check_array(light_along, f"light_along_{sweep}", ndim=1, shape=(n_lights,))
+    minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
+                         method="dip_centroid" if method == "edge_fit" else method)
+    in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
+    if method == "edge_fit":
+        in_order = _edge_fit_per_light(minima, in_order)
+    position, spread = light_positions(in_order["time"])
+    seen = in_order.pop("seen")
+    if light_along is None:
+        return in_order, position
+    if check_order:
+        check_light_order(position, spread, light_along, sweep=sweep, tolerance=tolerance, seen=seen)
+    # the k-th shadow along the sweep is the light k-th along the wire's motion
+    back = np.argsort(np.argsort(light_along, kind="stable"))
+    return {key: value[back] for key, value in in_order.items()}, position[back]
+
+
+def light_views_dataset(per_sweep, positions, reference, *, shape, lights, channels, attrs):
+    """Per-light dual views from each light's u and v shadow times, as one dataset.
+
+    Parameters
+    ----------
+    per_sweep : mapping of str to dict
+        ``u`` and ``v`` -> :func:`sweep_light_times`'s times.
+    positions : mapping of str to (L,) ndarray
+        ``u`` and ``v`` -> its positions.
+    reference : (H, W, C) ndarray
+        The unshadowed image the views are coloured from.
+    shape : (2,) tuple of int
+        ``(frames of v, frames of u)``: the dual grid.
+    lights, channels : sequence
+        Coordinates ``light`` and ``channel``.
+    attrs : mapping
+        The options, stored as attrs.
+
+    Returns
+    -------
+    xarray.Dataset
+        As :func:`light_set_views`.
+    """
+    n_lights = len(lights)
+    views = np.full((n_lights, *shape, reference.shape[2]), np.nan, np.float32)
+    coverage = np.zeros((n_lights, *shape), bool)
+    for k in range(n_lights):
+        views[k], coverage[k] = resample_dual_view(reference, per_sweep["u"]["time"][k],
+                                                   per_sweep["v"]["time"][k], shape=shape)
+    dims = ("sweep", "light", "y", "x")
+
+    def stacked(key, dtype):
+        return (dims, np.stack([per_sweep[s][key] for s in SWEEPS]).astype(dtype))
+
+    return xr.Dataset(
+        {"time": stacked("time", np.float32), "contrast": stacked("contrast", np.float32),
+         "confidence": stacked("confidence", np.float32), "time_std": stacked("time_std", np.float32),
+         "reason": stacked("reason", np.int8),
+         "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage),
+         "position": (("sweep", "light"), np.stack([positions[s] for s in SWEEPS]))},
+        coords={"sweep": list(SWEEPS), "light": np.asarray(lights), "channel": np.asarray(channels)},
+        attrs={"reasons": str(LIGHT_REASONS), **attrs})
+
+
 def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tolerance=2.0, check_order=True):
-    """Per-light shadow times and dual views.
+    """Per-light shadow times and dual views of a capture held in memory.
 
     Parameters
     ----------
     capture : xarray.Dataset
         ``frames_u``, ``frames_v`` (t, y, x, channel), ``reference`` (y, x, channel), a
-        ``light`` coordinate and ``light_along_u``, ``light_along_v`` (light,): each
-        light's position along the sweep's wire motion, which orders its shadows (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`).
+        ``light`` coordinate and optionally ``light_along_u``, ``light_along_v`` (light,):
+        each light's position along the sweep's wire motion, which orders its shadows
+        (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`);
+        without them light k is the k-th shadow to pass in both sweeps. A capture's
+        files: :func:`shadowcam.lab.light_files.light_set_views_of_plan`.
     half_window : int
         Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
         across the wire spreads its shadow over its projection).
@@ -192,50 +298,28 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         When the measured positions disagree with ``light_along_<sweep>``
         (:func:`check_light_order`).
     """
-    missing = {"frames_u", "frames_v", "reference", "light_along_u", "light_along_v"} - set(capture)
+    missing = {"frames_u", "frames_v", "reference"} - set(capture)
     if missing or "light" not in capture.coords:
         raise ValueError(f"capture: not a several-lights capture (missing {sorted(missing) or 'light'}); "
                          "render it with the render-lights step")
     n_lights = capture.sizes["light"]
     per_sweep, positions = {}, {}
     for name in SWEEPS:
-        frames = capture[f"frames_{name}"].values
-        minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
-                             method="dip_centroid" if method == "edge_fit" else method)
-        in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
-        if method == "edge_fit":
-            in_order = _edge_fit_per_light(minima, in_order)
-        positions[name], spread = light_positions(in_order["time"])
-        seen = in_order.pop("seen")
-        if check_order:
-            check_light_order(positions[name], spread, capture[f"light_along_{name}"].values, sweep=name,
-                              tolerance=tolerance, seen=seen)
-        # the k-th shadow along the sweep is the light k-th along the wire's motion
-        order = np.argsort(capture[f"light_along_{name}"].values, kind="stable")
-        per_sweep[name] = {key: value[np.argsort(order)] for key, value in in_order.items()}
-        positions[name] = positions[name][np.argsort(order)]
-    reference = capture["reference"].values
-    shape = (capture.sizes["t_v"], capture.sizes["t_u"])
-    views = np.full((n_lights, *shape, reference.shape[2]), np.nan, np.float32)
-    coverage = np.zeros((n_lights, *shape), bool)
-    for k in range(n_lights):
-        views[k], coverage[k] = resample_dual_view(reference, per_sweep["u"]["time"][k],
-                                                   per_sweep["v"]["time"][k], shape=shape)
-    dims = ("sweep", "light", "y", "x")
+        along = capture[f"light_along_{name}"].values if f"light_along_{name}" in capture else None
+        per_sweep[name], positions[name] = sweep_light_times(
+            capture[f"frames_{name}"].values, n_lights, sweep=name, light_along=along, half_window=half_window,
+            method=method, radius=radius, tolerance=tolerance, check_order=check_order)
+    return light_views_dataset(
+        per_sweep, positions, capture["reference"].values, shape=(capture.sizes["t_v"], capture.sizes["t_u"]),
+        lights=capture["light"].values, channels=capture["channel"].values,
+        attrs=view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
+                         check_order=check_order and "light_along_u" in capture))
 
-    def stacked(key, dtype):
-        return (dims, np.stack([per_sweep[s][key] for s in SWEEPS]).astype(dtype))
 
-    return xr.Dataset(
-        {"time": stacked("time", np.float32), "contrast": stacked("contrast", np.float32),
-         "confidence": stacked("confidence", np.float32), "time_std": stacked("time_std", np.float32),
-         "reason": stacked("reason", np.int8),
-         "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage),
-         "position": (("sweep", "light"), np.stack([positions[s] for s in SWEEPS]))},
-        coords={"sweep": list(SWEEPS), "light": capture["light"].values, "channel": capture["channel"].values},
-        attrs={"reasons": str(LIGHT_REASONS), "half_window": int(half_window), "method": method,
-               "radius": int(radius),
-               "tolerance": float(tolerance), "order_checked": int(bool(check_order))})
+def view_attrs(*, half_window, method, radius, tolerance, check_order):
+    """The options of :func:`light_set_views` as the dataset's attrs."""
+    return {"half_window": int(half_window), "method": method, "radius": int(radius),
+            "tolerance": float(tolerance), "order_checked": int(bool(check_order))}
 
 
 def light_set_errors(views, capture, *, min_level=0.2):
@@ -250,8 +334,8 @@ def light_set_errors(views, capture, *, min_level=0.2):
     views : xarray.Dataset
         From :func:`light_set_views`.
     capture : xarray.Dataset
-        With ``t_center_<sweep>``, ``t_first_<sweep>``, ``t_last_<sweep>`` (light, y, x)
-        and ``reference``.
+        The truth: ``t_center_<sweep>``, ``t_first_<sweep>``, ``t_last_<sweep>`` (light, y,
+        x) and ``reference`` (y, x, channel), as the capture's ``ground_truth.nc`` holds them.
     min_level : float
 
     Returns
@@ -264,7 +348,7 @@ def light_set_errors(views, capture, *, min_level=0.2):
     lit = level > min_level * np.median(level)
     out = {}
     for s, name in enumerate(SWEEPS):
-        n = capture.sizes[f"t_{name}"]
+        n = views.sizes[name]  # the sweep's frames: the dual grid's axis
         for k in range(capture.sizes["light"]):
             truth = capture[f"t_center_{name}"].values[k]
             scored = (lit & np.isfinite(truth) & (capture[f"t_first_{name}"].values[k] > 2)

@@ -33,8 +33,10 @@ DEFAULTS = {
 #: fraction of the frame interval; absent = an instant), ``wire_radius_frames`` (the wire's
 #: radius in mask steps; absent = one), ``area_light`` (shape, size, samples of an area
 #: light; absent = the preset's disc), ``camera_array`` (the static wire grid of a virtual
-#: camera array, written by :func:`shadowcam.synthetic.lab.array_capture.write_array_capture`)
-OPTIONAL_KEYS = ("camera", "shutter", "wire_radius_frames", "area_light", "camera_array")
+#: camera array, written by :func:`shadowcam.synthetic.lab.array_capture.write_array_capture`),
+#: ``lights`` (several lights under the sweeps, written by
+#: :func:`shadowcam.synthetic.lab.light_set_capture.write_light_set_capture`)
+OPTIONAL_KEYS = ("camera", "shutter", "wire_radius_frames", "area_light", "camera_array", "lights")
 #: optional keys that describe the lab scene (``scenes.DESCRIPTION_KEYS``)
 SCENE_KEYS = ("wire_radius_frames", "area_light")
 #: scenes rendered as outdoor time-lapses

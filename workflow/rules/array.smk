@@ -28,7 +28,7 @@ rule array_render:
 
 rule camera_array:
     input:
-        array_manifest,
+        capture_manifest("array"),
     output:
         "results/{ds}/array/camera_array.nc",
     log:
@@ -46,7 +46,7 @@ rule camera_array:
 
 rule array_accuracy:
     input:
-        truth=array_ground_truth,
+        truth=capture_ground_truth("array", "camera_array"),
         array="results/{ds}/array/camera_array.nc",
     output:
         json="results/{ds}/array/accuracy.json",

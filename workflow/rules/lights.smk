@@ -1,14 +1,17 @@
-# Stage: several lights under the wire sweeps (datasets whose manifest has
-# synthetic.lights): render the u and v sweeps, find each pixel's minima and assign them
-# to the lights (one shadow-time map and one dual view per light), then score them against
-# the renderer's per-light times (accuracy.json) and draw them beside it (lights.png).
+# Stage: several lights under the wire sweeps (datasets whose manifest has a top-level
+# lights block, captured, or synthetic.lights, rendered): a rendered capture is written as
+# a capture folder (frame files of the u and v sweeps, reference, capture.json,
+# ground_truth.nc); each sweep's minima are assigned to the lights from the capture's
+# files (one shadow-time map and one dual view per light), then scored against the
+# per-light ground truth (accuracy.json) and drawn beside it (lights.png).
 
 
 rule lights_render:
     input:
         "data_manifest/{ds}.yaml",
     output:
-        "results/{ds}/lights/capture.nc",
+        capture="results/{ds}/lights/capture/capture.json",
+        truth="results/{ds}/lights/capture/ground_truth.nc",
     log:
         "logs/{ds}/lights_render.log",
     benchmark:
@@ -19,12 +22,13 @@ rule lights_render:
         mem_mb=get_light_set_mem_mb,
         runtime=30,
     shell:
-        "shadowcam render-lights --manifest {input} --out {output} > {log} 2>&1"
+        "shadowcam render-lights --manifest {input} --out results/{wildcards.ds}/lights/capture"
+        " > {log} 2>&1"
 
 
 rule light_views:
     input:
-        "results/{ds}/lights/capture.nc",
+        capture_manifest("lights"),
     output:
         "results/{ds}/lights/light_views.nc",
     log:
@@ -37,12 +41,12 @@ rule light_views:
         mem_mb=get_light_set_mem_mb,
         runtime=30,
     shell:
-        "shadowcam light-views --capture {input} --out {output} > {log} 2>&1"
+        "shadowcam light-views --manifest {input} --out {output} > {log} 2>&1"
 
 
 rule light_accuracy:
     input:
-        capture="results/{ds}/lights/capture.nc",
+        truth=capture_ground_truth("lights", "light_set"),
         views="results/{ds}/lights/light_views.nc",
     output:
         json="results/{ds}/lights/accuracy.json",
@@ -61,15 +65,16 @@ rule light_accuracy:
         mem_mb=get_light_set_mem_mb,
         runtime=15,
     shell:
-        "shadowcam light-accuracy --capture {input.capture} --views {input.views}"
+        "shadowcam light-accuracy --ground-truth {input.truth} --views {input.views}"
         " --out-json {output.json} --out-png {output.png} > {log} 2>&1"
 
 
-# On request (not part of `all`: it reruns every method): speed against error of the
-# timing methods of several minima, results/<ds>/lights/methods/speed_vs_error.png.
+# On request (not part of `all`: it reruns every method; needs ground truth): speed against
+# error of the timing methods of several minima, results/<ds>/lights/methods/speed_vs_error.png.
 rule light_methods:
     input:
-        "results/{ds}/lights/capture.nc",
+        manifest=capture_manifest("lights"),
+        truth=capture_ground_truth("lights", "light_set"),
     output:
         dataset="results/{ds}/lights/methods/methods.nc",
         csv=report(
@@ -94,5 +99,5 @@ rule light_methods:
         mem_mb=get_light_set_mem_mb,
         runtime=30,
     shell:
-        "shadowcam light-methods --capture {input} --dataset {wildcards.ds} --out {output.dataset}"
-        " --csv {output.csv} --figure {output.figure} > {log} 2>&1"
+        "shadowcam light-methods --manifest {input.manifest} --dataset {wildcards.ds}"
+        " --out {output.dataset} --csv {output.csv} --figure {output.figure} > {log} 2>&1"

@@ -17,10 +17,10 @@ def dataset_targets(ds):
             names += ("accuracy.json", "views.png")
         return [f"results/{ds}/array/{name}" for name in names]
     if plan.light_set is not None:  # workflow/rules/lights.smk
-        return [
-            f"results/{ds}/lights/{name}"
-            for name in ("light_views.nc", "accuracy.json", "lights.png")
-        ]
+        names = ("light_views.nc",)
+        if plan.has_ground_truth:
+            names += ("accuracy.json", "lights.png")
+        return [f"results/{ds}/lights/{name}" for name in names]
     if plan.is_outdoor:
         targets = [
             f"results/{ds}/outdoor/arrival.nc",

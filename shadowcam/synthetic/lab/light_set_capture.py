@@ -5,7 +5,10 @@ Offers
 make_lights : the manifest's ``lights`` entries -> PointLight / TubeLight objects.
 render_light_set_capture : ``synthetic`` block (with ``lights``) -> frames of the u and v
     sweeps, the reference image and the per-light ground truth.
+write_light_set_capture : render and write the capture directory of a manifest's options.
 """
+
+import datetime
 
 import numpy as np
 import xarray as xr
@@ -123,3 +126,96 @@ def _sensor_exposure(synthetic, reference):
                            noise=True, mosaic=False)
         return raw_to_linear(raw, sensor=sensor) * to_radiance
     return sense
+
+
+def write_light_set_capture(options, out_dir):
+    """Render a several-lights capture and write it as a capture directory, like a camera would.
+
+    The layout is a standard lab capture's (docs/contracts.md): ``frames_u/000000.<ext>
+    ...``, ``frames_v/...``, ``reference.<ext>`` (all lights on, no wire), plus
+    ``ground_truth.nc`` and ``capture.json``, whose top-level ``lights`` block (``kinds``,
+    ``light_along_u``, ``light_along_v``) is the one a user's manifest gives.
+
+    Parameters
+    ----------
+    options : dict
+        :func:`shadowcam.synthetic.capture_options.capture_options` of a manifest whose
+        ``synthetic`` block has ``lights``: ``format`` (dng: the raw RGGB mosaic; tiff:
+        linear 16-bit RGB), ``noise`` (shot and read noise), ``bit_depth``, ``exposure``
+        (the reference's 99.5th percentile exposed to that fraction of the range), ``seed``
+        (noise seeds ``[seed, sweep_index, frame]``, sweep_index u=0 v=1 reference=9, as
+        the lab capture writer's).
+    out_dir : str or Path
+
+    Returns
+    -------
+    Path
+        `out_dir`, holding the frame files, ``ground_truth.nc`` (``reference`` radiance
+        (y, x, channel), per sweep s ``t_center_s``, ``t_first_s``, ``t_last_s`` (light, y,
+        x), ``share``, ``light_along_s``: :func:`render_light_set_capture` without the
+        frames) and ``capture.json``.
+
+    Raises
+    ------
+    ValueError
+        When the options have no ``lights``.
+    """
+    import json
+    from pathlib import Path
+
+    from shadowcam import __version__
+    from shadowcam._shared.atomic import atomic_directory
+    from shadowcam._shared.progress import Progress
+    from shadowcam.io.provenance import file_sha256
+    from shadowcam.synthetic.capture_writer import CAPTURE_START, write_frame, write_ground_truth
+
+    if not options.get("lights"):
+        raise ValueError(f"options['lights']: capture {options.get('name')!r} has no lights block; add "
+                         "lights: [{kind: point}, {kind: point, offset: [...]}] to the manifest's synthetic block")
+    out_dir = Path(out_dir)
+    capture = render_light_set_capture({**options, "noise": False}, light=options["light"])
+    sensor = SensorModel(bit_depth=options["bit_depth"])
+    scale = electrons_per_unit_radiance(capture["reference"].values, sensor=sensor,
+                                        target_fraction=options["exposure"])
+    ext, seed = options["format"], int(options["seed"])
+    images = {"reference": [("reference", capture["reference"].values)]}
+    for name in ("u", "v"):
+        images[name] = [(f"frames_{name}/{k:06d}", frame) for k, frame in enumerate(capture[f"frames_{name}"].values)]
+    progress = Progress(sum(len(group) for group in images.values()), "write several-lights frames", unit="images")
+    written = []
+    with atomic_directory(out_dir) as tmp:
+        for name, group in images.items():
+            for k, (stem, radiance) in enumerate(group):
+                (tmp / stem).parent.mkdir(exist_ok=True)
+                write_frame(tmp / f"{stem}.{ext}", radiance, frame_format=ext, noise=bool(options["noise"]),
+                            sensor=sensor, scale=scale, seed=[seed, SWEEP_INDEX[name], k],
+                            when=CAPTURE_START + datetime.timedelta(seconds=k))
+                written.append(f"{stem}.{ext}")
+                progress.update(len(written))
+        checksums = {rel: file_sha256(tmp / rel) for rel in written}
+        truth = capture.drop_vars(["frames_u", "frames_v"])
+        kinds = [entry["kind"] for entry in options["lights"]]
+        write_ground_truth(tmp, truth, sensor=sensor, scale=scale, config=dict(options),
+                           checksums=checksums, frame_format=ext,
+                           noise_seed="numpy.random.default_rng([seed, sweep_index, frame]); "
+                                      "sweep_index u=0 v=1 reference=9")
+        description = {
+            "name": options["name"], "kind": "lab", "description": options["description"], "light": "point",
+            "root": ".",
+            "sweeps": {name: {"files": f"frames_{name}/*.{ext}", "axis": name} for name in ("u", "v")},
+            "reference": f"reference.{ext}",
+            "timing": {"source": "rate", "rate_hz": 1.0},
+            "checksums": checksums,
+            "lights": {"kinds": kinds,
+                       **{f"light_along_{name}": [float(x) for x in capture[f"light_along_{name}"].values]
+                          for name in ("u", "v")}},
+            "ground_truth": {"format": "shadowcam_lights_nc", "file": "ground_truth.nc",
+                             "noise": "raw12" if options["noise"] else "noise_free"},
+            "provenance": (f"rendered by shadowcam {__version__} 'shadowcam render-lights' (scene "
+                           f"{options['scene']}, seed {seed}, {options['height']}x{options['width']}, "
+                           f"{len(kinds)} lights {kinds}, {ext} {options['bit_depth']}-bit, noise "
+                           f"{options['noise']}); deterministic"),
+            "licence": "CC0-1.0",
+        }
+        (tmp / "capture.json").write_text(json.dumps(description, indent=2) + "\n")
+    return out_dir
