@@ -44,10 +44,10 @@ rows), and the pixel's own shadow plateau ``S`` times ``R`` is its lit level: th
 ``S (1 + R) / 2`` times it (state ``neighbours_lit``), with the neighbours' spread of ``R``
 carried into its standard error (``S spread / 2`` over the ramp's rate). A pixel with fewer than
 :data:`MIN_RATIO_NEIGHBOURS` such neighbours or no shadow plateau of its own (``no_lit_level``), whose
-neighbours' ratios
-spread too much for a time within ``max_sigma`` (``lit_ratio_spread``: not one surface, or not
-one light), or whose record starts below that half level (``before_record``: the arrival came
-before the first frame) gets no time.
+neighbours' ratios spread too much for a time within ``max_sigma`` (``lit_ratio_spread``: not
+one surface, or not one light), whose record starts below that half level (``before_record``:
+the arrival came before the first frame), or whose crossing of it is unresolved or uncertain
+beyond ``max_sigma`` with both levels known (``ambiguous``) gets no time.
 
 Every step but the neighbours' duration and shadow level is per pixel; those read
 ``radius`` columns each side, within the halo of a column strip
@@ -250,7 +250,9 @@ def _neighbours_lit(buffer, time_s, centre, sigma, state, duration, begun, *, ra
     `shadow` ``(H, W)`` the shadow plateau ``S`` of the descents under way at their start (NaN
     elsewhere). The arrival came before the record when the first sample is below the half level
     by more than twice its uncertainty; a descent that never crosses it otherwise has a ratio
-    that does not hold (``lit_ratio_spread``).
+    that does not hold (``lit_ratio_spread``). One that crosses it, but between two samples that
+    do not resolve the ramp or with a standard error over `limit` not due to the ratio's spread
+    alone, is ``ambiguous`` (its levels are known, its time is not).
     """
     rows, cols = np.nonzero(np.isfinite(shadow))
     if rows.size == 0:
@@ -283,8 +285,9 @@ def _neighbours_lit(buffer, time_s, centre, sigma, state, duration, begun, *, ra
             before = ~crossed & (first < half - 2.0 * level_error)
             ok = crossed & resolved & (total <= limit)
             spread_out = (crossed & resolved & (from_ratio > limit)) | (~crossed & ~before)
+        # with its levels, a crossing that is unresolved or too uncertain is an ambiguous ramp
         untimed = begun[r, c] & ~ok
-        state[r[untimed], c[untimed]] = STATE_CODE["no_lit_level"]
+        state[r[untimed], c[untimed]] = STATE_CODE["ambiguous"]
         centre[r[ok], c[ok]], sigma[r[ok], c[ok]] = crossing[ok], total[ok]
         state[r[ok], c[ok]] = STATE_CODE["neighbours_lit"]
         state[r[spread_out], c[spread_out]] = STATE_CODE["lit_ratio_spread"]

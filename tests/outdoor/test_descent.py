@@ -260,3 +260,22 @@ def test_a_lit_to_shadow_ratio_that_varies_over_the_neighbours_gives_no_time():
     assert np.isin(out["ramp_state"][under_way], [STATE_CODE["lit_ratio_spread"], STATE_CODE["no_lit_level"]]).all()
     assert (out["ramp_state"][under_way] == STATE_CODE["lit_ratio_spread"]).mean() >= 0.85
     assert np.isnan(out["ramp_centre_s"][under_way]).all()
+
+
+def test_a_penumbra_under_way_with_both_levels_but_an_uncertain_crossing_is_ambiguous():
+    buffer, crossing, times, centre, _, _ = _cliff()
+    wide = fit_descents(buffer, crossing, times, cut_rows=CLIFF_DURATION, shadow_ratio=0.2)
+    # the neighbours' lit level crossings' standard errors are 0.13-0.23 interval: a bound inside that range
+    tight = fit_descents(buffer, crossing, times, cut_rows=CLIFF_DURATION, shadow_ratio=0.2, max_sigma=0.15)
+    # whether a pixel has a lit level does not depend on the bound
+    no_level = STATE_CODE["no_lit_level"]
+    np.testing.assert_array_equal(wide["ramp_state"] == no_level, tight["ramp_state"] == no_level)
+    lost = (wide["ramp_state"] == STATE_CODE["neighbours_lit"]) & (tight["ramp_state"] != STATE_CODE["neighbours_lit"])
+    assert lost.sum() >= 10
+    # its levels are known: the crossing is too uncertain (ambiguous), or the neighbours' spread alone is
+    assert np.isin(tight["ramp_state"][lost], [STATE_CODE["ambiguous"], STATE_CODE["lit_ratio_spread"]]).all()
+    ambiguous = lost & (tight["ramp_state"] == STATE_CODE["ambiguous"])
+    assert ambiguous.sum() >= 10
+    reason = np.full(centre.shape, REASON_CODE["coverage_crossing"], np.uint8)
+    arrival, reason = apply_ramps(crossing, reason, tight["ramp_centre_s"], tight["ramp_state"])
+    assert np.isnan(arrival[ambiguous]).all() and (reason[ambiguous] == REASON_CODE["ambiguous_ramp"]).all()
