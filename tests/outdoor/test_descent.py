@@ -279,3 +279,19 @@ def test_a_penumbra_under_way_with_both_levels_but_an_uncertain_crossing_is_ambi
     reason = np.full(centre.shape, REASON_CODE["coverage_crossing"], np.uint8)
     arrival, reason = apply_ramps(crossing, reason, tight["ramp_centre_s"], tight["ramp_state"])
     assert np.isnan(arrival[ambiguous]).all() and (reason[ambiguous] == REASON_CODE["ambiguous_ramp"]).all()
+
+
+def test_a_penumbra_begun_in_the_first_frames_is_timed_within_the_noise():
+    # begun 1-5 frames after frame 0: too few lit samples for the plateau test, so taken for under
+    # way; its shadow plateau and its neighbours' ratio still give its lit level
+    buffer, crossing, times, centre, albedo, shadow = _cliff()
+    out = fit_descents(buffer, crossing, times, cut_rows=CLIFF_DURATION, shadow_ratio=0.2)
+    true_centre = centre / INTERVAL
+    band = (true_centre >= CLIFF_DURATION / 2 + 1) & (true_centre <= CLIFF_DURATION / 2 + 5)
+    state = out["ramp_state"]
+    # timed, or (the shadow plateau test at 2 standard errors turns some flat levels down) no time
+    assert np.isin(state[band], [STATE_CODE["neighbours_lit"], STATE_CODE["no_lit_level"]]).all()
+    timed = band & (state == STATE_CODE["neighbours_lit"])
+    assert timed.sum() >= 0.8 * band.sum()
+    error = (out["ramp_centre_s"] - centre) / INTERVAL
+    assert np.all(np.abs(error[timed]) <= 4 * _cliff_sigma(albedo, shadow)[timed])
