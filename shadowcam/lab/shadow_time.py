@@ -27,6 +27,7 @@ shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials
 """
 
 import logging
+from collections.abc import Sequence
 
 import numba as nb
 import numpy as np
@@ -280,7 +281,8 @@ def _site_times(summary, site, *, noise_floor=1e-4):
     sites, independent noise) gives a second centroid, at the centre of the demosaic's
     symmetric taps. The two are combined by inverse variance where the estimated squared
     bias of the neighbours' time, ``(t_n - t_o)**2 - var_o - var_n``, is not positive
-    (their difference is noise); otherwise the own time stands alone.
+    (their difference is noise); otherwise the own time stands alone. Both noises are
+    bounded below by `noise_floor` (signal units), as in :func:`classify_dips`.
 
     Returns
     -------
@@ -291,17 +293,19 @@ def _site_times(summary, site, *, noise_floor=1e-4):
     """
     keep = np.isfinite(summary.window)
     own = np.where(keep, site.window, np.nan)
+    own_noise = np.maximum(np.nan_to_num(site.noise, nan=np.inf), noise_floor)
+    rest_noise = np.maximum(np.nan_to_num(site.neighbour_noise, nan=np.inf), noise_floor)
     own_time, own_std = _centroid_kernel(_removed_fraction(own, site.level), summary.window_start,
-                                         site.noise, site.level)
+                                         own_noise, site.level)
     smooth = 0.25 * own[:-2] + 0.5 * own[1:-1] + 0.25 * own[2:]
     with np.errstate(invalid="ignore", divide="ignore"):
         floor = np.nanmin(np.where(np.isfinite(smooth), smooth, np.inf), axis=0)
-        contrast = (site.level - floor) / (np.maximum(site.noise, noise_floor) * _SMOOTHED_NOISE)
+        contrast = (site.level - floor) / (own_noise * _SMOOTHED_NOISE)
     z = detection_threshold(summary.n_frames, false_alarm=_SITE_FALSE_ALARM)
     significant = (contrast > z) & np.isfinite(own_time) & (own_std > 0)
     rest = np.where(keep, summary.window - site.window, np.nan)
     rest_time, rest_std = _centroid_kernel(_removed_fraction(rest, site.neighbour_level), summary.window_start,
-                                           site.neighbour_noise, site.neighbour_level)
+                                           rest_noise, site.neighbour_level)
     with np.errstate(invalid="ignore", divide="ignore"):
         joined = significant & np.isfinite(rest_time) & (rest_std > 0) & (
             (rest_time - own_time) ** 2 <= own_std**2 + rest_std**2)
@@ -860,7 +864,10 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
     Parameters
     ----------
     blocks : iterable of (T, H, W, C) float ndarray
-        Linear frames in time order.
+        Linear frames in time order. A sequence (e.g. a list of blocks) of demosaiced RAW
+        frames is read twice: ``edge_fit`` then times each pixel from its own site where
+        its noise allows (:func:`shadowcam.lab.site_signal.track_site_window`); a one-shot
+        iterable is read once and timed from the channel sum.
     shape : tuple of int
         ``(H, W)``.
     method : str, optional
@@ -881,7 +888,10 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
         As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
     """
     summary, _, _ = track_sweep(blocks, shape, half_window=half_window, progress=progress)
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+    site = None
+    if cfa_pattern and method == "edge_fit" and isinstance(blocks, Sequence):
+        site = track_site_window(blocks, summary, site_colour=cfa_site_colours(shape, cfa_pattern))
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, site=site,
                                 method_params=method_params, classify_params=classify_params)
 
 
