@@ -1039,7 +1039,9 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
     ----------
     stores : mapping of str to xarray.Dataset
         Sweep name -> its frame store (``image (time, row, col, channel)``), streamed one
-        time chunk at a time.
+        time chunk at a time. A store of demosaiced RAW (attr ``cfa_pattern``) is streamed
+        once more for ``edge_fit``: each pixel's own site in its dip window
+        (:func:`shadowcam.lab.site_signal.track_site_window`).
     method : str
         Key of :data:`SHADOW_TIME_METHODS`.
     partials : mapping of str to sequence of path, optional
