@@ -28,6 +28,7 @@ shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials
 
 import logging
 from collections.abc import Sequence
+from dataclasses import replace
 
 import numba as nb
 import numpy as np
@@ -317,7 +318,7 @@ def _site_times(summary, site, *, noise_floor=1e-4):
             np.where(significant, share, 0.0))
 
 
-def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15, footprint_variance=None, site=None):
+def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15, footprint_variance=None):
     """Dip centroid combined with an edge-aware local plane fit of neighbours' times.
 
     See :func:`shadowcam.lab.edge_refine.refine_times`: each pixel's centroid
@@ -330,14 +331,15 @@ def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15, footpri
     `footprint_variance` (px^2 per axis, a camera fact): a dip is timed at the pixel's
     flux centroid (:func:`shadowcam._shared.flux_centroid.flux_centroid_shift` of the lit
     level), which the refinement takes to the pixel centre; None: at the centre.
-    `site` (:class:`shadowcam.lab.site_signal.SiteWindow`, demosaiced RAW): each pixel is
-    timed from its own mosaic site where that dip is significant, joined by its
+    With the summary's `site` (:class:`shadowcam.lab.site_signal.SiteWindow`, demosaiced
+    RAW), each pixel is timed from its own mosaic site where that dip is significant, joined by its
     neighbours' part where the two agree (:func:`_site_times`), else from the channel
     sum; the footprint's second moment is then the site's plus the demosaic taps' share
     in the time (:func:`shadowcam.lab.site_signal.blend_variance`).
     """
     time, entry, exit_, std = time_dip_centroid(summary)
     timed = time
+    site = summary.site
     if site is not None:
         site_time, site_std, share = _site_times(summary, site)
         own = np.isfinite(site_time)
@@ -778,8 +780,6 @@ def _local_width(width, known, *, min_count=8):
 
 def _masked_summary(summary, keep):
     """Copy of `summary` whose window is NaN outside `keep` (so methods ignore them)."""
-    from dataclasses import replace
-
     return replace(summary, window=np.where(keep[None], summary.window, np.nan))
 
 
@@ -923,8 +923,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
         and ``n_frames``.
     """
     lit_image = lit_colour(summary)
-    if site is not None and method == "edge_fit":
-        method_params = {**(method_params or {}), "site": site}
+    if site is not None:
+        summary = replace(summary, site=site)
     classify_params = dict(classify_params or {})
     if cfa_pattern:
         colour = cfa_site_colours(summary.lit_level.shape, cfa_pattern)
