@@ -10,13 +10,16 @@ site sees only its footprint, whose removed-light centroid is the truth when the
 radiance is uniform (a box footprint crossed at a constant speed: a symmetric coverage).
 """
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from shadowcam._shared.flux_centroid import flux_centroid_shift
 from shadowcam.io.cfa import demosaic_bilinear
 from shadowcam.lab.mosaic_signal import mosaic_signal
-from shadowcam.lab.shadow_time import OK, cfa_site_colours, summary_shadow_times, sweep_shadow_times, track_sweep
+from shadowcam.lab.shadow_time import (OK, _site_times, cfa_site_colours, summary_shadow_times, sweep_shadow_times,
+                                       track_sweep)
 from shadowcam.lab.site_signal import blend_variance, track_site_window
 
 SHAPE = (24, 32)
@@ -100,16 +103,14 @@ def test_dim_raw_falls_back_to_the_channel_sum_without_losing_coverage(wire_swee
     old = summary_shadow_times(summary, cfa_pattern="RGGB")
     np.testing.assert_array_equal(new["reason"], old["reason"])  # the same pixels are timed
     assert (new["reason"] == OK).mean() > 0.9
-    from shadowcam.lab.shadow_time import _site_times
-
-    from dataclasses import replace
     masked = replace(summary, window=np.where((old["reason"] == OK)[None], summary.window, np.nan))
     own_time, _, _ = _site_times(masked, site)
     fallen_back = (old["reason"] == OK) & ~np.isfinite(own_time)
-    assert fallen_back.mean() > 0.1  # the fallback is exercised
+    assert fallen_back.mean() > 0.3  # the fallback is exercised (64 % of the pixels here)
     err_new, err_old = _errors(new, truth), _errors(old, truth)
-    # the noise dominates here: the result is no worse than the channel sum's beyond the
-    # p95's sampling spread (~ 2 / sqrt(0.05 n) of it, n ~ 660 pixels: 0.35)
+    # the noise dominates here: no worse than the channel sum's beyond the p95's sampling
+    # error (half-normal errors, n ~ 650: sqrt(0.05 * 0.95 / n) / (2 phi(1.96)) / 1.96 ~ 4 %
+    # of it; 1.1 allows 2.5 of those)
     assert np.percentile(err_new, 95) <= 1.1 * np.percentile(err_old, 95)
     assert np.median(err_new) <= 1.1 * np.median(err_old)
 
