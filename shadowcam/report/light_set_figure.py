@@ -47,7 +47,7 @@ def light_titles(kinds, *, axes=None):
 
 
 def light_set_figure(times, truths, dual_views, *, titles, truth_views=None,
-                     truth_title="from exact times", sweeps=("u", "v"), frames=None, size=None):
+                     truth_title="from exact times", sweeps=("u", "v"), frames=None, shown=None, size=None):
     """Figure of per-light time maps beside their exact times, and each light's dual view.
 
     Parameters
@@ -71,6 +71,9 @@ def light_set_figure(times, truths, dual_views, *, titles, truth_views=None,
         Each sweep's number of frames: its colour scale runs over the sweep, 0 to
         ``frames - 1`` (exact times outside it saturate); default the range of its exact
         times over all lights.
+    shown : (S, L) array_like of bool, optional
+        Whether each sweep shows each light's dip; an estimated panel of a dip not shown
+        is titled "dip not shown" (its pixels are all flagged).
     size : (float, float), optional
         Figure width, height in inches; default :data:`_PANEL_INCHES` per panel.
 
@@ -88,6 +91,9 @@ def light_set_figure(times, truths, dual_views, *, titles, truth_views=None,
         raise ValueError(f"times and truths must be (S, L, H, W) and dual_views (L, V, U, C) with the "
                          f"same L; got {times.shape}, {truths.shape}, {dual_views.shape}")
     n_sweeps, n_lights = times.shape[:2]
+    shown = np.ones((n_sweeps, n_lights), bool) if shown is None else np.asarray(shown, bool)
+    if shown.shape != (n_sweeps, n_lights):
+        raise ValueError(f"shown must be (S, L) = {(n_sweeps, n_lights)}; got {shown.shape}")
     if frames is not None and len(frames) != n_sweeps:
         raise ValueError(f"frames must give one count per sweep ({n_sweeps}); got {list(frames)}")
     if len(sweeps) != n_sweeps or len(titles) != n_lights:
@@ -113,13 +119,14 @@ def light_set_figure(times, truths, dual_views, *, titles, truth_views=None,
         if frames is not None:
             vmin, vmax = 0.0, float(max(int(frames[s]) - 1, 1))
         for k in range(n_lights):
-            for c, (label, image) in enumerate((("estimated", times[s, k]), ("exact", truths[s, k]))):
+            estimated = "estimated" if shown[s, k] else "dip not shown"
+            for c, (label, image) in enumerate(((estimated, times[s, k]), ("exact", truths[s, k]))):
                 axes = figure.add_subplot(grid[k, 4 * s + c])
-                shown = _show_times(axes, image, vmin=vmin, vmax=vmax)
+                drawn = _show_times(axes, image, vmin=vmin, vmax=vmax)
                 _small_panel(axes, None, f"{titles[k]}:\n{sweep} {label}",
                              xlabel=_CAMERA_AXES[0] if k == n_lights - 1 else None,
                              ylabel=_CAMERA_AXES[1] if c == 0 else None)
-        bar = figure.colorbar(shown, cax=figure.add_subplot(grid[:, 4 * s + 2]))
+        bar = figure.colorbar(drawn, cax=figure.add_subplot(grid[:, 4 * s + 2]))
         bar.set_label("shadow time (frame)", fontsize="small")
         bar.ax.set_title(f"{sweep} sweep", fontsize="x-small")
         bar.ax.tick_params(labelsize="x-small")
@@ -171,4 +178,5 @@ def light_set_figure_of(views, truth, *, sweeps=("u", "v")):
     truth_views = np.stack([resample_dual_view(reference, truths[0, k], truths[1, k], shape=shape)[0]
                             for k in range(n_lights)])
     return light_set_figure(views["time"].values, truths, views["dual_view"].values, titles=titles,
-                            truth_views=truth_views, sweeps=sweeps, frames=[views.sizes[s] for s in sweeps])
+                            truth_views=truth_views, sweeps=sweeps, frames=[views.sizes[s] for s in sweeps],
+                            shown=views["shown"].values.astype(bool) if "shown" in views else None)

@@ -58,6 +58,10 @@ def test_rows_per_light_titles_axes_and_one_colour_bar_per_sweep():
     figure = light_set_figure(truths, truths, views, titles=["a", "b", "c"], frames=(20, 30))
     bars = [a for a in figure.axes if a.get_ylabel() == "shadow time (frame)"]
     assert bars[0].get_ylim() == pytest.approx((0, 19)) and bars[1].get_ylim() == pytest.approx((0, 29))
+    # a light whose dip a sweep does not show says so
+    figure = light_set_figure(truths, truths, views, titles=["a", "b", "c"], shown=[[1, 1, 1], [1, 1, 0]])
+    titles = [a.get_title() for a in figure.axes]
+    assert "c:\nv dip not shown" in titles and "c:\nu estimated" in titles and "c:\nv estimated" not in titles
 
 
 def test_flagged_pixels_are_grey_and_times_take_their_colour_bar_colour():
@@ -100,5 +104,7 @@ def test_shapes_and_names_must_match():
         light_set_figure(truths, truths, views, titles=["a", "b", "c"], truth_views=views[:, :2])
     with pytest.raises(ValueError, match="frames"):
         light_set_figure(truths, truths, views, titles=["a", "b", "c"], frames=(10,))
+    with pytest.raises(ValueError, match="shown"):
+        light_set_figure(truths, truths, views, titles=["a", "b", "c"], shown=[[1, 1, 1]])
     with pytest.raises(ValueError, match="axes"):
         light_titles(["point"], axes=["u", "v"])
