@@ -76,9 +76,10 @@ def test_a_shadow_below_the_noise_gives_no_times_and_says_so():
 def test_a_dip_just_above_the_noise_is_timed_within_its_noise():
     # light 1: a sharp 2-frame dip 8 noise deviations deep. Resolved where the observed
     # difference to every far sample beats z = Q^-1(1e-3 / 14) sqrt(2) = 5.8 deviations; the
-    # observed difference is 8 deviations less the deepest of 14 far noise differences
-    # (about 1.7 sqrt(2) = 2.4): just above, so nearly every pixel is timed (at 6.5
-    # deviations, 15 % of them are not: a lit sample 3.5 deviations low could have been it)
+    # observed difference is 8 deviations, plus the noise of the deeper of the box's two
+    # samples (about +0.6), less the lowest of the 14 far samples' noise (about -1.7): about
+    # 1.1 above, one deviation of the difference, so nearly every pixel is timed (at 6.5
+    # deviations 15 % are not: a lit sample 3.5 deviations low could have been the minimum)
     depth = 8 * SIGMA
     minima, a = _assigned([SHARP, (_start(26), 2, depth)], SIGMA, seed=3)
     assert list(a["shown"]) == [True, True]
