@@ -27,9 +27,11 @@ def flux_centroid_shift(irradiance, *, footprint_variance):
         The pixels' lit level (any positive scale; measured, so ``grad`` is taken by central
         differences of the pixel grid, one-sided at the border). Not finite or <= 0: no shift,
         and 0 in its neighbours' differences.
-    footprint_variance : float, keyword-only
+    footprint_variance : float or (H, W) array_like, keyword-only
         Per-axis second moment of a pixel's footprint, px^2 (>= 0): 1/12 for a box pixel,
-        ``(s**2 - 1) / (12 s**2)`` for ``s x s`` point samples, 1/6 for a tent.
+        ``(s**2 - 1) / (12 s**2)`` for ``s x s`` point samples, 1/6 for a tent; per pixel
+        where the footprints differ (a RAW pixel timed from its own site or from the
+        demosaic's blend of its neighbours).
 
     Returns
     -------
@@ -42,8 +44,13 @@ def flux_centroid_shift(irradiance, *, footprint_variance):
     irradiance = check_array(irradiance, "irradiance", ndim=2, dtype_kind="iuf").astype(np.float64)
     if min(irradiance.shape) < 2:
         raise ValueError(f"irradiance must be at least 2 x 2 pixels; got shape {irradiance.shape}")
-    if not (np.isfinite(footprint_variance) and footprint_variance >= 0):
-        raise ValueError(f"footprint_variance must be a finite number >= 0 (px^2); got {footprint_variance!r}")
+    variance = np.asarray(footprint_variance, dtype=np.float64)
+    if variance.ndim not in (0, 2) or (variance.ndim == 2 and variance.shape != irradiance.shape):
+        raise ValueError(f"footprint_variance must be a number or an array of the irradiance's shape "
+                         f"{irradiance.shape} (px^2); got shape {variance.shape}")
+    if not (np.all(np.isfinite(variance)) and np.all(variance >= 0)):
+        raise ValueError(f"footprint_variance must be finite and >= 0 (px^2); got {footprint_variance!r}")
+    footprint_variance = variance[()] if variance.ndim == 0 else variance
     usable = np.isfinite(irradiance) & (irradiance > 0)
     e = np.where(usable, irradiance, 0.0)
     half_width = np.sqrt(3.0 * footprint_variance)

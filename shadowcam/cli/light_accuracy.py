@@ -5,7 +5,8 @@ Reads the capture's per-light truth (``ground_truth.nc``: ``t_center_<sweep>``,
 ``accuracy.json`` (per light and sweep: p95 error, RMSE, coverage, contrast,
 reason counts; :func:`shadowcam.lab.light_views.light_set_accuracy`) and a figure with
 a row per light: estimated and exact times of each sweep and the light's dual view
-(:func:`shadowcam.report.light_set_figure.light_set_mosaic`).
+and the light's dual view beside the one its exact times give
+(:func:`shadowcam.report.light_set_figure.light_set_figure_of`).
 
 Example::
 
@@ -22,13 +23,12 @@ run : score and draw.
 
 import json
 
-import numpy as np
 import xarray as xr
 
 from shadowcam._shared.atomic import atomic_path
-from shadowcam.io.images import write_png
-from shadowcam.lab.light_views import SWEEPS, light_set_accuracy
-from shadowcam.report.light_set_figure import light_set_mosaic
+from shadowcam.lab.light_views import light_set_accuracy
+from shadowcam.report.figures import save_png
+from shadowcam.report.light_set_figure import light_set_figure_of
 
 
 def add_parser(subparsers, name):
@@ -48,6 +48,5 @@ def run(args):
         truth, views = a.load(), b.load()
     with atomic_path(args.out_json) as tmp:
         tmp.write_text(json.dumps(light_set_accuracy(views, truth), indent=2))
-    truths = np.stack([truth[f"t_center_{s}"].values for s in SWEEPS])
     with atomic_path(args.out_png) as tmp:
-        write_png(tmp, light_set_mosaic(views["time"].values, truths, views["dual_view"].values))
+        save_png(light_set_figure_of(views, truth), tmp)

@@ -6,8 +6,10 @@ sweeps one after the other; each sweep's minima are assigned to the lights by th
 along the sweep, checked by spatial continuity, and timed by ``edge_fit`` over each
 light's own map (:func:`shadowcam.lab.light_files.light_set_views_of_plan`); the lights'
 positions along the sweep measured from the data must agree with the manifest's
-``lights.light_along_*`` when it gives them. Writes the per-light shadow times, reasons,
-contrast, confidence, positions and dual views.
+``lights.light_along_*`` when it gives them. A light whose dip a sweep cannot show (its
+minima no more than noise alone places) keeps no time there: reason ``unresolved_dip``,
+``shown`` 0. Writes the per-light shadow times, reasons, contrast, confidence, ``shown``,
+positions and dual views.
 
 Example::
 

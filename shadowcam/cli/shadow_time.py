@@ -5,7 +5,9 @@ shadow-time method and writes ``results/<ds>/shadow_time.nc``
 (:func:`shadowcam.lab.shadow_time.shadow_time_of_stores`). With
 ``--partials SWEEP FILE...`` (per sweep) the dips were tracked per time chunk
 by ``shadowcam shadow-time-chunk`` jobs: their partials are merged instead
-(the result is the same bit for bit).
+(the result is the same bit for bit). Stores of demosaiced RAW (``cfa_pattern``) are
+read once more for each pixel's own mosaic site in its dip window: ``edge_fit`` times the
+pixel from it where its noise allows (:mod:`shadowcam.lab.site_signal`).
 
 Example::
 

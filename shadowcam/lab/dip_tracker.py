@@ -86,6 +86,10 @@ class DipSummary:
         the tracker was fed ``(T, H, W, C)`` blocks.
     saturated : (H, W) bool ndarray or None
         Whether any channel reached the saturation level in any frame.
+    site : SiteWindow or None
+        Demosaiced RAW: each pixel's own mosaic site in the window
+        (:func:`shadowcam.lab.site_signal.track_site_window`), from which ``edge_fit``
+        times it where its noise allows; None: timed from the tracked signal.
     """
 
     window: np.ndarray
@@ -102,6 +106,7 @@ class DipSummary:
     n_frames: int
     channel_sum: np.ndarray = None
     saturated: np.ndarray = None
+    site: object = None
 
     @property
     def half_window(self):

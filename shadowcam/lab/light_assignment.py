@@ -11,20 +11,32 @@ Pixels with another number of minima (a light hidden from the point, two
 shadows merged, a spurious dip) get ``minima_count``, except minima that match
 exactly one light's neighbourhood within `tolerance`, which are kept.
 
+A dip is timed over a window around its minimum's place. Under the sweep's
+Poisson-Gaussian noise (:mod:`shadowcam.lab.sensor_noise`) that window is the shadow's
+only where no sample so far from the minimum that the window around it would miss the
+dip could have been as deep by noise alone (:func:`place_noise_probability`): a long shallow shadow (a tube lying along
+the wire: a few percent of the light over many frames) has a floor whose noise minima fall anywhere on
+it. A time whose probability exceeds `false_alarm` is ``unresolved_dip``. A light whose
+resolved dips in a sweep are no more than noise alone gives at `false_alarm` (the
+binomial upper `false_alarm` quantile over the pixels its shadow crosses) is not shown by
+that sweep: ``shown`` is False and its times that passed are ``unresolved_dip`` too.
+
 Offers
 ------
 LIGHT_REASONS : reason code -> meaning, per light and pixel.
 assign_minima : :class:`~shadowcam.lab.minima.Minima` -> per-light time maps, contrast,
     confidence and reasons.
 light_summary : per-light contrast, coverage and reason counts.
+place_noise_probability : probability that noise alone makes a sample far from a dip's minimum as deep.
 """
 
 import warnings
 
 import numpy as np
-from scipy.special import ndtr
+from scipy.special import ndtr, ndtri
+from scipy.stats import binom
 
-from shadowcam._shared.validation import check_positive
+from shadowcam._shared.validation import check_in_interval, check_positive
 from shadowcam.lab import minima as _m
 
 #: reason code -> meaning, per light and pixel (0 = a reliable time)
@@ -37,8 +49,9 @@ LIGHT_REASONS = {
     5: "dip_at_sweep_end",
     6: "invalid_input",
     7: "wide_dip",
+    8: "unresolved_dip",
 }
-OK, MINIMA_COUNT, LOW_CONTRAST, AMBIGUOUS_ORDER, OVERLAPPING, AT_END, INVALID, WIDE = range(8)
+OK, MINIMA_COUNT, LOW_CONTRAST, AMBIGUOUS_ORDER, OVERLAPPING, AT_END, INVALID, WIDE, UNRESOLVED = range(9)
 _FROM_MINIMUM = {_m.OK: OK, _m.MISSING: MINIMA_COUNT, _m.LOW_CONTRAST: LOW_CONTRAST,
                  _m.OVERLAPPING: OVERLAPPING, _m.AT_END: AT_END, _m.INVALID: INVALID, _m.WIDE: WIDE}
 
@@ -219,7 +232,74 @@ def _seed_partial(seed, estimate, gaps, n_frames, tolerance, *, informative):
     return out
 
 
-def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None):
+def place_noise_probability(window, noise, *, tolerance, width=None):
+    """Probability that noise alone makes a sample far from a dip's minimum as deep as it:
+    that the minimum's place, and the window timed around it, are noise's.
+
+    The minimum sits at the window's centre slot (``S // 2`` samples each side). Had noise
+    put it ``r`` frames away, the window around it would still hold the dip's half-depth
+    span (`width`) while ``r <= S // 2 - width / 2``: those samples, and all within
+    `tolerance` frames, are near; its depth is their deepest. A far sample ``d`` above that
+    depth (the difference's noise standard deviation ``sqrt(2) noise``) reaches it by
+    noise with probability ``Q(d / (sqrt(2) noise))``; the probability that any far
+    sample does is ``1 - prod(1 - Q)``. A sharp dip's far samples lie at the lit level,
+    many noise deviations up (about 0); a shadow whose floor is longer than the window
+    allows has far floor samples within the noise of its minimum (near 1).
+
+    Parameters
+    ----------
+    window : (S, ...) array_like
+        Samples around each minimum (S odd, the minimum at ``S // 2``), in the units of
+        `noise` (e.g. normalised by the lit level); NaN = not the dip's (cut, outside).
+    noise : (...) array_like
+        Standard deviation of one sample (0 = noise-free: a far sample as deep counts 1/2).
+    tolerance : float
+        Frames within which the minimum's place is its own.
+    width : (...) array_like, optional
+        The dip's half-depth width in frames (NaN or None: only `tolerance`).
+
+    Returns
+    -------
+    (...) float64 ndarray
+        In [0, 1]; NaN where the minimum's slot is not finite.
+    """
+    window = np.asarray(window, np.float64)
+    check_positive(tolerance, "tolerance", finite=True)
+    if window.ndim < 1 or window.shape[0] % 2 != 1:
+        raise ValueError(f"window must have an odd number of samples along axis 0; got shape {window.shape}")
+    noise = np.broadcast_to(np.asarray(noise, np.float64), window.shape[1:])
+    offset = np.abs(np.arange(window.shape[0]) - window.shape[0] // 2).reshape((-1,) + (1,) * (window.ndim - 1))
+    half = window.shape[0] // 2
+    own = np.full(window.shape[1:], float(tolerance))
+    if width is not None:
+        spare = half - 0.5 * np.broadcast_to(np.asarray(width, np.float64), window.shape[1:])
+        own = np.fmax(own, np.where(np.isfinite(spare), spare, -np.inf))
+    far = offset > own[None]
+    near = np.where(~far & np.isfinite(window), window, np.inf)
+    bottom = np.min(near, axis=0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        above = window - bottom[None]
+        exact = np.where(above > 0, np.inf, np.where(above < 0, -np.inf, 0.0))  # noise-free
+        z = np.where(noise[None] > 0, above / (np.sqrt(2.0) * noise[None]), exact)
+    # a far sample reaches the minimum's depth by noise with Q(z); none does with prod(1 - Q)
+    reached = np.where(far & np.isfinite(window), ndtr(-z), 0.0)
+    out = -np.expm1(np.sum(np.log1p(-np.minimum(reached, 1.0 - 1e-16)), axis=0))
+    return np.where(np.isfinite(window[window.shape[0] // 2]), out, np.nan)
+
+
+def _shown(resolved, crossed, false_alarm):
+    """Per light: its resolved dips are more than noise alone gives, (L,) bool.
+
+    `resolved` (L, H, W): pixels with a resolved timed dip; `crossed` (L, H, W): the pixels
+    the light's shadow crosses inside the sweep. Noise alone resolves a share of at most
+    `false_alarm` of them; more than its binomial upper `false_alarm` quantile is the light.
+    """
+    n = crossed.sum(axis=(1, 2))
+    limit = binom.isf(false_alarm, np.maximum(n, 1), false_alarm)
+    return resolved.sum(axis=(1, 2)) > limit
+
+
+def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None, false_alarm=1e-3):
     """Per-light shadow times from each pixel's minima, checked by spatial continuity.
 
     Seeds are the pixels with exactly `n_lights` significant minima whose gaps agree with
@@ -247,6 +327,11 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
     iterations : int, optional
         Most passes of the prediction and matching (each grows the assigned regions by
         about `radius` pixels); default until nothing changes, at most ``max(H, W)``.
+    false_alarm : float
+        Probability, per pixel and light, that noise alone places a timed dip's minimum
+        (``unresolved_dip`` above it, :func:`place_noise_probability`), and that a light
+        whose dips the sweep cannot resolve is taken as shown. The rate of
+        :func:`~shadowcam.lab.minima.find_minima`'s detection: one rate for every test.
 
     Returns
     -------
@@ -258,10 +343,12 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
         pixels where the light's shadow is predicted inside the sweep in which its minimum
         is timed (before the partial seeds); ``confidence`` (L, H, W) in [0, 1], 0 where
         flagged: the probability that the time is light k's shadow, as the product of
-        ``Phi(depth_snr - significance)`` (the dip is real: its depth over the depth's
-        noise against the detection level) and ``(a + 1) / (n + 2)`` (the neighbours
+        ``(1 - Q(depth_snr)) ** n_frames`` (noise alone makes no minimum this deep anywhere
+        in the sweep), ``1 -`` :func:`place_noise_probability` (no sample far from it
+        reaches its depth by noise) and ``(a + 1) / (n + 2)`` (the neighbours
         agree: ``a`` of the ``n`` neighbours with a time for light k lie within
-        `tolerance` of it; the posterior mean under a uniform prior).
+        `tolerance` of it; the posterior mean under a uniform prior); ``shown`` (L,) bool:
+        the sweep shows the light's dip (its resolved dips are more than noise alone gives).
     """
     if int(n_lights) != n_lights or n_lights < 1:
         raise ValueError(f"n_lights must be an integer >= 1; got {n_lights!r}")
@@ -270,6 +357,7 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
         raise ValueError(f"minima: found with count={minima.time.shape[0]} < n_lights={n_lights}; "
                          "find at least one minimum per light")
     check_positive(tolerance, "tolerance", finite=True)
+    check_in_interval(false_alarm, "false_alarm", 0, 1, closed="neither")
     radius = int(radius)
     iterations = max(minima.count.shape) if iterations is None else int(iterations)
     significant = (minima.reason != _m.MISSING) & (minima.reason != _m.LOW_CONTRAST)
@@ -308,13 +396,28 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None)
     # (an isolated time included): flagged, not guessed
     reason[jump | ((reason == OK) & (2 * agree <= total))] = AMBIGUOUS_ORDER
     contrast, std, snr = (_gather(a, pick) for a in (minima.contrast, minima.time_std, minima.depth_snr))
+    place = np.zeros(pick.shape)
+    if minima.summary is not None:  # each light's minimum's window, normalised by its level
+        index = np.maximum(pick, 0)
+        window = np.take_along_axis(minima.summary.window, index[None], 1)
+        noise = np.take_along_axis(np.asarray(minima.summary.noise, np.float64), index, 0)
+        # the half-depth span is the dip's own only where no sample of the window reaches
+        # half the depth by noise (at false_alarm); else it is noise's and not used
+        with np.errstate(invalid="ignore", divide="ignore"):
+            crossings_own = contrast / (2.0 * noise) > -ndtri(false_alarm / window.shape[0])
+        width = np.where(crossings_own, _gather(minima.width, pick), np.nan)
+        place = np.nan_to_num(place_noise_probability(window, noise, tolerance=tolerance, width=width), nan=1.0)
+    reason[(reason == OK) & (place > false_alarm)] = UNRESOLVED
+    shown = _shown(reason == OK, inside | (pick >= 0), false_alarm)
+    reason[~shown[:, None, None] & (reason == OK)] = UNRESOLVED
     ok = reason == OK
-    with np.errstate(invalid="ignore"):
-        real = ndtr(np.where(np.isfinite(snr), snr - minima.significance, np.inf))
-    confidence = real * (agree + 1.0) / (total + 2.0)
+    with np.errstate(invalid="ignore", over="ignore"):
+        # no minimum this deep from noise anywhere in the sweep: (1 - Q(snr)) ** n_frames
+        real = np.exp(minima.n_frames * np.log1p(-ndtr(-np.where(np.isfinite(snr), snr, np.inf))))
+    confidence = real * (1.0 - place) * (agree + 1.0) / (total + 2.0)
     return {"time": np.where(ok, time, np.nan), "contrast": contrast, "time_std": std,
             "confidence": np.where(ok, confidence, 0.0), "reason": reason, "minimum": pick,
-            "seen": seen}
+            "seen": seen, "shown": shown}
 
 
 def light_summary(assigned, *, valid=None):

@@ -181,8 +181,8 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
     -------
     times : dict of str to (L, H, W) ndarray
         ``time``, ``contrast``, ``confidence``, ``time_std``, ``reason``, ``minimum``
-        (:func:`~shadowcam.lab.light_assignment.assign_minima`, re-timed by ``edge_fit``)
-        with light k at index k.
+        (L, H, W) and ``shown`` (L,) (:func:`~shadowcam.lab.light_assignment.assign_minima`,
+        re-timed by ``edge_fit``) with light k at index k.
     position : (L,) float64 ndarray
         Each light's position along the sweep measured from its shadows (frames from the
         first shadow's, :func:`light_positions`), light k at index k.
@@ -251,6 +251,7 @@ def light_views_dataset(per_sweep, positions, reference, *, shape, lights, chann
         {"time": stacked("time", np.float32), "contrast": stacked("contrast", np.float32),
          "confidence": stacked("confidence", np.float32), "time_std": stacked("time_std", np.float32),
          "reason": stacked("reason", np.int8),
+         "shown": (("sweep", "light"), np.stack([per_sweep[s]["shown"] for s in SWEEPS]).astype(np.int8)),
          "dual_view": (("light", "v", "u", "channel"), views), "coverage": (("light", "v", "u"), coverage),
          "position": (("sweep", "light"), np.stack([positions[s] for s in SWEEPS]))},
         coords={"sweep": list(SWEEPS), "light": np.asarray(lights), "channel": np.asarray(channels)},
@@ -288,7 +289,8 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
     xarray.Dataset
         ``time``, ``contrast``, ``confidence``, ``time_std`` (sweep, light, y, x) float32,
         ``reason`` (sweep, light, y, x) int8 (:data:`~shadowcam.lab.light_assignment.LIGHT_REASONS`),
-        ``dual_view`` (light, v, u, channel), ``coverage`` (light, v, u) and ``position``
+        ``shown`` (sweep, light) int8 (1: the sweep shows the light's dip; 0: its dips are
+        no more than noise alone places, every time ``unresolved_dip``), ``dual_view`` (light, v, u, channel), ``coverage`` (light, v, u) and ``position``
         (sweep, light): each light's position along the sweep measured from its shadows
         (frames from the first light's, :func:`light_positions`).
 
@@ -381,7 +383,9 @@ def light_set_accuracy(views, capture, *, min_level=0.2, false_error=1.0):
         ``n_scored``, ``contrast`` (median), ``false_rate`` (fraction of the timed scored
         pixels further than `false_error` from the truth), ``confidence_true`` and
         ``confidence_false`` (median confidence on the timed pixels within and beyond
-        `false_error`; None where none) and ``reasons`` (name -> count).
+        `false_error`; None where none), ``reasons`` (name -> count) and, from the views'
+        ``shown``, ``dip_shown`` (bool) with a ``note`` where the sweep cannot show the
+        light's dip.
     """
     errors = light_set_errors(views, capture, min_level=min_level)
     out = []
@@ -408,5 +412,10 @@ def light_set_accuracy(views, capture, *, min_level=0.2, false_error=1.0):
                 "confidence_false": float(np.median(confidence[false])) if false.any() else None,
                 "reasons": {label: int(np.sum(reason[scored] == code)) for code, label in LIGHT_REASONS.items()},
             }
+            if "shown" in views:
+                entry[name]["dip_shown"] = bool(views["shown"].values[s, k])
+                if not entry[name]["dip_shown"]:
+                    entry[name]["note"] = (f"the {name} sweep cannot show this light's dip: its minima are no "
+                                           "more than noise alone places (reason unresolved_dip)")
         out.append(entry)
     return {"lights": out}

@@ -27,6 +27,8 @@ shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials
 """
 
 import logging
+from collections.abc import Sequence
+from dataclasses import replace
 
 import numba as nb
 import numpy as np
@@ -38,6 +40,7 @@ from shadowcam._shared.coverage import MIN_COVERAGE, check_coverage
 from shadowcam._shared.validation import check_in_interval, check_positive
 from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.lab.edge_refine import refine_times, shifted
+from shadowcam.lab.site_signal import blend_variance, track_site_window
 
 log = logging.getLogger(__name__)
 
@@ -61,6 +64,9 @@ TIMED = (OK, DIP_AT_SWEEP_END_TIMED)
 
 #: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
 _SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))
+#: probability that a RAW site's own samples of pure noise pass as a dip (``classify_dips``'
+#: default `false_alarm`): below it a pixel is timed from the channel sum
+_SITE_FALSE_ALARM = 1e-2
 
 
 def _window_times(summary):
@@ -71,9 +77,14 @@ def _window_times(summary):
 
 def _coverage(summary):
     """Fraction of light removed in each window frame, ``(K, H, W)``; NaN outside."""
+    return _removed_fraction(summary.window, summary.lit_level)
+
+
+def _removed_fraction(window, lit_level):
+    """``1 - window / lit_level`` clipped to [0, 1], ``(K, H, W)``; NaN where `window` is."""
     with np.errstate(invalid="ignore", divide="ignore"):
-        level = summary.lit_level[None]
-        return np.clip(1.0 - summary.window / level, 0.0, 1.0)
+        level = lit_level[None]
+        return np.clip(1.0 - window / level, 0.0, 1.0)
 
 
 @nb.njit(cache=True, parallel=True, error_model="numpy")
@@ -260,6 +271,53 @@ def time_argmin_gaussian_smoothed(summary, *, sigma=1.0):
     return time, entry, exit_, std
 
 
+def _site_times(summary, site, *, noise_floor=1e-4):
+    """Each RAW pixel's time from its own site, joined by its neighbours' where they agree.
+
+    The own site's samples (``site.window``, masked as `summary`'s window) give the
+    removed-light centroid of the site's own footprint, where the own dip is deeper than
+    pure noise gets within the sweep (:func:`detection_threshold` at
+    :data:`_SITE_FALSE_ALARM`, on the [1, 2, 1]-smoothed samples, as the tracker's).
+    The neighbours' part of the tracked signal (channel sum less the own value: other
+    sites, independent noise) gives a second centroid, at the centre of the demosaic's
+    symmetric taps. The two are combined by inverse variance where the estimated squared
+    bias of the neighbours' time, ``(t_n - t_o)**2 - var_o - var_n``, is not positive
+    (their difference is noise); otherwise the own time stands alone. Both noises are
+    bounded below by `noise_floor` (signal units), as in :func:`classify_dips`.
+
+    Returns
+    -------
+    time, std : (H, W) float64 ndarray
+        NaN where the own dip is not significant (the channel sum's centroid is then used).
+    neighbour_share : (H, W) float64 ndarray
+        Weight of the neighbours' time in `time` (0 where not joined).
+    """
+    keep = np.isfinite(summary.window)
+    own = np.where(keep, site.window, np.nan)
+    own_noise = np.maximum(np.nan_to_num(site.noise, nan=np.inf), noise_floor)
+    rest_noise = np.maximum(np.nan_to_num(site.neighbour_noise, nan=np.inf), noise_floor)
+    own_time, own_std = _centroid_kernel(_removed_fraction(own, site.level), summary.window_start,
+                                         own_noise, site.level)
+    smooth = 0.25 * own[:-2] + 0.5 * own[1:-1] + 0.25 * own[2:]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        floor = np.nanmin(np.where(np.isfinite(smooth), smooth, np.inf), axis=0)
+        contrast = (site.level - floor) / (own_noise * _SMOOTHED_NOISE)
+    z = detection_threshold(summary.n_frames, false_alarm=_SITE_FALSE_ALARM)
+    significant = (contrast > z) & np.isfinite(own_time) & (own_std > 0)
+    rest = np.where(keep, summary.window - site.window, np.nan)
+    rest_time, rest_std = _centroid_kernel(_removed_fraction(rest, site.neighbour_level), summary.window_start,
+                                           rest_noise, site.neighbour_level)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        joined = significant & np.isfinite(rest_time) & (rest_std > 0) & (
+            (rest_time - own_time) ** 2 <= own_std**2 + rest_std**2)
+        w_own, w_rest = 1.0 / own_std**2, np.where(joined, 1.0 / rest_std**2, 0.0)
+        time = (w_own * own_time + w_rest * np.where(joined, rest_time, 0.0)) / (w_own + w_rest)
+        std = 1.0 / np.sqrt(w_own + w_rest)
+        share = w_rest / (w_own + w_rest)
+    return (np.where(significant, time, np.nan), np.where(significant, std, np.nan),
+            np.where(significant, share, 0.0))
+
+
 def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15, footprint_variance=None):
     """Dip centroid combined with an edge-aware local plane fit of neighbours' times.
 
@@ -273,13 +331,27 @@ def time_edge_fit(summary, *, radius=3, range_sigma=0.5, floor_std=0.15, footpri
     `footprint_variance` (px^2 per axis, a camera fact): a dip is timed at the pixel's
     flux centroid (:func:`shadowcam._shared.flux_centroid.flux_centroid_shift` of the lit
     level), which the refinement takes to the pixel centre; None: at the centre.
+    With the summary's `site` (:class:`shadowcam.lab.site_signal.SiteWindow`, demosaiced
+    RAW), each pixel is timed from its own mosaic site where that dip is significant, joined by its
+    neighbours' part where the two agree (:func:`_site_times`), else from the channel
+    sum; the footprint's second moment is then the site's plus the demosaic taps' share
+    in the time (:func:`shadowcam.lab.site_signal.blend_variance`).
     """
     time, entry, exit_, std = time_dip_centroid(summary)
+    timed = time
+    site = summary.site
+    if site is not None:
+        site_time, site_std, share = _site_times(summary, site)
+        own = np.isfinite(site_time)
+        timed, std = np.where(own, site_time, time), np.where(own, site_std, std)
+        if footprint_variance is not None:
+            footprint_variance = footprint_variance + np.where(
+                own, share * blend_variance(site.colour, own=False), blend_variance(site.colour))
     shift = clipped = None
     if footprint_variance is not None:
         shift, clipped = flux_centroid_shift(summary.lit_level, footprint_variance=footprint_variance)
     refined, refined_std = refine_times(
-        time, np.hypot(std, floor_std), radius=radius, range_sigma=range_sigma, centroid_shift=shift,
+        timed, np.hypot(std, floor_std), radius=radius, range_sigma=range_sigma, centroid_shift=shift,
         shift_std=None if clipped is None else np.abs(clipped)
     )
     shift = refined - time
@@ -708,8 +780,6 @@ def _local_width(width, known, *, min_count=8):
 
 def _masked_summary(summary, keep):
     """Copy of `summary` whose window is NaN outside `keep` (so methods ignore them)."""
-    from dataclasses import replace
-
     return replace(summary, window=np.where(keep[None], summary.window, np.nan))
 
 
@@ -794,7 +864,10 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
     Parameters
     ----------
     blocks : iterable of (T, H, W, C) float ndarray
-        Linear frames in time order.
+        Linear frames in time order. A sequence (e.g. a list of blocks) of demosaiced RAW
+        frames is read twice: ``edge_fit`` then times each pixel from its own site where
+        its noise allows (:func:`shadowcam.lab.site_signal.track_site_window`); a one-shot
+        iterable is read once and timed from the channel sum.
     shape : tuple of int
         ``(H, W)``.
     method : str, optional
@@ -815,12 +888,15 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
         As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
     """
     summary, _, _ = track_sweep(blocks, shape, half_window=half_window, progress=progress)
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern,
+    site = None
+    if cfa_pattern and method == "edge_fit" and isinstance(blocks, Sequence):
+        site = track_site_window(blocks, summary, site_colour=cfa_site_colours(shape, cfa_pattern))
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, site=site,
                                 method_params=method_params, classify_params=classify_params)
 
 
 def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
-                         classify_params=None, interval=None):
+                         classify_params=None, interval=None, site=None):
     """Shadow times of one sweep from its tracked :class:`DipSummary`.
 
     The second half of :func:`sweep_shadow_times`, for a summary obtained
@@ -835,6 +911,10 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
         As :func:`sweep_shadow_times`.
     interval : DipInterval, optional
         As :func:`shadow_times`.
+    site : SiteWindow, optional
+        The RAW sites' own samples (:func:`shadowcam.lab.site_signal.track_site_window`):
+        ``edge_fit`` times each pixel from its own site where its noise allows (other
+        methods time the channel sum).
 
     Returns
     -------
@@ -843,6 +923,8 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
         and ``n_frames``.
     """
     lit_image = lit_colour(summary)
+    if site is not None:
+        summary = replace(summary, site=site)
     classify_params = dict(classify_params or {})
     if cfa_pattern:
         colour = cfa_site_colours(summary.lit_level.shape, cfa_pattern)
@@ -957,7 +1039,9 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
     ----------
     stores : mapping of str to xarray.Dataset
         Sweep name -> its frame store (``image (time, row, col, channel)``), streamed one
-        time chunk at a time.
+        time chunk at a time. A store of demosaiced RAW (attr ``cfa_pattern``) is streamed
+        once more for ``edge_fit``: each pixel's own site in its dip window
+        (:func:`shadowcam.lab.site_signal.track_site_window`).
     method : str
         Key of :data:`SHADOW_TIME_METHODS`.
     partials : mapping of str to sequence of path, optional
@@ -1008,7 +1092,12 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
         log.info("sweep %s: dip intervals", sweep)
         interval = track_intervals((block for _, block in iter_frame_chunks(frames)), summary)
         summary, interval = without_interval(summary, interval)
-        per_sweep[sweep] = summary_shadow_times(summary, interval=interval, **options)
+        site = None
+        if options["cfa_pattern"] and method == "edge_fit":
+            log.info("sweep %s: own-site samples of the dip windows", sweep)
+            site = track_site_window((block for _, block in iter_frame_chunks(frames)), summary,
+                                     site_colour=cfa_site_colours(shape, options["cfa_pattern"]))
+        per_sweep[sweep] = summary_shadow_times(summary, interval=interval, site=site, **options)
     dataset = shadow_time_dataset(per_sweep)
     check_timed(dataset, min_coverage=min_coverage)
     return dataset

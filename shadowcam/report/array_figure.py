@@ -9,7 +9,7 @@ array_figure : each camera's view (left block) and the reciprocal render of the 
 import numpy as np
 
 from shadowcam.io.images import tone_map, white_point
-from shadowcam.report.figures import WHITE_PERCENTILE, _new_figure
+from shadowcam.report.figures import DUAL_AXES, WHITE_PERCENTILE, _new_figure, _small_panel
 
 #: inches per panel side (before the longer dual axis sets its aspect)
 _PANEL_INCHES = 1.9
@@ -50,14 +50,9 @@ def array_figure(views, reciprocal, *, size=None):
         scale = white_point(images.reshape(-1, 1, images.shape[-1]), percentile=WHITE_PERCENTILE)
         for i in range(n):
             for j in range(m):
-                axes = figure.add_subplot(n, 2 * m, i * 2 * m + block * m + j + 1)
-                axes.imshow(tone_map(images[i, j], scale=scale), interpolation="nearest", origin="upper")
-                axes.set_title(f"{label} ({i}, {j})", fontsize="small")
-                axes.tick_params(labelsize="x-small")
-                if i == n - 1:
-                    axes.set_xlabel("u (dual px)", fontsize="small")
-                if j == 0:
-                    axes.set_ylabel("v (dual px)", fontsize="small")
+                _small_panel(figure.add_subplot(n, 2 * m, i * 2 * m + block * m + j + 1),
+                             tone_map(images[i, j], scale=scale), f"{label} ({i}, {j})",
+                             xlabel=DUAL_AXES[0] if i == n - 1 else None, ylabel=DUAL_AXES[1] if j == 0 else None)
     figure.suptitle("virtual camera array: views from the shadows (left), reciprocal renders (right)",
                     fontsize="medium")
     figure.tight_layout(rect=(0, 0, 1, 0.95))

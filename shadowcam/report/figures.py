@@ -11,6 +11,7 @@ Offers
 FIGURE_DPI : dots per inch of every figure (image size = size x FIGURE_DPI pixels).
 NAN_GREY : RGB colour of pixels without a value.
 WHITE_PERCENTILE : percentile of the brightest channel shown as white.
+DUAL_AXES : axis labels of the dual-view panels of many-panel figures.
 FRINGE_MEDIAN : median window of the primal figure's colour-fringe suppression.
 suppress_colour_fringes : median of the colour differences (demosaic false colour), for display.
 primal_figure : the camera (primal) image.
@@ -35,6 +36,8 @@ from shadowcam.io.images import HOLE_COLOUR, tone_map
 FIGURE_DPI = 100
 NAN_GREY = HOLE_COLOUR
 WHITE_PERCENTILE = 99.5
+#: axis labels of a small dual-view panel (u, v)
+DUAL_AXES = ("u (dual px)", "v (dual px)")
 #: median window of the colour differences in the primal figure (demosaic fringes)
 FRINGE_MEDIAN = 5
 
@@ -53,6 +56,27 @@ def _show_image(axes, rgb, title, *, xlabel="col", ylabel="row"):
     axes.set_title(title)
     axes.set_xlabel(xlabel)
     axes.set_ylabel(ylabel)
+
+
+def _show_times(axes, times, *, vmin, vmax, cmap="viridis"):
+    """Draw a (rows, cols) time map on `axes`, NaN in :data:`NAN_GREY`; return the image
+    (the mappable of its colour bar)."""
+    colours = colormaps[cmap].with_extremes(bad=NAN_GREY)
+    return axes.imshow(np.ma.masked_invalid(times), cmap=colours, vmin=vmin, vmax=vmax,
+                       interpolation="nearest", origin="upper")
+
+
+def _small_panel(axes, rgb, title, *, xlabel=None, ylabel=None):
+    """A small panel of a many-panel figure: `rgb` (rows, cols, 3) in [0, 1] (or a drawn
+    image when None), small title, tick labels and axis labels (None = no label)."""
+    if rgb is not None:
+        axes.imshow(rgb, interpolation="nearest", origin="upper")
+    axes.set_title(title, fontsize="small")
+    axes.tick_params(labelsize="x-small")
+    if xlabel:
+        axes.set_xlabel(xlabel, fontsize="small")
+    if ylabel:
+        axes.set_ylabel(ylabel, fontsize="small")
 
 
 def suppress_colour_fringes(image, *, size=FRINGE_MEDIAN):
@@ -136,7 +160,6 @@ def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
         raise ValueError(f"times must be a (rows, cols) array; got shape {times.shape}")
     if not np.issubdtype(times.dtype, np.number):
         raise ValueError(f"times must be numeric, got dtype {times.dtype}")
-    colours = colormaps[cmap].with_extremes(bad=NAN_GREY)
     finite = times[np.isfinite(times)]
     if vmin is None:
         vmin = float(finite.min()) if finite.size else 0.0
@@ -144,8 +167,7 @@ def time_map_figure(times, *, title="shadow time", label="shadow time (frame)",
         vmax = float(finite.max()) if finite.size else 1.0
     figure = _new_figure(size)
     axes = figure.add_subplot()
-    shown = axes.imshow(np.ma.masked_invalid(times), cmap=colours, vmin=vmin, vmax=vmax,
-                        interpolation="nearest", origin="upper")
+    shown = _show_times(axes, times, vmin=vmin, vmax=vmax, cmap=cmap)
     axes.set_title(title)
     axes.set_xlabel("col")
     axes.set_ylabel("row")
