@@ -60,8 +60,8 @@ def load(args):
     return xr.load_dataset(store_path), xr.load_dataset(truth_path)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def add_render_arguments(parser):
+    """The render's options (size, window, frames, elevations, cloud, supersample, sun, shake, cache)."""
     parser.add_argument("--size", type=int, nargs=2, default=(128, 192), metavar=("ROWS", "COLS"))
     parser.add_argument("--window", type=int, nargs=4, default=None, metavar=("ROW0", "COL0", "ROWS", "COLS"))
     parser.add_argument("--frames", type=int, default=120)
@@ -71,7 +71,11 @@ def main():
     parser.add_argument("--point-sun", action="store_true")
     parser.add_argument("--shake", type=float, default=1.0)
     parser.add_argument("--cache", default=None)
-    args = parser.parse_args()
+    return parser
+
+
+def main():
+    args = add_render_arguments(argparse.ArgumentParser(description=__doc__.splitlines()[0])).parse_args()
     store, truth = load(args)
     photometry = photometry_from_frames(store)
     arrival = arrival_map(photometry, track_edges(store, photometry))

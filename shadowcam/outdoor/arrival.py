@@ -50,7 +50,7 @@ import xarray as xr
 
 from shadowcam._shared.validation import check_positive, check_same_shape
 from shadowcam.io.frame_times import median_interval, time_to_frame
-from shadowcam.outdoor.descent import STATE_CODE
+from shadowcam.outdoor.descent import STATE_CODE, TIMED_STATES
 
 #: reason code -> meaning (stored as CF flag_values / flag_meanings)
 ARRIVAL_REASONS = {
@@ -64,6 +64,9 @@ ARRIVAL_REASONS = {
     7: "penumbra_fit",
     8: "ramp_cut",
     9: "ambiguous_ramp",
+    10: "no_lit_level",
+    11: "lit_ratio_spread",
+    12: "arrival_before_record",
 }
 REASON_CODE = {name: code for code, name in ARRIVAL_REASONS.items()}
 #: event kind code -> meaning: the ridge shadow's arrival (end = relit time, NaN if it lasts),
@@ -244,8 +247,11 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
     Returns
     -------
     arrival_s : (H, W) float64 ndarray
-        The ramp centre where the state is ``fitted``, ``neighbours_duration`` or ``cut_centred``; NaN where
-        it is ``cut`` (reason ``ramp_cut``) or ``ambiguous`` (reason ``ambiguous_ramp``).
+        The ramp centre where the state is one of
+        :data:`shadowcam.outdoor.descent.TIMED_STATES`; NaN where it is ``cut`` (reason
+        ``ramp_cut``), ``ambiguous`` (reason ``ambiguous_ramp``), ``no_lit_level``,
+        ``lit_ratio_spread`` (reasons of the same names) or ``before_record`` (reason
+        ``arrival_before_record``).
     reason : (H, W) uint8 ndarray
     """
     arrival = np.array(arrival_s, dtype=np.float64)
@@ -254,11 +260,11 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
     check_same_shape({"arrival_s": arrival, "reason": reason, "ramp_centre_s": np.asarray(ramp_centre_s),
                       "ramp_state": state})
     final = (reason == REASON_CODE["edge_crossing"]) | (reason == REASON_CODE["coverage_crossing"])
-    fitted = final & np.isin(state, [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred",
-                                                                             "half_level")])
+    fitted = final & np.isin(state, [STATE_CODE[name] for name in TIMED_STATES])
     arrival[fitted] = np.asarray(ramp_centre_s, dtype=np.float64)[fitted]
     reason[fitted] = REASON_CODE["penumbra_fit"]
-    for name, code in (("cut", "ramp_cut"), ("ambiguous", "ambiguous_ramp")):
+    for name, code in (("cut", "ramp_cut"), ("ambiguous", "ambiguous_ramp"), ("no_lit_level", "no_lit_level"),
+                       ("lit_ratio_spread", "lit_ratio_spread"), ("before_record", "arrival_before_record")):
         where = final & (state == STATE_CODE[name])
         arrival[where] = np.nan
         reason[where] = REASON_CODE[code]

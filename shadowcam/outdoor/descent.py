@@ -33,8 +33,21 @@ luminance), a ramp that spans several frames and starts on its lit plateau is ti
 crossing of its half level instead (:mod:`shadowcam.outdoor.half_level`, state
 ``half_level``): no law, only the lit level and the shadow level (its own plateau after the
 ramp, or the lit level times the ratio). A ramp already under way at the start of its record
-that the law could not fit with certainty has no lit level: no time (``ambiguous``), and its
-level crossing, whose lit level is too low, does not stand in.
+has no lit level of its own: its level crossing (read against a lit level that is too low) and
+the law's fit of it (whose centre comes late) do not stand.
+
+Its lit level follows from the physics: fully lit a pixel reads ``a (E cos i + sky)``,
+fully shadowed ``a sky`` (``a`` its albedo), so its lit-to-shadow ratio depends on the surface's
+orientation and the light, not on the albedo. Its neighbours on the same surface whose descents
+start and end on plateaus give that ratio ``R`` (their median, within the penumbra's width in
+rows), and the pixel's own shadow plateau ``S`` times ``R`` is its lit level: the crossing of
+``S (1 + R) / 2`` times it (state ``neighbours_lit``), with the neighbours' spread of ``R``
+carried into its standard error (``S spread / 2`` over the ramp's rate). A pixel with fewer than
+:data:`MIN_RATIO_NEIGHBOURS` such neighbours or no shadow plateau of its own (``no_lit_level``), whose
+neighbours' ratios spread too much for a time within ``max_sigma`` (``lit_ratio_spread``: not
+one surface, or not one light), whose record starts below that half level (``before_record``:
+the arrival came before the first frame), or whose crossing of it is unresolved or uncertain
+beyond ``max_sigma`` with both levels known (``ambiguous``) gets no time.
 
 Every step but the neighbours' duration and shadow level is per pixel; those read
 ``radius`` columns each side, within the halo of a column strip
@@ -56,14 +69,21 @@ from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, neighbour_
 
 #: ramp state code -> meaning
 RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: "cut", 5: "ambiguous",
-               6: "cut_centred", 7: "half_level"}
+               6: "cut_centred", 7: "half_level", 8: "neighbours_lit", 9: "no_lit_level", 10: "lit_ratio_spread",
+               11: "before_record"}
 STATE_CODE = {name: code for code, name in RAMP_STATES.items()}
+#: states whose ramp centre is the arrival
+TIMED_STATES = ("fitted", "neighbours_duration", "cut_centred", "half_level", "neighbours_lit")
+#: states timed by the penumbra law's fit
+LAW_STATES = [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred")]
 #: pixels each side whose fitted durations steady a noisy ramp (:func:`fit_descents`)
 NEIGHBOUR_RADIUS = 3
 #: samples each side of the half level whose line gives the rate of a descent that does not start on its plateau
 UNDER_WAY_WINDOW = 3
 #: largest drop (share of the contrast) over the interval around a resolved ramp's centre: 4 / (pi 3)
 RESOLVED_STEP = 4.0 / (np.pi * 3)
+#: fewest neighbours whose lit-to-shadow ratios give a spread (:func:`fit_descents`)
+MIN_RATIO_NEIGHBOURS = 3
 #: pixels fitted at once (bounds the (N, K) float64 series gathered from the buffer)
 _CHUNK = 4096
 
@@ -160,15 +180,19 @@ def _fit(buffer, rows, cols, time_s, centre, interval, duration=None, shadow=Non
     return {key: np.concatenate([o[key] for o in out]) for key in out[0]} if out else None
 
 
-def _half_level(buffer, time_s, centre, sigma, state, duration, *, shadow_ratio, limit, interval):
+def _half_level(buffer, time_s, centre, sigma, state, duration, *, shadow_ratio, limit, interval, window):
     """Time the ramps that span several frames and start on their lit plateau by their half level (in place).
 
     A ramp the law found shorter than the sampling resolves (``short``) is taken too when the
     two samples around its half-level crossing show that it is not: they drop by less than
     the disc law's ``4 / (pi n)`` of the contrast over an interval at its centre, ``n`` the
-    law fit's ``min_samples`` (3). Such a ramp, or one the law could not fit with certainty
-    (``ambiguous``), that was already under way at the start of its record has no lit level
-    and no time (``ambiguous``; the returned mask keeps the level crossing from standing in).
+    law fit's ``min_samples`` (3). A resolved ramp (``short`` so taken, ``ambiguous`` or timed by
+    the law) that was already under way at the start of its record has no lit level of its own
+    (``no_lit_level``; the returned mask keeps the level crossing from standing in).
+
+    The ramps under way at their start that end on their shadow plateau are then timed from
+    their neighbours' lit-to-shadow ratio (:func:`_neighbours_lit`; `window` the neighbourhood's
+    ``(rows, cols)`` half size).
 
     Returns
     -------
@@ -176,12 +200,17 @@ def _half_level(buffer, time_s, centre, sigma, state, duration, *, shadow_ratio,
         The ramps under way at the start of their record.
     """
     begun = np.zeros(state.shape, dtype=bool)
-    rows, cols = np.nonzero(state >= STATE_CODE["short"])
+    ratio = np.full(state.shape, np.nan)  # lit over shadow level of the descents with both plateaus
+    shadow = np.full(state.shape, np.nan)  # the shadow plateau of the descents under way at their start
+    rows, cols = np.nonzero((state >= STATE_CODE["short"]) & (state <= STATE_CODE["half_level"]))
     for a in range(0, rows.size, _CHUNK):
         r, c = rows[a:a + _CHUNK], cols[a:a + _CHUNK]
         values, frame = buffer.series(r, c, record="luminance")
         t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
         levels = half_levels(values, t, shadow_ratio=shadow_ratio)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            both = levels["own_shadow"] & (levels["shadow"] > 0)
+            ratio[r[both], c[both]] = levels["lit"][both] / levels["shadow"][both]
         probe = np.where(levels["lit_seen"], levels["half"], levels["lit"] - 0.5 * levels["contrast"])
         with np.errstate(invalid="ignore"):  # a line over an eighth of the fitted duration each side
             k = np.where(state[r, c] > STATE_CODE["short"], np.rint(0.125 * duration[r, c] / interval), 1)
@@ -200,11 +229,69 @@ def _half_level(buffer, time_s, centre, sigma, state, duration, *, shadow_ratio,
         with np.errstate(invalid="ignore", divide="ignore"):
             reach = 4.0 / np.pi * levels["contrast"] / -rate
             first = np.nanmin(t, axis=1)
-            under_way = (levels["under_way"] & long_ramp & (crossing - first <= reach)
-                         & np.isin(state[r, c], [STATE_CODE["short"], STATE_CODE["ambiguous"]]))
-        state[r[under_way], c[under_way]] = STATE_CODE["ambiguous"]
-        begun[r[under_way], c[under_way]] = True
+            under_way = levels["under_way"] & long_ramp & (crossing - first <= reach)
+            own = under_way & levels["shadow_seen"] & (levels["shadow"] > 0)
+        # such a ramp has no lit level of its own: the level crossing and the law's fit (its centre
+        # comes late) do not stand; with its shadow plateau its neighbours' ratio may give one
+        begun_here = under_way & np.isin(state[r, c], [STATE_CODE["short"], STATE_CODE["ambiguous"], *LAW_STATES])
+        state[r[begun_here], c[begun_here]] = STATE_CODE["no_lit_level"]
+        begun[r[begun_here], c[begun_here]] = True
+        own &= begun_here
+        shadow[r[own], c[own]] = levels["shadow"][own]
+    _neighbours_lit(buffer, time_s, centre, sigma, state, duration, begun, ratio=ratio, shadow=shadow, limit=limit,
+                    interval=interval, window=window)
     return begun
+
+
+def _neighbours_lit(buffer, time_s, centre, sigma, state, duration, begun, *, ratio, shadow, limit, interval, window):
+    """Time the descents under way at their record's start from their neighbours' lit-to-shadow ratio (in place).
+
+    `ratio` ``(H, W)`` holds ``L / S`` of the descents with both plateaus seen (NaN elsewhere),
+    `shadow` ``(H, W)`` the shadow plateau ``S`` of the descents under way at their start (NaN
+    elsewhere). The arrival came before the record when the first sample is below the half level
+    by more than twice its uncertainty; a descent that never crosses it otherwise has a ratio
+    that does not hold (``lit_ratio_spread``). One that crosses it, but between two samples that
+    do not resolve the ramp or with a standard error over `limit` not due to the ratio's spread
+    alone, is ``ambiguous`` (its levels are known, its time is not).
+    """
+    rows, cols = np.nonzero(np.isfinite(shadow))
+    if rows.size == 0:
+        return
+    median, spread, count = neighbour_median(ratio, np.isfinite(ratio), radius=window, at=(rows, cols), spread=True)
+    known = (count >= MIN_RATIO_NEIGHBOURS) & np.isfinite(median)
+    lone = ~known & begun[rows, cols]
+    state[rows[lone], cols[lone]] = STATE_CODE["no_lit_level"]
+    rows, cols, median, spread = rows[known], cols[known], median[known], spread[known]
+    for a in range(0, rows.size, _CHUNK):
+        s = slice(a, a + _CHUNK)
+        r, c = rows[s], cols[s]
+        values, frame = buffer.series(r, c, record="luminance")
+        t = np.where(frame >= 0, time_s[np.maximum(frame, 0)], np.nan)
+        low = shadow[r, c]
+        lit = low * median[s]
+        half = 0.5 * (lit + low)
+        with np.errstate(invalid="ignore"):
+            k = np.rint(0.125 * duration[r, c] / interval)
+        k = np.maximum(np.nan_to_num(k, nan=1.0), UNDER_WAY_WINDOW).astype(np.int64)
+        crossing, error, step, rate = half_level_crossings(values, t, half_level=half, half_window=k)
+        first = values[np.arange(r.size), np.argmax(np.isfinite(values), axis=1)]
+        level_error = 0.5 * low * spread[s]  # the half level's uncertainty from the neighbours' ratios
+        with np.errstate(invalid="ignore", divide="ignore"):
+            from_ratio = level_error / np.abs(rate)  # ... as time
+            total = np.hypot(error, from_ratio)
+            resolved = step < RESOLVED_STEP * (lit - low)
+            crossed = np.isfinite(crossing)
+            # never crossed: below the half level from the first sample by more than its uncertainty
+            before = ~crossed & (first < half - 2.0 * level_error)
+            ok = crossed & resolved & (total <= limit)
+            spread_out = (crossed & resolved & (from_ratio > limit)) | (~crossed & ~before)
+        # with its levels, a crossing that is unresolved or too uncertain is an ambiguous ramp
+        untimed = begun[r, c] & ~ok
+        state[r[untimed], c[untimed]] = STATE_CODE["ambiguous"]
+        centre[r[ok], c[ok]], sigma[r[ok], c[ok]] = crossing[ok], total[ok]
+        state[r[ok], c[ok]] = STATE_CODE["neighbours_lit"]
+        state[r[spread_out], c[spread_out]] = STATE_CODE["lit_ratio_spread"]
+        state[r[before], c[before]] = STATE_CODE["before_record"]
 
 
 def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_RADIUS, cut_rows=0, speed_change=False,
@@ -317,7 +404,7 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
     begun = None
     if shadow_ratio is not None:
         begun = _half_level(buffer, time_s, centre, sigma, state, duration, shadow_ratio=shadow_ratio, limit=limit,
-                            interval=interval)
+                            interval=interval, window=(max(int(cut_rows), int(radius)), int(radius)))
     # an uncertain fit that does not contradict the level crossing (within two standard
     # errors) leaves it standing; one that does, or a ramp under way at its record's start
     # (the crossing's lit level is then too low), gives no time
@@ -326,7 +413,7 @@ def fit_descents(buffer, crossing_s, time_s, *, max_sigma=1.0, radius=NEIGHBOUR_
     if begun is not None:
         agrees &= ~begun
     state[agrees] = STATE_CODE["short"]
-    keep = np.isin(state, [STATE_CODE[name] for name in ("fitted", "neighbours_duration", "cut_centred", "half_level")])
+    keep = np.isin(state, [STATE_CODE[name] for name in TIMED_STATES])
     out["ramp_centre_s"] = np.where(keep, centre, np.nan).astype(np.float32)
     out["ramp_duration_s"] = np.where(state > 0, duration, np.nan).astype(np.float32)
     out["ramp_sigma_s"] = np.where(state > 0, sigma, np.nan).astype(np.float32)

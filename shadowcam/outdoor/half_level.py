@@ -117,7 +117,8 @@ def half_levels(values, time_s, *, shadow_ratio, samples=END_SAMPLES, z=PLATEAU_
         descent starts on a plateau), ``under_way`` (bool: it starts descending, every start
         sample above the half level of the start's mean and the shadow level: the ramp had
         begun) and ``own_shadow`` (bool: the shadow level is the pixel's own, its descent ends
-        on a plateau).
+        on a plateau), ``shadow`` (the end's level) with ``shadow_seen`` (bool: the descent
+        ends on a plateau).
     """
     check_in_interval(shadow_ratio, "shadow_ratio", 0.0, 1.0, closed="left")
     _check_end("start", samples, z)
@@ -131,7 +132,7 @@ def half_levels(values, time_s, *, shadow_ratio, samples=END_SAMPLES, z=PLATEAU_
     with np.errstate(invalid="ignore"):
         under_way = ~lit_seen & (lit_slope < 0) & (lowest > half)
     return {"half": np.where(lit_seen, half, np.nan), "lit": lit, "contrast": lit - level, "lit_seen": lit_seen,
-            "under_way": under_way, "own_shadow": own}
+            "under_way": under_way, "own_shadow": own, "shadow": shadow, "shadow_seen": shadow_seen}
 
 
 def half_level_crossings(values, time_s, *, half_level, half_window):

@@ -178,7 +178,7 @@ def fit_ramps(series, time_s, *, centre_s, interval_s, duration_s=None, shadow=N
             "resolved": resolved}
 
 
-def neighbour_median(values, confident, *, radius=3, at=None):
+def neighbour_median(values, confident, *, radius=3, at=None, spread=False):
     """Median of each pixel's confident, finite neighbours (the pixel included).
 
     Parameters
@@ -190,11 +190,15 @@ def neighbour_median(values, confident, *, radius=3, at=None):
         Half size of the neighbourhood (pixels), or ``(rows, cols)``.
     at : tuple of (N,) int ndarray, optional, keyword-only
         ``(rows, cols)`` of the pixels wanted (default: every pixel).
+    spread : bool, keyword-only
+        Also return the values' spread about the median (1.4826 times their median absolute
+        deviation: the standard deviation of normal values) and their count.
 
     Returns
     -------
     (H, W) or (N,) float64 ndarray
-        NaN where the neighbourhood has no confident finite value.
+        NaN where the neighbourhood has no confident finite value. With `spread`, a tuple
+        ``(median, spread, count)`` of such arrays (``count`` int64).
     """
     values = np.asarray(values, dtype=np.float64)
     confident = np.asarray(confident, dtype=bool)
@@ -212,6 +216,8 @@ def neighbour_median(values, confident, *, radius=3, at=None):
     padded = np.pad(kept, ((rr, rr), (rc, rc)), constant_values=np.nan)
     dr, dc = (g.ravel() for g in np.indices((2 * rr + 1, 2 * rc + 1)))
     out = np.full(rows.size, np.nan)
+    mad = np.full(rows.size, np.nan)
+    count = np.zeros(rows.size, dtype=np.int64)
     candidates = np.nonzero(_any_in_window(np.isfinite(kept), rr, rc)[rows, cols])[0]
     step = max(1, 2**22 // dr.size)
     for a in range(0, candidates.size, step):
@@ -219,7 +225,11 @@ def neighbour_median(values, confident, *, radius=3, at=None):
         window = padded[rows[idx, None] + dr[None, :], cols[idx, None] + dc[None, :]]
         with np.errstate(all="ignore"):
             out[idx] = np.nanmedian(window, axis=-1)
-    return out.reshape(values.shape) if at is None else out
+            if spread:
+                mad[idx] = 1.4826 * np.nanmedian(np.abs(window - out[idx, None]), axis=-1)
+                count[idx] = np.isfinite(window).sum(axis=-1)
+    shaped = (lambda a: a.reshape(values.shape)) if at is None else (lambda a: a)
+    return (shaped(out), shaped(mad), shaped(count)) if spread else shaped(out)
 
 
 def _any_in_window(mask, rr, rc):

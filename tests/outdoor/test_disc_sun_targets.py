@@ -56,11 +56,13 @@ def test_disc_sun_renders_meet_the_nuisance_targets(case):
 def test_long_penumbrae_at_a_photographers_cadence():
     # the sun 8.0 -> 7.2 deg in 96 frames: each pixel's penumbra lasts ~55 intervals, most ramps
     # begin before the first frame or end after the last; the nuisance targets are not met
-    # (docs/benchmarks.md, "Outdoor arrival from the half level"): bounds at the figures reached
-    # (0.96 / 13.8 / 13.7 %, coverage 77 %; before the half level 1.78 / 20.6 / 28.5 %, 80 %)
+    # (docs/benchmarks.md, "Outdoor arrival of a penumbra under way at the first frame"): bounds
+    # at the figures reached (0.94 / 11.3 / 12.0 %, coverage 53 %: the ramps under way at the
+    # first frame without a lit level get no time; with the law's fit of them 1.05 / 14.6 / 14.1 %,
+    # 78 %)
     report, penumbra_intervals = _disc_sun_accuracy(height=128, width=192, frames=96, cloud=True,
                                                     elevations=(8.0, 7.2))
     assert penumbra_intervals > 40
     stats = report["errors"]["combined"][PRIMARY_DEFINITION]
-    assert stats["median_abs"] <= 1.1 and stats["p95_abs"] <= 15.0 and stats["frac_over_5"] <= 0.15
-    assert stats["coverage"] >= 0.72
+    assert stats["median_abs"] <= 1.0 and stats["p95_abs"] <= 12.0 and stats["frac_over_5"] <= 0.125
+    assert stats["coverage"] >= 0.5

@@ -273,7 +273,7 @@ def _reference_levels(values, time_s, shadow_ratio, samples=10, z=2.0):
     with np.errstate(invalid="ignore"):
         under_way = ~lit_seen & (lit_slope < 0) & (np.min(start, axis=1) > half)
     out = {"half": np.where(lit_seen, half, np.nan), "lit": lit, "contrast": lit - low, "lit_seen": lit_seen,
-           "under_way": under_way, "own_shadow": own}
+           "under_way": under_way, "own_shadow": own, "shadow": shadow, "shadow_seen": shadow_seen}
     return out, (lit, lit_seen, lit_slope), (shadow, shadow_seen, shadow_slope)
 
 

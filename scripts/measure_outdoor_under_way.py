@@ -1,0 +1,141 @@
+"""The outdoor arrival by pixel group: penumbra inside the record, under way at the first frame, cut by the end.
+
+Usage::
+
+    python scripts/measure_outdoor_under_way.py [render options of measure_outdoor_gain.py]
+        [--save MAPS.npz]
+
+Renders (or reads from ``--cache``) the ridge sunset of ``scripts/measure_outdoor_gain.py``
+(seed 3, every nuisance, 14-bit Poisson-Gaussian noise on linear RGB), runs the outdoor passes in
+process (photometry, edge tracking, arrival map) and reports the combined arrival error against
+the pixel-centre truth (class-3 pixels, median intervals: median / p95 / beyond 5 (coverage),
+signed median), overall and, with the disc sun, by the pixel's penumbra in the truth
+(``penumbra_start_time_s``, ``penumbra_end_time_s``, NaN outside the record): whole penumbra
+inside the record, under way at the first frame, not ended by the last frame; for the pixels under way at the first frame
+the arrival reasons and the ramp states. Also the CPU time (``time.process_time``, every
+thread) of each pass and of the step that times descents under way at their start from the
+neighbours' lit-to-shadow ratio (``outdoor.descent._neighbours_lit``, where the installed
+package has it) with the number of pixels it reads.
+
+Run it with ``PYTHONPATH`` on a source tree to measure that tree (before -> after of a change).
+"""
+
+import argparse
+import os
+import time
+
+import numpy as np
+
+import shadowcam.outdoor.descent as descent
+from measure_outdoor_gain import add_render_arguments, load
+from shadowcam.outdoor.accuracy import arrival_errors, map_to_truth_camera
+from shadowcam.outdoor.arrival import ARRIVAL_REASONS, arrival_map
+from shadowcam.outdoor.edges import track_edges
+from shadowcam.outdoor.photometry import photometry_from_frames
+
+#: options of this script that are not the render's (left out of the cache key)
+OWN_OPTIONS = ("save",)
+
+
+class _StepClock:
+    """Wraps a function: CPU seconds spent in it and the pixels it was given (finite ``shadow``)."""
+
+    def __init__(self, function):
+        self.function, self.seconds, self.pixels = function, 0.0, 0
+
+    def __call__(self, *args, **kwargs):
+        self.pixels += int(np.isfinite(kwargs["shadow"]).sum())
+        start = time.process_time()
+        try:
+            return self.function(*args, **kwargs)
+        finally:
+            self.seconds += time.process_time() - start
+
+
+def _line(errors):
+    if not errors["n_evaluated"]:
+        return "none"
+    return (f"{errors['median_abs']:.3f} / {errors['p95_abs']:.2f} / {100 * errors['frac_over_5']:.2f} % "
+            f"({100 * errors['coverage']:.1f} %), signed {errors['median_signed']:+.2f}")
+
+
+def _counts(names, values):
+    keys, counts = np.unique(values, return_counts=True)
+    return ", ".join(f"{names.get(int(k), int(k))} {int(c)}" for k, c in zip(keys, counts))
+
+
+def _nearest(values, shift_row, shift_col):
+    """A label map of the first frame's grid in the truth camera's (nearest pixel)."""
+    rows, cols = values.shape
+    r = np.clip(np.rint(np.arange(rows) + shift_row).astype(int), 0, rows - 1)
+    c = np.clip(np.rint(np.arange(cols) + shift_col).astype(int), 0, cols - 1)
+    return values[np.ix_(r, c)]
+
+
+def main():
+    parser = add_render_arguments(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
+    parser.add_argument("--save", default=None, help="write the maps (estimate, reason, state, truth) here")
+    args = parser.parse_args()
+    render_args = argparse.Namespace(**{k: v for k, v in vars(args).items() if k not in OWN_OPTIONS})
+    store, truth = load(render_args)
+    clock = None
+    if hasattr(descent, "_neighbours_lit"):
+        clock = descent._neighbours_lit = _StepClock(descent._neighbours_lit)
+    cpu = [time.process_time()]
+    wall = time.perf_counter()
+    photometry = photometry_from_frames(store)
+    cpu.append(time.process_time())
+    edges = track_edges(store, photometry)
+    cpu.append(time.process_time())
+    arrival = arrival_map(photometry, edges)
+    cpu.append(time.process_time())
+    wall = time.perf_counter() - wall
+    shift = float(truth["shake_dy_px"][0]), float(truth["shake_dx_px"][0])
+    estimate = map_to_truth_camera(arrival["arrival_time_s"].values, shift_row=shift[0], shift_col=shift[1])
+    reason = _nearest(arrival["reason"].values, *shift)
+    state = _nearest(edges["ramp_state"].values, *shift)
+    times = truth["times_s"].values
+    interval = float(np.median(np.diff(times)))
+    true_arrival = truth["arrival_time_s"].values
+    class3 = truth["shadow_class"].values == 3
+    height, width = class3.shape
+    print(f"{vars(render_args)} ({os.path.dirname(os.path.dirname(descent.__file__))})")
+    print(f"  {height}x{width} px, {times.size} frames; CPU s photometry {cpu[1] - cpu[0]:.2f}, edges "
+          f"{cpu[2] - cpu[1]:.2f}, arrival {cpu[3] - cpu[2]:.2f}; wall {wall:.1f} s")
+    if clock is not None:
+        print(f"  neighbours' lit level: {clock.pixels} px, {clock.seconds:.3f} s CPU "
+              f"({1e6 * clock.seconds / max(clock.pixels, 1):.1f} us per pixel read, "
+              f"{1e6 * clock.seconds / (height * width):.2f} us per pixel of the frame)")
+    print(f"  class 3 ({class3.sum()} px): "
+          f"{_line(arrival_errors(estimate, true_arrival, evaluate=class3, interval_s=interval))}")
+    start = truth["penumbra_start_time_s"].values if "penumbra_start_time_s" in truth else None
+    if start is not None and np.isfinite(start).any():
+        end = truth["penumbra_end_time_s"].values
+        # the truth's penumbra times are searched within the record: NaN = before its start / after its end
+        begun, ended = np.isfinite(start), np.isfinite(end)
+        groups = {"whole penumbra in the record": class3 & begun & ended,
+                  "under way at the first frame": class3 & ~begun,
+                  "not ended by the last frame": class3 & begun & ~ended}
+        error = np.abs(estimate - true_arrival) / interval
+        with np.errstate(invalid="ignore"):
+            beyond = class3 & (error > 5)
+        for name, group in groups.items():
+            print(f"  {name} ({group.sum()} px, {100 * group.sum() / class3.sum():.0f} %): "
+                  f"{_line(arrival_errors(estimate, true_arrival, evaluate=group, interval_s=interval))}; "
+                  f"{100 * (beyond & group).sum() / max(beyond.sum(), 1):.0f} % of those beyond 5")
+        group = groups["under way at the first frame"]
+        print(f"    timed {int(np.isfinite(estimate[group]).sum())} of {int(group.sum())}; reasons: "
+              f"{_counts(ARRIVAL_REASONS, reason[group])}")
+        print(f"    ramp states: {_counts(descent.RAMP_STATES, state[group])}")
+        for code, name in descent.RAMP_STATES.items():
+            chosen = group & (state == code) & np.isfinite(estimate)
+            if chosen.any():
+                print(f"    timed in state {name} ({chosen.sum()} px): "
+                      f"{_line(arrival_errors(estimate, true_arrival, evaluate=chosen, interval_s=interval))}")
+    if args.save:
+        np.savez_compressed(args.save, estimate=estimate, reason=reason, state=state, truth=true_arrival,
+                            class3=class3, times=times)
+
+
+if __name__ == "__main__":
+    main()
