@@ -827,8 +827,7 @@ def support_intervals(read, summary, interval, *, false_alarm=1e-2, classify_par
     with np.errstate(invalid="ignore"):
         closed = (candidate & ~support.entry_open & ~support.exit_open & (support.invalid == 0)
                   & np.isfinite(support.entry) & np.isfinite(support.exit))
-    centroid, centroid_std = _removed_light_centroid(read(), closed, support, level, noise)
-    return DipSupport(interval=support, centroid=centroid, centroid_std=centroid_std)
+    return DipSupport(support, *_removed_light_centroid(read(), closed, support, level, noise))
 
 
 @dataclass
@@ -842,11 +841,18 @@ class DipSupport:
     centroid, centroid_std : (H, W) float64 ndarray
         Centroid of the removed light over the frames inside the interval, and its
         standard deviation from the noise (frames; NaN where not measured).
+    width, width_std : (H, W) float64 ndarray
+        The removed light over the lit level, summed over those frames (frames), and its
+        standard deviation: an opaque wire narrower than the light hides each of the
+        light's chords for the time its width takes to pass, so this is the wire's
+        width in frames, whatever the light's shape.
     """
 
     interval: object
     centroid: np.ndarray
     centroid_std: np.ndarray
+    width: np.ndarray
+    width_std: np.ndarray
 
 
 def _removed_light_centroid(blocks, pixels, support, level, noise):
@@ -854,13 +860,13 @@ def _removed_light_centroid(blocks, pixels, support, level, noise):
 
     Streams `blocks` (``(T, H, W[, C])``, channels summed, from frame 0) once,
     keeping two sums per selected pixel; nothing is read when none is selected.
-    Returns the centroid and its standard deviation (`noise` per sample),
-    ``(H, W)`` each, NaN elsewhere.
+    Returns the centroid, its standard deviation (`noise` per sample), the
+    removed light over `level` (frames) and its standard deviation, ``(H, W)``
+    each, NaN elsewhere.
     """
-    centroid = np.full(pixels.shape, np.nan)
-    centroid_std = np.full(pixels.shape, np.nan)
+    out = [np.full(pixels.shape, np.nan) for _ in range(4)]
     if not pixels.any():
-        return centroid, centroid_std
+        return tuple(out)
     rows, cols = np.nonzero(pixels)
     first, last = support.entry[rows, cols], support.exit[rows, cols]
     lit = level[rows, cols]
@@ -884,9 +890,12 @@ def _removed_light_centroid(blocks, pixels, support, level, noise):
         centre = moment / removed
         # each frame's noise moves the centroid by (t - centre) / removed
         spread = square - 2 * centre * total + count * centre**2
-        centroid[rows, cols] = np.where(removed > 0, centre, np.nan)
-        centroid_std[rows, cols] = noise[rows, cols] * np.sqrt(np.maximum(spread, 0.0)) / removed
-    return centroid, centroid_std
+        sigma = noise[rows, cols]
+        out[0][rows, cols] = np.where(removed > 0, centre, np.nan)
+        out[1][rows, cols] = sigma * np.sqrt(np.maximum(spread, 0.0)) / removed
+        out[2][rows, cols] = removed / lit
+        out[3][rows, cols] = sigma * np.sqrt(count) / lit
+    return tuple(out)
 
 
 def _time_connected_dips(summary, support, reason, time, entry, exit_, std, extra):
@@ -903,32 +912,30 @@ def _time_connected_dips(summary, support, reason, time, entry, exit_, std, extr
     (:class:`DipSupport`'s ``centroid``, its ``centroid_std`` the time's). Kept where the
     time agrees with timed neighbours' (as a flagged wide dip in
     :func:`_time_wide_dips`). ``entry`` / ``exit`` and the ``interval_*``
-    variables become the support's crossings.
+    variables are the wire's edges passing the light's centre: the centroid less
+    and plus half the wire's width (:class:`DipSupport`'s ``width``).
 
     Returns the updated ``reason, time, entry, exit, std, extra``.
     """
-    centroid, centroid_std, support = support.centroid, support.centroid_std, support.interval
-    sigma = summary.noise * _SMOOTHED_NOISE
+    bounds, centroid = support.interval, support.centroid
+    edge_std = np.hypot(support.centroid_std, 0.5 * support.width_std)
     with np.errstate(invalid="ignore", divide="ignore"):
-        entry_std = sigma / support.entry_slope
-        exit_std = sigma / support.exit_slope
-        closed = (~support.entry_open & ~support.exit_open & (support.invalid == 0)
-                  & np.isfinite(support.entry) & np.isfinite(support.exit))
-        inside = (summary.second_frame >= np.floor(support.entry)) & (summary.second_frame <= np.ceil(support.exit))
-    centre = centroid
-    candidate = closed & (((reason == SEVERAL_MINIMA) & inside) | (reason == WIDE_DIP))
-    candidate &= (centre >= 0) & (centre <= summary.n_frames - 1)
+        # centroid is finite only where the support closes inside the sweep with finite samples
+        inside = (summary.second_frame >= np.floor(bounds.entry)) & (summary.second_frame <= np.ceil(bounds.exit))
+        candidate = (np.isfinite(centroid) & (centroid >= 0) & (centroid <= summary.n_frames - 1)
+                     & (((reason == SEVERAL_MINIMA) & inside) | (reason == WIDE_DIP)))
     others = (reason == OK) | candidate
-    connected = candidate & _supported_by_neighbours(candidate, others, np.where(candidate, centre, time))
+    connected = candidate & _supported_by_neighbours(candidate, others, np.where(candidate, centroid, time))
     reason = reason.copy()
     reason[connected] = OK
-    time = np.where(connected, centre, time)
-    entry = np.where(connected, support.entry, entry)
-    exit_ = np.where(connected, support.exit, exit_)
-    std = np.where(connected, centroid_std, std)
+    time = np.where(connected, centroid, time)
+    first, last = centroid - 0.5 * support.width, centroid + 0.5 * support.width
+    entry = np.where(connected, first, entry)
+    exit_ = np.where(connected, last, exit_)
+    std = np.where(connected, support.centroid_std, std)
     extra = dict(extra)
-    for name, value in (("interval_entry", support.entry), ("interval_exit", support.exit),
-                        ("interval_entry_std", entry_std), ("interval_exit_std", exit_std)):
+    for name, value in (("interval_entry", first), ("interval_exit", last),
+                        ("interval_entry_std", edge_std), ("interval_exit_std", edge_std)):
         extra[name] = np.where(connected, value, extra[name])
     return reason, time, entry, exit_, std, extra
 
