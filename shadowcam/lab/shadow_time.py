@@ -928,13 +928,6 @@ def _time_connected_dips(summary, support, reason, time, entry, exit_, std, extr
     # neighbouring connected dips (a pixel whose footprint runs two surfaces' shadows
     # together stands alone among single dips)
     connected = candidate & _supported_by_neighbours(candidate, candidate, centroid)
-    # the wire's width in frames varies smoothly over a planar sweep under one light: a
-    # dip removing more or less light than its neighbours' (two surfaces' shadows run
-    # together, a shadow and a step) is not one wire's
-    removed = np.where(connected, support.width, _window_removed(summary))
-    reference, spread = _local_width(removed, (reason == OK) | connected)
-    with np.errstate(invalid="ignore"):
-        connected &= np.abs(support.width - reference) <= 3 * np.hypot(spread, support.width_std)
     reason = reason.copy()
     reason[connected] = OK
     time = np.where(connected, centroid, time)
@@ -947,12 +940,6 @@ def _time_connected_dips(summary, support, reason, time, entry, exit_, std, extr
                         ("interval_entry_std", edge_std), ("interval_exit_std", edge_std)):
         extra[name] = np.where(connected, value, extra[name])
     return reason, time, entry, exit_, std, extra
-
-
-def _window_removed(summary):
-    """The light removed over the lit level, summed over the window's finite samples (frames), ``(H, W)``."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.nansum(summary.lit_level - summary.window, axis=0) / summary.lit_level
 
 
 def _local_width(width, known, *, min_count=8):
