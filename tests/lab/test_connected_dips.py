@@ -93,3 +93,22 @@ def test_the_support_threshold_is_the_lit_level_less_what_noise_reaches(wire_swe
     np.testing.assert_allclose(threshold, summary.lit_level - margin)
     with pytest.raises(ValueError, match="noise_floor"):
         support_threshold(summary, noise_floor=0.0)
+
+
+def test_the_frames_are_not_read_again_when_no_dip_has_several_minima(wire_sweep):
+    # a thin wire under a point light: every dip fits its window, none needs the support
+    frames, _ = wire_sweep(n_frames=40, shape=(16, 16), level=1.0)
+    frames = frames[..., None]
+    summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)
+    summary, interval = without_interval(summary, track_intervals([frames], summary))
+
+    def read():  # lazy, as the workflow's reader: calling it reads nothing
+        raise AssertionError("the frames were read")
+        yield frames
+
+    support = support_intervals(read, summary, interval)
+    assert not np.isfinite(support.centroid).any()
+    before = summary_shadow_times(summary, interval=interval)
+    after = summary_shadow_times(summary, interval=interval, support=support)
+    for name in ("shadow_time", "reason", "interval_entry", "time_std"):
+        np.testing.assert_array_equal(after[name], before[name])
