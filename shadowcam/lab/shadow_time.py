@@ -17,6 +17,7 @@ TIMED : the codes of the pixels with a time.
 classify_dips : reason code, contrast and confidence per pixel.
 shadow_times : timing + classification of one sweep's :class:`DipSummary`.
 footprint_spread_std : time uncertainty of a footprint that sees two surfaces' shadow times.
+support_threshold, support_intervals, DipSupport : a dip's excursion below the lit level (several minima, one dip).
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 lit_colour : unshadowed colour per pixel from a summary with channel sums.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
