@@ -38,6 +38,7 @@ DipInterval : entry, exit and their slopes per pixel; ``at(fraction)`` across th
 IntervalPartial, merge_intervals : the interval of a sweep from its time chunks.
 half_depth : the default crossing level.
 without_interval : the summary's lit statistics without the whole dip, and the crossings at its half depth.
+lit_without : the lit level, noise and count with some lit samples taken out.
 window_intervals : the interval of the pixels whose crossings lie in their stored window.
 track_intervals : the interval of every pixel: from the window, else a pass over the sweep's frames.
 """
@@ -831,6 +832,39 @@ def _without_ramps(lit_level, lit_count, summary, interval, *, iterations=8):
     return level
 
 
+def lit_without(summary, count, total, square):
+    """The lit level, noise and count of `summary` with some of its lit samples taken out.
+
+    Parameters
+    ----------
+    summary : DipSummary
+    count : (H, W) int ndarray
+        Samples taken out of each pixel's lit ones.
+    total, square : (H, W) float ndarray
+        Their sum and sum of squares.
+
+    Returns
+    -------
+    lit_level, noise : (H, W) float64 ndarray
+    lit_count : (H, W) int64 ndarray
+    changed : (H, W) bool ndarray
+        Pixels with samples taken out and at least 3 left; the others keep their values.
+    """
+    n = summary.lit_count.astype(np.float64)
+    k = np.asarray(count).astype(np.float64)
+    level, noise = summary.lit_level, summary.noise
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lit_sum = level * n - total
+        variance = noise**2 * np.maximum(n - 1, 1) / n
+        lit_square = (variance + level**2) * n - square
+        new_level = lit_sum / (n - k)
+        new_variance = np.maximum(lit_square / (n - k) - new_level**2, 0) * (n - k) / np.maximum(n - k - 1, 1)
+    changed = (k > 0) & (n - k >= 3)
+    lit_level = np.where(changed, new_level, level)
+    lit_count = np.where(changed, summary.lit_count - count, summary.lit_count)
+    return lit_level, np.where(changed, np.sqrt(new_variance), noise), lit_count, changed
+
+
 def without_interval(summary, interval):
     """The lit statistics of `summary` with the whole dip interval taken out, and the crossings moved to match.
 
@@ -853,19 +887,8 @@ def without_interval(summary, interval):
     """
     from dataclasses import replace
 
-    n = summary.lit_count.astype(np.float64)
-    k = interval.beyond_count.astype(np.float64)
-    level, noise = summary.lit_level, summary.noise
-    with np.errstate(invalid="ignore", divide="ignore"):
-        lit_sum = level * n - interval.beyond_sum
-        variance = noise**2 * np.maximum(n - 1, 1) / n
-        lit_square = (variance + level**2) * n - interval.beyond_square
-        new_level = lit_sum / (n - k)
-        new_variance = np.maximum(lit_square / (n - k) - new_level**2, 0) * (n - k) / np.maximum(n - k - 1, 1)
-    changed = (k > 0) & (n - k >= 3)
-    lit_level = np.where(changed, new_level, level)
-    lit_count = np.where(changed, summary.lit_count - interval.beyond_count, summary.lit_count)
-    new_noise = np.where(changed, np.sqrt(new_variance), noise)
+    lit_level, new_noise, lit_count, changed = lit_without(
+        summary, interval.beyond_count, interval.beyond_sum, interval.beyond_square)
     # only a dip that runs beyond the window has its ramps' frames counted as lit to first
     # order; a narrower one's ramp beyond the window is at most a noisy frame's worth
     ramp_level = np.where(changed, _without_ramps(lit_level, lit_count, summary, interval), lit_level)
