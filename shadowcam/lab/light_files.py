@@ -7,7 +7,8 @@ plan (:func:`shadowcam.io.capture_plan.capture_plan`) lists them. Each sweep is 
 the lab sweeps' decoder (:func:`shadowcam.cameras.array_files.read_stack` over
 :func:`shadowcam.io.decode.iter_frames`: camera RAW, TIFF, PNG, EXR to linear RGB) into
 one float32 stack, whose minima :func:`shadowcam.lab.light_views.sweep_light_times` assigns
-to the lights, and is freed before the next is read.
+to the lights (camera RAW: timed from each pixel's own mosaic site where its noise allows),
+and is freed before the next is read.
 
 Offers
 ------
@@ -20,6 +21,8 @@ import numpy as np
 import xarray as xr
 
 from shadowcam.cameras.array_files import read_stack
+from shadowcam.io.decode import frame_info
+from shadowcam.lab.shadow_time import cfa_site_colours
 from shadowcam.lab.light_views import SWEEPS, light_views_dataset, sweep_light_times, view_attrs
 
 
@@ -41,6 +44,8 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
     """Per-light shadow times and dual views of a captured (or rendered and written) several-lights capture.
 
     The sweeps are decoded one after the other, each freed once its minima are assigned.
+    Camera RAW sweeps are timed from each pixel's own mosaic site where its noise allows
+    (the CFA pattern of the sweep's first file, :func:`shadowcam.io.decode.frame_info`).
 
     Parameters
     ----------
@@ -69,10 +74,13 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
     described = block["light_along_u"] is not None
     per_sweep, positions = {}, {}
     for name in SWEEPS:
-        frames = read_stack(plan.sweep(name).files, shape=plan.frame_shape)
+        files = plan.sweep(name).files
+        frames = read_stack(files, shape=plan.frame_shape)
+        pattern = frame_info(files[0])["cfa_pattern"]
         per_sweep[name], positions[name] = sweep_light_times(
             frames, block["count"], sweep=name, light_along=block[f"light_along_{name}"], half_window=half_window,
-            method=method, radius=radius, tolerance=tolerance, check_order=check_order)
+            method=method, radius=radius, tolerance=tolerance, check_order=check_order,
+            site_colour=cfa_site_colours(frames.shape[1:3], pattern) if pattern else None)
         del frames
     attrs = view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
                        check_order=check_order and described)

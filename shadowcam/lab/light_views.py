@@ -131,6 +131,15 @@ def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0, se
     return np.concatenate([[0.0], np.cumsum(scale * described)])
 
 
+def _gather_light(record, index, ok):
+    """One light's fields of a per-minimum record (window ``(W, K, H, W)``, others ``(K, H, W)``)
+    at its minimum `index` ((1, H, W)); the window NaN where not `ok`."""
+    gathered = {f.name: np.take_along_axis(getattr(record, f.name), index, 0)[0] for f in fields(record)
+                if f.name not in ("window", "colour") and isinstance(getattr(record, f.name), np.ndarray)}
+    window = np.take_along_axis(record.window, index[None], 1)[:, 0]
+    return dict(gathered, window=np.where(ok[None], window, np.nan))
+
+
 def _edge_fit_per_light(minima, assigned):
     """Each light's ok times re-timed by ``edge_fit`` over that light's own time map.
 
@@ -138,7 +147,9 @@ def _edge_fit_per_light(minima, assigned):
     dip centroid against its neighbours' local plane by their variances; given the
     windows of one light's minima (:attr:`shadowcam.lab.minima.Minima.summary`, gathered
     at ``assigned["minimum"]``) its neighbours are that light's, never another light's.
-    Flagged pixels neither get a time nor take part.
+    Flagged pixels neither get a time nor take part. With the minima's own-site samples
+    (demosaiced RAW, ``summary.site``) each is timed from its own site where that dip is
+    significant (:func:`shadowcam.lab.shadow_time.time_edge_fit`).
     """
     summary = minima.summary
     out = dict(assigned)
@@ -146,11 +157,9 @@ def _edge_fit_per_light(minima, assigned):
     for k, pick in enumerate(assigned["minimum"]):
         ok = assigned["reason"][k] == OK
         index = np.maximum(pick, 0)[None]
-        gathered = {f.name: np.take_along_axis(getattr(summary, f.name), index, 0)[0]
-                    for f in fields(summary)
-                    if f.name != "window" and isinstance(getattr(summary, f.name), np.ndarray)}
-        window = np.take_along_axis(summary.window, index[None], 1)[:, 0]
-        light = replace(summary, window=np.where(ok[None], window, np.nan), **gathered)
+        light = replace(summary, **_gather_light(summary, index, ok))
+        if summary.site is not None:
+            light.site = replace(summary.site, **_gather_light(summary.site, index, ok))
         with np.errstate(invalid="ignore", divide="ignore"):
             time, _, _, std = SHADOW_TIME_METHODS["edge_fit"](light)
         out["time"][k] = np.where(ok, time, np.nan)
@@ -159,7 +168,7 @@ def _edge_fit_per_light(minima, assigned):
 
 
 def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=4, method="edge_fit", radius=2,
-                      tolerance=2.0, check_order=True):
+                      tolerance=2.0, check_order=True, site_colour=None):
     """One sweep's minima assigned to the lights, with the lights' positions along it.
 
     Parameters
@@ -176,6 +185,12 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
         later). None: light k is the k-th shadow to pass (nothing to check).
     half_window, method, radius, tolerance, check_order
         See :func:`light_set_views`.
+    site_colour : (H, W) int ndarray, optional
+        Demosaiced RAW frames: the CFA channel of each site
+        (:func:`shadowcam.lab.shadow_time.cfa_site_colours`). With ``edge_fit`` each assigned
+        minimum is then timed from its own site where that dip is significant against its
+        noise (:func:`shadowcam.lab.minima.find_minima`); which minima are found and assigned
+        does not depend on it.
 
     Returns
     -------
@@ -198,7 +213,8 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
     if light_along is not None:
         light_along = check_array(light_along, f"light_along_{sweep}", ndim=1, shape=(n_lights,))
     minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
-                         method="dip_centroid" if method == "edge_fit" else method)
+                         method="dip_centroid" if method == "edge_fit" else method,
+                         site_colour=site_colour if method == "edge_fit" else None)
     in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
     if method == "edge_fit":
         in_order = _edge_fit_per_light(minima, in_order)

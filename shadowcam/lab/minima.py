@@ -36,10 +36,11 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 from scipy.special import ndtri
 
-from shadowcam._shared.validation import check_in, check_positive
+from shadowcam._shared.validation import check_array, check_in, check_positive
 from shadowcam.lab.dip_tracker import DipSummary, DipTracker
 from shadowcam.lab.sensor_noise import fit_noise_model, pixel_noise
 from shadowcam.lab.shadow_time import _SMOOTHED_NOISE, SHADOW_TIME_METHODS, detection_threshold
+from shadowcam.lab.site_signal import SiteWindow
 
 #: reason code -> meaning, per minimum (0 = a reliable time)
 MINIMUM_REASONS = {
@@ -191,6 +192,43 @@ def _as_blocks(frames):
 def _signal(block):
     block = np.asarray(block, dtype=np.float32)
     return block.sum(axis=-1) if block.ndim == 4 else block
+
+
+def _own_site(block, colour):
+    """Each site's own channel of a demosaiced block ``(T, H, W, C)`` -> ``(T, H, W)`` float32."""
+    block = np.asarray(block, dtype=np.float32)
+    if block.ndim != 4 or block.shape[1:3] != colour.shape:
+        raise ValueError(f"frames must be (T, {colour.shape[0]}, {colour.shape[1]}, C) with site_colour; "
+                         f"got a block of shape {block.shape}")
+    rows, cols = np.indices(colour.shape)
+    return block[:, rows, cols, colour]
+
+
+def _lit_noise(passing):
+    """Per-pixel noise standard deviation of a :class:`_WindowPass`'s lit frames (first differences)."""
+    return np.sqrt(passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0)
+
+
+def _site_windows(own, rest, normal, level, lit_level, replaced):
+    """The own sites' :class:`~shadowcam.lab.site_signal.SiteWindow` of every minimum, in the
+    units of its normalised window (its channel-sum line `level`, ``(K, W, P)``).
+
+    `own`, `rest` are the :class:`_WindowPass` of the sites' own channel and of the rest of the
+    channel sum; the samples that `normal` ((K, W, P) bool) excludes (another minimum's, or
+    outside the dip) stay NaN, and those `replaced` by the lit level (another light's shadow)
+    take the site's lit level. Its ``colour`` is left to the caller.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        centre = level[:, (level.shape[1] - 1) // 2, :]
+        own_level = np.where(own.lit_count > 0, own.lit_sum / np.maximum(own.lit_count, 1), np.nan)
+        rest_level = np.where(rest.lit_count > 0, rest.lit_sum / np.maximum(rest.lit_count, 1), np.nan)
+        share = np.broadcast_to(own_level / lit_level, centre.shape)
+        window = np.where(normal, own.window / level, np.nan)
+        window = np.where(replaced, share[:, None, :], window).astype(np.float32)
+        return SiteWindow(window=window.transpose(1, 0, 2), level=share, noise=_lit_noise(own)[None] / centre,
+                          count=np.broadcast_to(own.lit_count, centre.shape),
+                          neighbour_level=np.broadcast_to(rest_level / lit_level, centre.shape),
+                          neighbour_noise=_lit_noise(rest)[None] / centre, colour=None)
 
 
 class _WindowPass:
@@ -365,7 +403,7 @@ def _depth_snr(level, smoothed, noise, model, outside_sequence):
 
 
 def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3,
-                steady_level=True, noise_model=None):
+                steady_level=True, noise_model=None, site_colour=None):
     """The `count` deepest separated minima of each pixel, timed and classified.
 
     Parameters
@@ -391,6 +429,15 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         ends stay more than a tenth of the dip's depth below the level of the frames far
         from every minimum has not reached the lit level (``wide_dip``, or
         ``overlapping`` when cut by another minimum). False under a moving light.
+    noise_model : (gain, floor), optional
+        The sensor's Poisson-Gaussian model (default: fitted to the sweep).
+    site_colour : (H, W) int ndarray, optional
+        Demosaiced RAW frames: the CFA channel of each site
+        (:func:`shadowcam.lab.shadow_time.cfa_site_colours`). The second pass also keeps
+        each site's own samples, and each minimum's summary carries them as its ``site``
+        (:class:`~shadowcam.lab.site_signal.SiteWindow`, in the units of its normalised
+        window), from which ``edge_fit`` times it where its own dip is significant. Minima,
+        their reasons and the other methods' times do not depend on it.
 
     Returns
     -------
@@ -405,6 +452,8 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         if len(noise_model) != 2 or not all(np.isfinite(v) and v >= 0 for v in noise_model):
             raise ValueError(f"noise_model must be (gain, floor), two finite numbers >= 0; got {noise_model!r}")
     blocks = _as_blocks(frames)
+    if site_colour is not None:
+        site_colour = check_array(site_colour, "site_colour", shape=tuple(shape), dtype_kind="iu").astype(np.intp)
     count, h = int(count), int(half_window)
     tracker = DipTracker(tuple(shape), half_window=h)
     for block in blocks():
@@ -424,8 +473,16 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     # is its first lowest frame, and its whole width must still fit
     w = 2 * h
     passing = _WindowPass(centres, w, h)
+    own_pass = rest_pass = None
+    if site_colour is not None:
+        own_pass, rest_pass = _WindowPass(centres, w, h), _WindowPass(centres, w, h)
     for block in blocks():
-        passing.update(_signal(block))
+        signal = _signal(block)
+        passing.update(signal)
+        if site_colour is not None:
+            own = _own_site(block, site_colour)
+            own_pass.update(own)
+            rest_pass.update(signal - own)
     window = passing.window
     slot_frame = centres[:, None, :] - w + np.arange(2 * w + 1)[None, :, None]  # (K+1, W, P)
     outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
@@ -446,6 +503,7 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         cuts = (present & dip)[other]
         nearest &= ~cuts[None, None] | (own <= np.abs(slot_frame - centres[other][None, None]))
     cut = np.where(nearest, window, np.nan)
+    before_own_dip = cut
     if steady_level:
         cut = _own_dip(cut, detectable, ~outside_sequence)
     cut_by_other = ~nearest & np.isfinite(window)
@@ -470,6 +528,13 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         invalid_count=passing.invalid, n_frames=n_frames)
     with np.errstate(invalid="ignore", divide="ignore"):
         estimate, entry, exit_, std = (np.asarray(a, np.float64) for a in SHADOW_TIME_METHODS[method](summary))
+    if site_colour is not None:
+        with np.errstate(invalid="ignore"):
+            replaced = np.isfinite(cut) & (cut != before_own_dip)
+            # the own site's dip lies within the channel sum's (the demosaic only widens it):
+            # within its full width at half depth of its time
+            extent = np.abs(slot_frame - estimate[:, None, :]) <= (exit_ - entry)[:, None, :]
+        site = _site_windows(own_pass, rest_pass, nearest & extent, level, far_level, replaced & extent)
     depth_snr = _depth_snr(centre_level, smoothed, noise, noise_model, outside_sequence)
     with np.errstate(invalid="ignore"):
         strong = depth_snr > significance
@@ -510,9 +575,13 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     def slots(a):  # (W, K + 1, P) -> (W, K, H, W)
         return np.take_along_axis(a[:, :count], perm[None], 1).reshape(a.shape[0], count, rows, cols)
 
-    per_minimum = replace(summary, **{
-        f.name: (slots(getattr(summary, f.name)) if f.name == "window" else image(getattr(summary, f.name)))
-        for f in fields(summary) if isinstance(getattr(summary, f.name), np.ndarray)})
+    def per_slot(record):
+        return {f.name: (slots(getattr(record, f.name)) if f.name == "window" else image(getattr(record, f.name)))
+                for f in fields(record) if isinstance(getattr(record, f.name), np.ndarray) and f.name != "colour"}
+
+    per_minimum = replace(summary, **per_slot(summary))
+    if site_colour is not None:
+        per_minimum.site = replace(site, colour=site_colour.astype(np.int8), **per_slot(site))
 
     return Minima(time=image(time), estimate=image(estimate), frame=image(centres),
                   depth=image(depth), contrast=image(contrast), level=image(centre_level),

@@ -7,7 +7,9 @@ ones of a green site), each shadowed at its own time. The dip's window is found
 on that sum (its noise is the lowest), and the pixel is then timed from the site's
 own samples where their noise allows (:func:`shadowcam.lab.shadow_time.time_edge_fit`).
 The demosaic keeps a site's own value in its own channel, so those samples are
-read from the demosaiced frames without the mosaic.
+read from the demosaiced frames without the mosaic. Under several lights each minimum's
+window carries its own :class:`SiteWindow`, in the units of its normalised window
+(:func:`shadowcam.lab.minima.find_minima` with ``site_colour``).
 
 Offers
 ------
