@@ -40,7 +40,7 @@ from shadowcam._shared.validation import check_array, check_in, check_positive
 from shadowcam.lab.dip_tracker import DipSummary, DipTracker
 from shadowcam.lab.sensor_noise import fit_noise_model, pixel_noise
 from shadowcam.lab.shadow_time import _SMOOTHED_NOISE, SHADOW_TIME_METHODS, detection_threshold
-from shadowcam.lab.site_signal import SiteWindow
+from shadowcam.lab.site_signal import SiteWindow, own_site_samples
 
 #: reason code -> meaning, per minimum (0 = a reliable time)
 MINIMUM_REASONS = {
@@ -192,16 +192,6 @@ def _as_blocks(frames):
 def _signal(block):
     block = np.asarray(block, dtype=np.float32)
     return block.sum(axis=-1) if block.ndim == 4 else block
-
-
-def _own_site(block, colour):
-    """Each site's own channel of a demosaiced block ``(T, H, W, C)`` -> ``(T, H, W)`` float32."""
-    block = np.asarray(block, dtype=np.float32)
-    if block.ndim != 4 or block.shape[1:3] != colour.shape:
-        raise ValueError(f"frames must be (T, {colour.shape[0]}, {colour.shape[1]}, C) with site_colour; "
-                         f"got a block of shape {block.shape}")
-    rows, cols = np.indices(colour.shape)
-    return block[:, rows, cols, colour]
 
 
 def _lit_noise(passing):
@@ -480,7 +470,7 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         signal = _signal(block)
         passing.update(signal)
         if site_colour is not None:
-            own = _own_site(block, site_colour)
+            own = own_site_samples(np.asarray(block, dtype=np.float32), site_colour)
             own_pass.update(own)
             rest_pass.update(signal - own)
     window = passing.window

@@ -14,6 +14,7 @@ window carries its own :class:`SiteWindow`, in the units of its normalised windo
 Offers
 ------
 SiteWindow : own-site samples at the window's frames, and the site's lit level and noise.
+own_site_samples : each site's own channel of a demosaiced block.
 track_site_window : one pass over a sweep's demosaiced frames -> the :class:`SiteWindow`.
 blend_variance : per-axis second moment of the channel sum's (or its neighbours' part's) demosaic taps.
 """
@@ -62,6 +63,29 @@ class SiteWindow:
     colour: np.ndarray
 
 
+def own_site_samples(block, site_colour):
+    """Each site's own channel of a demosaiced block.
+
+    Parameters
+    ----------
+    block : (T, H, W, C) ndarray
+        Demosaiced frames.
+    site_colour : (H, W) intp ndarray
+        CFA channel of each site.
+
+    Returns
+    -------
+    (T, H, W) ndarray
+        ``block[t, r, c, site_colour[r, c]]``, in `block`'s dtype.
+    """
+    block = np.asarray(block)
+    shape = site_colour.shape
+    if block.ndim != 4 or block.shape[1:3] != shape:
+        raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C) with site_colour; got {block.shape}")
+    rows, cols = np.indices(shape)
+    return block[:, rows, cols, site_colour]
+
+
 def track_site_window(blocks, summary, *, site_colour):
     """Own-site samples of every pixel in its dip window, and its own lit statistics.
 
@@ -87,13 +111,10 @@ def track_site_window(blocks, summary, *, site_colour):
     total, square = np.zeros(shape), np.zeros(shape)
     rest_total, rest_square = np.zeros(shape), np.zeros(shape)
     count = np.zeros(shape, np.int64)
-    rows, cols = np.indices(shape)
     first = 0
     for block in blocks:
         block = np.asarray(block)
-        if block.ndim != 4 or block.shape[1:3] != shape:
-            raise ValueError(f"blocks must be (T, {shape[0]}, {shape[1]}, C), got {block.shape}")
-        own = block[:, rows, cols, colour]
+        own = own_site_samples(block, colour)
         slot = first + np.arange(own.shape[0])[:, None, None] - start[None]
         inside = (slot >= 0) & (slot < k)
         t, r, c = np.nonzero(inside)
