@@ -235,7 +235,8 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     e1u, e1v = pu[:, 1] - pu[:, 0], pv[:, 1] - pv[:, 0]
     e2u, e2v = pu[:, 2] - pu[:, 0], pv[:, 2] - pv[:, 0]
     det = e1u * e2v - e1v * e2u
-    keep = np.abs(det) > 1e-12
+    nondegenerate = np.abs(det) > 1e-12
+    keep = nondegenerate.copy()
     i0 = np.maximum(np.ceil(pu.min(axis=1) - eps), 0).astype(np.int64)
     i1 = np.minimum(np.floor(pu.max(axis=1) + eps), width - 1).astype(np.int64)
     j0 = np.maximum(np.ceil(pv.min(axis=1) - eps), 0).astype(np.int64)
@@ -244,9 +245,9 @@ def dual_view_mesh(colours, u, v, *, valid, shape, max_edge=2.0, smooth_tol=2.0 
     keep &= (bw > 0) & (bh > 0)
     with np.errstate(divide="ignore", invalid="ignore"):
         weight = np.ones(len(det))
-        if density:
-            weight[keep] = 1.0 / mesh_smoothed_areas(tri[keep], np.abs(det[keep]), n_vertices=rows * cols,
-                                                     passes=density_passes)
+        if density:  # smoothed over every kept triangle, also those covering no dual pixel centre
+            weight[nondegenerate] = 1.0 / mesh_smoothed_areas(tri[nondegenerate], np.abs(det[nondegenerate]),
+                                                              n_vertices=rows * cols, passes=density_passes)
         # inward gradients of the barycentrics l1, l2, l0 (dual px^-1): an edge owns the
         # centres on it when its gradient points to +u (or +v when along u)
         grads = [(e2v / det, -e2u / det), (-e1v / det, e1u / det)]

@@ -337,6 +337,28 @@ def test_density_is_camera_pixels_per_dual_pixel_under_an_affine_map(scale):
     np.testing.assert_allclose(img[cov], colour[cov] / scale**2, rtol=1e-5)
 
 
+def test_density_smoothing_reaches_triangles_smaller_than_a_dual_pixel():
+    # Camera pixels 0.4 dual px apart (6.25 per dual pixel, as in the lab captures), dual
+    # coordinates with white noise of 0.03 dual px (a timing noise of 0.03 frame): a single
+    # triangle's area is off by ~15 % (each edge's two components carry sigma sqrt 2 over a
+    # 0.4 step), so the density must be smoothed over the mesh around it, not only over the
+    # few triangles that happen to hold a dual pixel centre.
+    rng = np.random.default_rng(3)
+    r, c = np.mgrid[0:120, 0:120].astype(float)
+    u = 0.4 * c + 1.3 + 0.03 * rng.standard_normal(c.shape)
+    v = 0.4 * r + 0.7 + 0.03 * rng.standard_normal(r.shape)
+    colours = np.ones((120, 120, 3), dtype=np.float32)
+    inner = (slice(4, 44), slice(4, 44))
+    errors = {}
+    for passes in (0, 2):
+        img, cov = _density_view(u, v, colours, (50, 50), density_passes=passes)
+        assert cov[inner].all()
+        errors[passes] = np.sqrt(np.mean((img[inner][..., 0] / 6.25 - 1.0) ** 2))
+    assert errors[0] > 0.08  # the unsmoothed areas' own noise (expected ~0.15)
+    # two passes average each area over the triangles of about two camera pixels around it
+    assert errors[2] < errors[0] / 3.0
+
+
 def test_density_sums_the_branches_and_draws_nothing_across_the_jump():
     # two camera halves (a direct view and a mirror branch) land on overlapping dual pixels:
     # the density view is the sum of the two; triangles across the jump between the halves
