@@ -17,7 +17,8 @@ white balance is *reported* by :func:`frame_info`, never applied).
 Offers
 ------
 read_frame : one frame as a (H, W, 3) float32 array (optionally with its info).
-header_metadata : exposure and capture time from the file header only.
+header_metadata : exposure and capture time from the file header only
+    (:mod:`shadowcam.io.file_header`).
 frame_info : size, bit depth, black/white levels, white balance, exposure and
     capture time of a frame, without decoding more than needed.
 iter_frames : decode several frames one at a time, checking they share a size.
@@ -28,7 +29,6 @@ The Bayer maths are in :mod:`shadowcam.io.cfa`, the rawpy mosaic read in
 :mod:`shadowcam.io.raw_mosaic`.
 """
 
-import datetime as _dt
 import logging
 import math
 from pathlib import Path
@@ -36,73 +36,11 @@ from pathlib import Path
 import numpy as np
 
 from shadowcam.io.cfa import demosaic_scaled, site_map
+from shadowcam.io.file_header import header_metadata
 from shadowcam.io.mosaic_reader import MosaicReader
 from shadowcam.io.raw_mosaic import check_frame_path, is_raw, read_mosaic
 
 log = logging.getLogger(__name__)
-
-
-# ---------------------------------------------------------------------------
-# metadata
-
-
-def _parse_exif_datetime(text, subsec=None):
-    """EXIF "YYYY:MM:DD HH:MM:SS" (+ sub-second digits) -> naive datetime, or None."""
-    if not text:
-        return None
-    text = str(text).strip().rstrip("\x00")
-    for fmt in ("%Y:%m:%d %H:%M:%S", "%Y-%m-%d %H:%M:%S", "%Y-%m-%dT%H:%M:%S"):
-        try:
-            stamp = _dt.datetime.strptime(text[:19], fmt)
-            break
-        except ValueError:
-            continue
-    else:
-        return None
-    digits = "".join(ch for ch in str(subsec or "") if ch.isdigit())
-    if digits:
-        stamp += _dt.timedelta(seconds=float("0." + digits))
-    return stamp
-
-
-def header_metadata(path):
-    """Read exposure and capture time from a file header only (OpenImageIO).
-
-    Parameters
-    ----------
-    path : str or Path
-
-    Returns
-    -------
-    dict
-        ``exposure_s`` (float or None), ``capture_time`` (ISO 8601 string from
-        EXIF DateTimeOriginal plus SubsecTimeOriginal, or None) and
-        ``bits_per_sample`` (int or None). All None if OpenImageIO cannot
-        open the file (e.g. a non-TIFF camera RAW).
-    """
-    import OpenImageIO as oiio
-
-    out = {"exposure_s": None, "capture_time": None, "bits_per_sample": None}
-    inp = oiio.ImageInput.open(str(path))
-    if not inp:
-        oiio.geterror()  # clear the error state; RAW formats may be unknown to OIIO
-        return out
-    try:
-        spec = inp.spec()
-        exposure = spec.getattribute("ExposureTime")
-        if exposure is not None and float(exposure) > 0:
-            out["exposure_s"] = float(f"{float(exposure):.7g}")  # OIIO holds it as float32
-        stamp = _parse_exif_datetime(
-            spec.getattribute("Exif:DateTimeOriginal") or spec.getattribute("DateTimeOriginal"),
-            spec.getattribute("Exif:SubsecTimeOriginal"),
-        )
-        if stamp is not None:
-            out["capture_time"] = stamp.isoformat()
-        bits = spec.getattribute("oiio:BitsPerSample")
-        out["bits_per_sample"] = int(bits) if bits else None
-    finally:
-        inp.close()
-    return out
 
 
 # ---------------------------------------------------------------------------
