@@ -11,15 +11,16 @@ a workflow dataset's decoded frame store and rendered truth (``RESULTS_DIR/frame
 ``RESULTS_DIR/capture/ground_truth.nc``: the DNG path), optionally keeps rows ``A:B`` of both
 (``--rows``), runs the outdoor passes in process (photometry, edge tracking, arrival map; with
 ``--gains-from-rows`` the first pass's per-frame curves, ``gain``, ``gain_sky``, ``gain_source``
-and ``cloud_shade``, are those of the first pass run on rows ``A:B`` alone) and reports the combined arrival error against
-the pixel-centre truth (class-3 pixels, median intervals: median / p95 / beyond 5 (coverage),
-signed median), overall and, with the disc sun, by the pixel's penumbra in the truth
-(``penumbra_start_time_s``, ``penumbra_end_time_s``, NaN outside the record): whole penumbra
-inside the record, under way at the first frame, not ended by the last frame; for the pixels under way at the first frame
-the arrival reasons and the ramp states. Also the CPU time (``time.process_time``, every
-thread) of each pass and of the step that times descents under way at their start from the
-neighbours' lit-to-shadow ratio (``outdoor.descent._neighbours_lit``, where the installed
-package has it) with the number of pixels it reads.
+and ``cloud_shade``, are those of the first pass run on rows ``A:B`` alone) and reports the
+combined arrival error against the pixel-centre truth (class-3 pixels, median intervals:
+median / p95 / beyond 5 (coverage), signed median), overall and, with the disc sun, by the
+pixel's penumbra in the truth (``penumbra_start_time_s``, ``penumbra_end_time_s``, NaN outside
+the record): whole penumbra inside the record, under way at the first frame, not ended by the
+last frame; for the pixels under way at the first frame the arrival reasons and the ramp states.
+Also the CPU time (``time.process_time``, every thread) of each pass and of the step that times
+descents under way at their start from the neighbours' lit-to-shadow ratio
+(``outdoor.descent._neighbours_lit``, where the installed package has it) with the number of
+pixels it reads.
 
 Run it with ``PYTHONPATH`` on a source tree to measure that tree (before -> after of a change).
 """
