@@ -3,19 +3,24 @@
 Usage::
 
     python scripts/measure_outdoor_under_way.py [render options of measure_outdoor_gain.py]
-        [--save MAPS.npz]
+        [--capture RESULTS_DIR] [--rows A B] [--gains-from-rows A B] [--save MAPS.npz]
 
 Renders (or reads from ``--cache``) the ridge sunset of ``scripts/measure_outdoor_gain.py``
-(seed 3, every nuisance, 14-bit Poisson-Gaussian noise on linear RGB), runs the outdoor passes in
-process (photometry, edge tracking, arrival map) and reports the combined arrival error against
-the pixel-centre truth (class-3 pixels, median intervals: median / p95 / beyond 5 (coverage),
-signed median), overall and, with the disc sun, by the pixel's penumbra in the truth
-(``penumbra_start_time_s``, ``penumbra_end_time_s``, NaN outside the record): whole penumbra
-inside the record, under way at the first frame, not ended by the last frame; for the pixels under way at the first frame
-the arrival reasons and the ramp states. Also the CPU time (``time.process_time``, every
-thread) of each pass and of the step that times descents under way at their start from the
-neighbours' lit-to-shadow ratio (``outdoor.descent._neighbours_lit``, where the installed
-package has it) with the number of pixels it reads.
+(seed 3, every nuisance, 14-bit Poisson-Gaussian noise on linear RGB), or with ``--capture`` reads
+a workflow dataset's decoded frame store and rendered truth (``RESULTS_DIR/frames/timelapse.zarr``,
+``RESULTS_DIR/capture/ground_truth.nc``: the DNG path), optionally keeps rows ``A:B`` of both
+(``--rows``), runs the outdoor passes in process (photometry, edge tracking, arrival map; with
+``--gains-from-rows`` the first pass's per-frame curves, ``gain``, ``gain_sky``, ``gain_source``
+and ``cloud_shade``, are those of the first pass run on rows ``A:B`` alone) and reports the
+combined arrival error against the pixel-centre truth (class-3 pixels, median intervals:
+median / p95 / beyond 5 (coverage), signed median), overall and, with the disc sun, by the
+pixel's penumbra in the truth (``penumbra_start_time_s``, ``penumbra_end_time_s``, NaN outside
+the record): whole penumbra inside the record, under way at the first frame, not ended by the
+last frame; for the pixels under way at the first frame the arrival reasons and the ramp states.
+Also the CPU time (``time.process_time``, every thread) of each pass and of the step that times
+descents under way at their start from the neighbours' lit-to-shadow ratio
+(``outdoor.descent._neighbours_lit``, where the installed package has it) with the number of
+pixels it reads.
 
 Run it with ``PYTHONPATH`` on a source tree to measure that tree (before -> after of a change).
 """
@@ -25,16 +30,20 @@ import os
 import time
 
 import numpy as np
+import xarray as xr
 
 import shadowcam.outdoor.descent as descent
 from measure_outdoor_gain import add_render_arguments, load
 from shadowcam.outdoor.accuracy import arrival_errors, map_to_truth_camera
+from shadowcam.io.frame_store import open_frames
 from shadowcam.outdoor.arrival import ARRIVAL_REASONS, arrival_map
 from shadowcam.outdoor.edges import track_edges
 from shadowcam.outdoor.photometry import photometry_from_frames
 
 #: options of this script that are not the render's (left out of the cache key)
-OWN_OPTIONS = ("save",)
+OWN_OPTIONS = ("save", "capture", "rows", "gains_from_rows")
+#: the first pass's per-frame curves that ``--gains-from-rows`` takes from a band of rows
+FRAME_CURVES = ("gain", "gain_sky", "gain_source", "cloud_shade")
 
 
 class _StepClock:
@@ -72,18 +81,46 @@ def _nearest(values, shift_row, shift_col):
     return values[np.ix_(r, c)]
 
 
+def _rows(dataset, rows):
+    return dataset if rows is None else dataset.isel(row=slice(*rows))
+
+
+def _with_curves(photometry, source):
+    """`photometry` with the per-frame curves (:data:`FRAME_CURVES`) of `source`."""
+    out = photometry.copy()
+    for name in FRAME_CURVES:
+        if name in out.coords:
+            out = out.assign_coords({name: source[name]})
+        else:
+            out[name] = source[name]
+    return out
+
+
 def main():
     parser = add_render_arguments(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     parser.add_argument("--save", default=None, help="write the maps (estimate, reason, state, truth) here")
+    parser.add_argument("--capture", default=None,
+                        help="a workflow dataset's results dir: its frame store and rendered truth, not a render")
+    parser.add_argument("--rows", type=int, nargs=2, default=None, metavar=("A", "B"), help="keep rows A:B")
+    parser.add_argument("--gains-from-rows", type=int, nargs=2, default=None, metavar=("A", "B"),
+                        help="per-frame gains and cloud shade from the first pass on rows A:B alone")
     args = parser.parse_args()
     render_args = argparse.Namespace(**{k: v for k, v in vars(args).items() if k not in OWN_OPTIONS})
-    store, truth = load(render_args)
+    if args.capture:
+        store = open_frames(os.path.join(args.capture, "frames", "timelapse.zarr"))
+        truth = xr.load_dataset(os.path.join(args.capture, "capture", "ground_truth.nc"))
+        render_args = argparse.Namespace(capture=args.capture)
+    else:
+        store, truth = load(render_args)
+    store, truth = _rows(store, args.rows), _rows(truth, args.rows)
     clock = None
     if hasattr(descent, "_neighbours_lit"):
         clock = descent._neighbours_lit = _StepClock(descent._neighbours_lit)
     cpu = [time.process_time()]
     wall = time.perf_counter()
     photometry = photometry_from_frames(store)
+    if args.gains_from_rows:
+        photometry = _with_curves(photometry, photometry_from_frames(_rows(store, args.gains_from_rows)))
     cpu.append(time.process_time())
     edges = track_edges(store, photometry)
     cpu.append(time.process_time())
@@ -99,7 +136,8 @@ def main():
     true_arrival = truth["arrival_time_s"].values
     class3 = truth["shadow_class"].values == 3
     height, width = class3.shape
-    print(f"{vars(render_args)} ({os.path.dirname(os.path.dirname(descent.__file__))})")
+    print(f"{vars(render_args)} rows {args.rows} gains from rows {args.gains_from_rows} "
+          f"({os.path.dirname(os.path.dirname(descent.__file__))})")
     print(f"  {height}x{width} px, {times.size} frames; CPU s photometry {cpu[1] - cpu[0]:.2f}, edges "
           f"{cpu[2] - cpu[1]:.2f}, arrival {cpu[3] - cpu[2]:.2f}; wall {wall:.1f} s")
     if clock is not None:
