@@ -15,7 +15,7 @@ SHADOW_TIME_METHODS : name -> timing function ``f(summary) -> (time, entry, exit
 REASONS : flag code -> meaning, for pixels without a reliable time.
 TIMED : the codes of the pixels with a time.
 classify_dips : reason code, contrast and confidence per pixel.
-shadow_times : timing + classification of one sweep's :class:`DipSummary`.
+shadow_times : timing of one sweep's classified :class:`DipSummary`.
 footprint_spread_std : time uncertainty of a footprint that sees two surfaces' shadow times.
 support_threshold, support_intervals, DipSupport : a dip's excursion below the lit level (several minima, one dip).
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
@@ -28,8 +28,8 @@ shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials
 """
 
 import logging
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numba as nb
 import numpy as np
@@ -587,16 +587,17 @@ def classify_dips(summary, *, saturated=None, site_level=None, site_colour=None,
     return reason, np.nan_to_num(contrast, nan=0.0, posinf=0.0).astype(np.float32)
 
 
-def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=None, interval=None,
-                 support=None, **classify_params):
-    """Time and classify the dips of one sweep.
+def shadow_times(summary, reason, contrast, *, method="edge_fit", method_params=None, interval=None,
+                 support=None):
+    """Time the dips of one classified sweep.
 
     Parameters
     ----------
     summary : DipSummary
+    reason, contrast : (H, W) ndarray
+        The sweep's :func:`classify_dips` (with the same `interval`).
     method : str, optional
         Key of :data:`SHADOW_TIME_METHODS`.
-    saturated : (H, W) bool ndarray, optional
     method_params : dict, optional
         Keyword options of the timing method.
     interval : DipInterval, optional
@@ -607,12 +608,10 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
         ``interval_*`` variables are returned, and ``time_std`` adds the
         footprint's excess span (:func:`footprint_spread_std`).
     support : DipSupport, optional
-        The dips' excursions below the lit level (:func:`support_intervals`):
+        The dips' excursions below the lit level (:func:`support_intervals` of `reason`):
         a ``several_minima`` or ``wide_dip`` pixel whose minima lie in one excursion
         below the lit level is one dip, timed at its removed light's centroid
         (:func:`_time_connected_dips`). Needs `interval`.
-    **classify_params
-        Options of :func:`classify_dips`.
 
     Returns
     -------
@@ -627,7 +626,8 @@ def shadow_times(summary, *, method="edge_fit", saturated=None, method_params=No
         raise ValueError(
             f"method must be one of {sorted(SHADOW_TIME_METHODS)}, got {method!r}"
         )
-    reason, contrast = classify_dips(summary, saturated=saturated, interval=interval, **classify_params)
+    if support is not None and interval is None:
+        raise ValueError("support needs the interval it was measured with")
     masked = _masked_summary(summary, reason == OK)
     time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
     if interval is not None:
@@ -787,11 +787,10 @@ def support_threshold(summary, *, false_alarm=1e-2, noise_floor=1e-4):
     return level - np.minimum(z * noise, 0.5 * depth)
 
 
-def support_intervals(read, summary, interval, *, false_alarm=1e-2, classify_params=None):
+def support_intervals(read, summary, interval, reason, *, false_alarm=1e-2):
     """The crossings of :func:`support_threshold` of the pixels whose dip shows several minima.
 
-    Only the ``several_minima`` and ``wide_dip`` pixels of :func:`classify_dips`
-    are measured. Their lit noise counts the parts of the dip outside the
+    Only the ``several_minima`` and ``wide_dip`` pixels of `reason` are measured. Their lit noise counts the parts of the dip outside the
     half-depth interval as lit (a second lobe of a sampled light inflates it to a
     fraction of the depth), so the support is found in two passes: first at the
     lit level itself (the signal's first return to it, a frame or so outside the
@@ -807,16 +806,15 @@ def support_intervals(read, summary, interval, *, false_alarm=1e-2, classify_par
     summary : DipSummary
     interval : DipInterval
         The half-depth intervals (whose ``beyond_*`` samples `summary` no longer counts as lit).
+    reason : (H, W) uint8 ndarray
+        The sweep's :func:`classify_dips` with `interval`.
     false_alarm : float, optional
         Of :func:`support_threshold`.
-    classify_params : mapping, optional
-        Options of :func:`classify_dips`.
 
     Returns
     -------
     DipSupport
     """
-    reason, _ = classify_dips(summary, interval=interval, **dict(classify_params or {}))
     candidate = np.isin(reason, (SEVERAL_MINIMA, WIDE_DIP))
     first = track_intervals(read(), summary, threshold=np.where(candidate, summary.lit_level, np.nan))
     level, noise, _, _ = lit_without(summary, np.maximum(first.beyond_count - interval.beyond_count, 0),
@@ -1052,16 +1050,13 @@ def cfa_site_colours(shape, pattern):
 
 
 def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_pattern=None,
-                       method_params=None, classify_params=None, progress=None):
+                       own_site=False, method_params=None, classify_params=None, progress=None):
     """Shadow times of one sweep from its frames, streamed.
 
     Parameters
     ----------
     blocks : iterable of (T, H, W, C) float ndarray
-        Linear frames in time order. A sequence (e.g. a list of blocks) of demosaiced RAW
-        frames is read twice: ``edge_fit`` then times each pixel from its own site where
-        its noise allows (:func:`shadowcam.lab.site_signal.track_site_window`); a one-shot
-        iterable is read once and timed from the channel sum.
+        Linear frames in time order; read once, or twice with `own_site`.
     shape : tuple of int
         ``(H, W)``.
     method : str, optional
@@ -1071,6 +1066,10 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
     cfa_pattern : str, optional
         Bayer pattern when the frames were demosaiced from RAW (e.g. ``"RGGB"``);
         the shadow-boundary test then uses each site's measured channel.
+    own_site : bool, optional
+        Time each pixel from its own mosaic site where its noise allows (as
+        :func:`summary_shadow_times`): needs `cfa_pattern`, ``edge_fit`` and `blocks`
+        that can be read again (a collection such as a list, not a one-shot iterator).
     method_params, classify_params : dict, optional
         Options of the timing method and of :func:`classify_dips`.
     progress : callable, optional
@@ -1081,21 +1080,24 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
     results : dict of (H, W) ndarrays
         As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)`` and ``n_frames``.
     """
+    if own_site and iter(blocks) is blocks:
+        raise ValueError("own_site reads the frames a second time: blocks must be a collection such as a "
+                         "list of blocks, not a one-shot iterator")
     summary, _, _ = track_sweep(blocks, shape, half_window=half_window, progress=progress)
-    site = None
-    if cfa_pattern and method == "edge_fit" and isinstance(blocks, Sequence):
-        site = track_site_window(blocks, summary, site_colour=cfa_site_colours(shape, cfa_pattern))
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, site=site,
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, own_site=own_site,
+                                read=(lambda: blocks) if own_site else None,
                                 method_params=method_params, classify_params=classify_params)
 
 
 def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
-                         classify_params=None, interval=None, site=None, support=None):
+                         classify_params=None, interval=None, read=None, own_site=False):
     """Shadow times of one sweep from its tracked :class:`DipSummary`.
 
     The second half of :func:`sweep_shadow_times`, for a summary obtained
     otherwise, e.g. :func:`shadowcam.lab.dip_tracker.merge_partials` of time chunks
-    tracked in separate jobs (the result is then the same bit for bit).
+    tracked in separate jobs (the result is then the same bit for bit). The dips are
+    classified once (:func:`classify_dips`); that classification chooses the pixels
+    whose support is measured and is then timed.
 
     Parameters
     ----------
@@ -1104,22 +1106,35 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
     method, cfa_pattern, method_params, classify_params
         As :func:`sweep_shadow_times`.
     interval : DipInterval, optional
-    support : DipSupport, optional
         As :func:`shadow_times`.
-    site : SiteWindow, optional
-        The RAW sites' own samples (:func:`shadowcam.lab.site_signal.track_site_window`):
-        ``edge_fit`` times each pixel from its own site where its noise allows (other
-        methods time the channel sum).
+    read : callable, optional
+        ``read()`` -> an iterable of the sweep's ``(T, H, W, C)`` frame blocks in time
+        order, from its first frame (read lazily, only for what needs the frames
+        again). With `interval`, the dips' support (:func:`support_intervals`) is
+        measured and ``several_minima`` / ``wide_dip`` pixels whose minima form one
+        dip are timed (:func:`shadow_times`); without it they are not.
+    own_site : bool, optional
+        ``edge_fit`` times each demosaiced RAW pixel from its own mosaic site where
+        its noise allows (:func:`shadowcam.lab.site_signal.track_site_window`, one more
+        `read`); needs `cfa_pattern`, ``edge_fit`` and `read`.
 
     Returns
     -------
     results : dict of (H, W) ndarrays
         As :func:`shadow_times`, plus ``lit_image`` ``(H, W, C)``, ``saturated`` (bool)
         and ``n_frames``.
+
+    Raises
+    ------
+    ValueError
+        If `own_site` is asked for without a CFA pattern, with a method other than
+        ``edge_fit`` or without `read`.
     """
+    if own_site and not (cfa_pattern and method == "edge_fit" and read is not None):
+        raise ValueError("own_site timing needs the frames' CFA pattern (cfa_pattern), method 'edge_fit' and a "
+                         f"way to read the frames again (read); got cfa_pattern={cfa_pattern!r}, "
+                         f"method={method!r}, read={'given' if read is not None else None}")
     lit_image = lit_colour(summary)
-    if site is not None:
-        summary = replace(summary, site=site)
     classify_params = dict(classify_params or {})
     if cfa_pattern:
         colour = cfa_site_colours(summary.lit_level.shape, cfa_pattern)
@@ -1127,8 +1142,15 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
             site_colour=colour,
             site_level=np.take_along_axis(lit_image, colour[..., None].astype(np.intp), axis=2)[..., 0],
         )
-    results = shadow_times(summary, method=method, saturated=summary.saturated,
-                           method_params=method_params, interval=interval, support=support, **classify_params)
+    reason, contrast = classify_dips(summary, saturated=summary.saturated, interval=interval, **classify_params)
+    support = None
+    if interval is not None and read is not None:
+        support = support_intervals(read, summary, interval, reason)
+    if own_site:
+        site = track_site_window(read(), summary, site_colour=cfa_site_colours(summary.lit_level.shape, cfa_pattern))
+        summary = replace(summary, site=site)
+    results = shadow_times(summary, reason, contrast, method=method, method_params=method_params,
+                           interval=interval, support=support)
     results["lit_image"] = lit_image
     if summary.saturated is not None:
         results["saturated"] = summary.saturated
@@ -1226,6 +1248,13 @@ def check_timed(shadow_time, *, min_coverage=MIN_COVERAGE):
                        hint=_EMPTY_HINTS[worst], min_coverage=min_coverage)
 
 
+def _store_blocks(frames):
+    """The frame blocks of a frame store, ``(T, H, W, C)`` each, in time order."""
+    from shadowcam.io.frame_store import iter_frame_chunks
+
+    return (block for _, block in iter_frame_chunks(frames))
+
+
 def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_window=4, method_params=None,
                           classify_params=None, min_coverage=MIN_COVERAGE):
     """Shadow times of every sweep of a capture.
@@ -1260,7 +1289,6 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
     ValueError
         If a sweep has (almost) no timed pixel, with the reason counts.
     """
-    from shadowcam.io.frame_store import iter_frame_chunks
     from shadowcam.lab.dip_tracker import DipPartial, merge_partials, track_intervals, without_interval
 
     if method not in SHADOW_TIME_METHODS:
@@ -1282,19 +1310,17 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
         else:
             log.info("sweep %s: %d frames of %dx%d", sweep, n_frames, shape[0], shape[1])
             progress = Progress(max(n_frames, 1), f"shadow times of sweep {sweep}")
-            summary, _, _ = track_sweep((block for _, block in iter_frame_chunks(frames)), shape,
+            summary, _, _ = track_sweep(_store_blocks(frames), shape,
                                         half_window=half_window, progress=progress.update)
         log.info("sweep %s: dip intervals", sweep)
-        interval = track_intervals((block for _, block in iter_frame_chunks(frames)), summary)
+        interval = track_intervals(_store_blocks(frames), summary)
         summary, interval = without_interval(summary, interval)
-        support = support_intervals(lambda: (block for _, block in iter_frame_chunks(frames)), summary, interval,
-                                    classify_params=classify_params)
-        site = None
-        if options["cfa_pattern"] and method == "edge_fit":
+        own_site = bool(options["cfa_pattern"]) and method == "edge_fit"
+        if own_site:
             log.info("sweep %s: own-site samples of the dip windows", sweep)
-            site = track_site_window((block for _, block in iter_frame_chunks(frames)), summary,
-                                     site_colour=cfa_site_colours(shape, options["cfa_pattern"]))
-        per_sweep[sweep] = summary_shadow_times(summary, interval=interval, site=site, support=support, **options)
+        per_sweep[sweep] = summary_shadow_times(summary, interval=interval, own_site=own_site,
+                                                read=partial(_store_blocks, frames),
+                                                **options)
     dataset = shadow_time_dataset(per_sweep)
     check_timed(dataset, min_coverage=min_coverage)
     return dataset

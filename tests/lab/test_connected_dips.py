@@ -6,7 +6,7 @@ import pytest
 
 from shadowcam.lab.dip_tracker import track_intervals, without_interval
 from shadowcam.lab.shadow_time import (
-    OK, SEVERAL_MINIMA, WIDE_DIP, summary_shadow_times, support_intervals, support_threshold, track_sweep,
+    OK, SEVERAL_MINIMA, WIDE_DIP, classify_dips, summary_shadow_times, support_intervals, support_threshold, track_sweep,
 )
 
 #: the renderer's 4 x 4 disc samples (equal-area polar strata) projected on the sweep direction,
@@ -35,8 +35,8 @@ def _times(frames, *, with_support=True):
     """As ``shadow_time_of_stores`` runs a sweep."""
     summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)
     summary, interval = without_interval(summary, track_intervals([frames], summary))
-    support = support_intervals(lambda: [frames], summary, interval) if with_support else None
-    return summary_shadow_times(summary, interval=interval, support=support, method="edge_fit")
+    return summary_shadow_times(summary, interval=interval, read=(lambda: [frames]) if with_support else None,
+                                method="edge_fit")
 
 
 def test_a_thin_wire_under_a_sampled_disc_is_one_dip_timed_at_the_discs_centre(wire_sweep):
@@ -106,9 +106,10 @@ def test_the_frames_are_not_read_again_when_no_dip_has_several_minima(wire_sweep
         raise AssertionError("the frames were read")
         yield frames
 
-    support = support_intervals(read, summary, interval)
+    reason, _ = classify_dips(summary, interval=interval)
+    support = support_intervals(read, summary, interval, reason)
     assert not np.isfinite(support.centroid).any()
     before = summary_shadow_times(summary, interval=interval)
-    after = summary_shadow_times(summary, interval=interval, support=support)
+    after = summary_shadow_times(summary, interval=interval, read=read)
     for name in ("shadow_time", "reason", "interval_entry", "time_std"):
         np.testing.assert_array_equal(after[name], before[name])
