@@ -1,13 +1,13 @@
 """A thin wire under an area light wider than it: one shallow dip with several minima, timed at
-its removed light's centroid (``shadow_time.support_intervals``), against exact ground truth."""
+its removed light's centroid (``connected_dips.support_intervals``), against exact ground truth."""
 
 import numpy as np
 import pytest
 
 from shadowcam.lab.dip_tracker import track_intervals, without_interval
-from shadowcam.lab.shadow_time import (
-    OK, SEVERAL_MINIMA, WIDE_DIP, classify_dips, summary_shadow_times, support_intervals, support_threshold, track_sweep,
-)
+from shadowcam.lab.connected_dips import support_intervals, support_threshold
+from shadowcam.lab.dip_classification import OK, SEVERAL_MINIMA, WIDE_DIP, classify_dips
+from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
 
 #: the renderer's 4 x 4 disc samples (equal-area polar strata) projected on the sweep direction,
 #: as fractions of the disc's radius: two groups either side of the centre, none at it
@@ -83,7 +83,7 @@ def test_a_second_shadow_after_a_return_to_the_lit_level_stays_several_minima(wi
 
 
 def test_the_support_threshold_is_the_lit_level_less_what_noise_reaches(wire_sweep):
-    from shadowcam.lab.shadow_time import detection_threshold, _SMOOTHED_NOISE
+    from shadowcam.lab.dip_classification import _SMOOTHED_NOISE, detection_threshold
 
     frames, _ = _disc_sweep(wire_sweep, noise=0.01)
     summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)

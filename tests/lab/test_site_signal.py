@@ -18,9 +18,10 @@ import pytest
 from shadowcam._shared.flux_centroid import flux_centroid_shift
 from shadowcam.io.cfa import demosaic_bilinear
 from shadowcam.lab.mosaic_signal import mosaic_signal
-from shadowcam.lab.shadow_time import (OK, _site_times, cfa_site_colours, summary_shadow_times, sweep_shadow_times,
-                                       track_sweep)
-from shadowcam.lab.site_signal import blend_variance, track_site_window
+from shadowcam.lab.dip_classification import OK
+from shadowcam.lab.shadow_time import summary_shadow_times, sweep_shadow_times, track_sweep
+from shadowcam.lab.shadow_time_methods import _site_times
+from shadowcam.lab.site_signal import blend_variance, cfa_site_colours, track_site_window
 
 SHAPE = (24, 32)
 WHITE, BLACK = 4095, 256
