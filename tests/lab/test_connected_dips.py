@@ -113,3 +113,20 @@ def test_the_frames_are_not_read_again_when_no_dip_has_several_minima(wire_sweep
     after = summary_shadow_times(summary, interval=interval, read=read)
     for name in ("shadow_time", "reason", "interval_entry", "time_std"):
         np.testing.assert_array_equal(after[name], before[name])
+
+
+def test_a_sweep_with_connected_dips_is_classified_once(wire_sweep, monkeypatch):
+    # the support of the several-minima pixels is measured on the sweep's one classification
+    import shadowcam.lab.shadow_time as shadow_time
+
+    frames, _ = _disc_sweep(wire_sweep)
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return classify_dips(*args, **kwargs)
+
+    monkeypatch.setattr(shadow_time, "classify_dips", counted)
+    result = _times(frames)
+    assert len(calls) == 1
+    assert np.mean(result["reason"] == OK) >= 0.98  # the connected dips were measured and timed
