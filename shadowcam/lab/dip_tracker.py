@@ -40,6 +40,7 @@ half_depth : the default crossing level.
 without_interval : the summary's lit statistics without the whole dip, and the crossings at its half depth.
 lit_without : the lit level, noise and count with some lit samples taken out.
 window_intervals : the interval of the pixels whose crossings lie in their stored window.
+lit_colour : unshadowed colour per pixel from a summary with channel sums.
 track_intervals : the interval of every pixel: from the window, else a pass over the sweep's frames.
 """
 
@@ -899,3 +900,18 @@ def without_interval(summary, interval):
         entry = np.where(changed, interval.entry - shift / interval.entry_slope, interval.entry)
         exit_ = np.where(changed, interval.exit + shift / interval.exit_slope, interval.exit)
     return new_summary, replace(interval, entry=entry, exit=exit_, threshold=threshold)
+
+
+def lit_colour(summary):
+    """Unshadowed colour per pixel, ``(H, W, C)`` float32.
+
+    The channel means scaled by the ratio of the lit level to the mean level
+    (the mask removes light from all channels alike).
+    """
+    if summary.channel_sum is None:
+        raise ValueError("summary has no channel sums: feed the tracker (T, H, W, C) blocks")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        # a pixel with no light at all (mean 0) has no colour, not an infinite one
+        scale = np.where(summary.mean_level > 0, summary.lit_level / summary.mean_level, 0.0)
+        lit_image = summary.channel_sum / summary.n_frames * scale[..., None]
+    return np.nan_to_num(lit_image, nan=0.0).astype(np.float32)

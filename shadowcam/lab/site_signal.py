@@ -5,7 +5,7 @@ The tracker follows the channel sum of the bilinear demosaic
 two thirds come from its neighbours (the 8 around a red or blue site, the 4 edge
 ones of a green site), each shadowed at its own time. The dip's window is found
 on that sum (its noise is the lowest), and the pixel is then timed from the site's
-own samples where their noise allows (:func:`shadowcam.lab.shadow_time.time_edge_fit`).
+own samples where their noise allows (:func:`shadowcam.lab.shadow_time_methods.time_edge_fit`).
 The demosaic keeps a site's own value in its own channel, so those samples are
 read from the demosaiced frames without the mosaic. Under several lights each minimum's
 window carries its own :class:`SiteWindow`, in the units of its normalised window
@@ -17,6 +17,7 @@ SiteWindow : own-site samples at the window's frames, and the site's lit level a
 own_site_samples : each site's own channel of a demosaiced block.
 track_site_window : one pass over a sweep's demosaiced frames -> the :class:`SiteWindow`.
 blend_variance : per-axis second moment of the channel sum's (or its neighbours' part's) demosaic taps.
+cfa_site_colours : the CFA channel measured at each pixel of a Bayer mosaic.
 """
 
 from dataclasses import dataclass
@@ -97,7 +98,7 @@ def track_site_window(blocks, summary, *, site_colour):
     summary : DipSummary
         The tracked sweep (its ``window_start`` and window length).
     site_colour : (H, W) int ndarray
-        CFA channel of each site (:func:`shadowcam.lab.shadow_time.cfa_site_colours`).
+        CFA channel of each site (:func:`cfa_site_colours`).
 
     Returns
     -------
@@ -167,3 +168,25 @@ def blend_variance(site_colour, *, own=True):
     colour = check_array(site_colour, "site_colour", ndim=2, dtype_kind="iu")
     which = 0 if own else 1
     return np.where(colour == _GREEN, _BLEND_VARIANCE["green"][which], _BLEND_VARIANCE["red_blue"][which])
+
+
+def cfa_site_colours(shape, pattern):
+    """Channel index (0 R, 1 G, 2 B) measured at each pixel of a Bayer mosaic.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        ``(H, W)``.
+    pattern : str
+        CFA letters of the top-left 2x2 block in reading order, e.g. ``"RGGB"``.
+
+    Returns
+    -------
+    (H, W) int8 ndarray
+    """
+    if len(pattern) != 4 or set(pattern) - set("RGB"):
+        raise ValueError(f"pattern must be four letters of R, G, B such as 'RGGB'; got {pattern!r}")
+    tile = np.array(["RGB".index(ch) for ch in pattern], np.int8).reshape(2, 2)
+    rows = np.arange(shape[0])[:, None] % 2
+    cols = np.arange(shape[1])[None, :] % 2
+    return tile[rows, cols]

@@ -1,13 +1,13 @@
 """A thin wire under an area light wider than it: one shallow dip with several minima, timed at
-its removed light's centroid (``shadow_time.support_intervals``), against exact ground truth."""
+its removed light's centroid (``connected_dips.support_intervals``), against exact ground truth."""
 
 import numpy as np
 import pytest
 
 from shadowcam.lab.dip_tracker import track_intervals, without_interval
-from shadowcam.lab.shadow_time import (
-    OK, SEVERAL_MINIMA, WIDE_DIP, summary_shadow_times, support_intervals, support_threshold, track_sweep,
-)
+from shadowcam.lab.connected_dips import support_intervals, support_threshold
+from shadowcam.lab.dip_classification import OK, SEVERAL_MINIMA, WIDE_DIP, classify_dips
+from shadowcam.lab.shadow_time import summary_shadow_times, track_sweep
 
 #: the renderer's 4 x 4 disc samples (equal-area polar strata) projected on the sweep direction,
 #: as fractions of the disc's radius: two groups either side of the centre, none at it
@@ -35,8 +35,8 @@ def _times(frames, *, with_support=True):
     """As ``shadow_time_of_stores`` runs a sweep."""
     summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)
     summary, interval = without_interval(summary, track_intervals([frames], summary))
-    support = support_intervals(lambda: [frames], summary, interval) if with_support else None
-    return summary_shadow_times(summary, interval=interval, support=support, method="edge_fit")
+    return summary_shadow_times(summary, interval=interval, read=(lambda: [frames]) if with_support else None,
+                                method="edge_fit")
 
 
 def test_a_thin_wire_under_a_sampled_disc_is_one_dip_timed_at_the_discs_centre(wire_sweep):
@@ -83,7 +83,7 @@ def test_a_second_shadow_after_a_return_to_the_lit_level_stays_several_minima(wi
 
 
 def test_the_support_threshold_is_the_lit_level_less_what_noise_reaches(wire_sweep):
-    from shadowcam.lab.shadow_time import detection_threshold, _SMOOTHED_NOISE
+    from shadowcam.lab.dip_classification import _SMOOTHED_NOISE, detection_threshold
 
     frames, _ = _disc_sweep(wire_sweep, noise=0.01)
     summary, _, _ = track_sweep([frames], frames.shape[1:3], half_window=4)
@@ -106,9 +106,27 @@ def test_the_frames_are_not_read_again_when_no_dip_has_several_minima(wire_sweep
         raise AssertionError("the frames were read")
         yield frames
 
-    support = support_intervals(read, summary, interval)
+    reason, _ = classify_dips(summary, interval=interval)
+    support = support_intervals(read, summary, interval, reason)
     assert not np.isfinite(support.centroid).any()
     before = summary_shadow_times(summary, interval=interval)
-    after = summary_shadow_times(summary, interval=interval, support=support)
+    after = summary_shadow_times(summary, interval=interval, read=read)
     for name in ("shadow_time", "reason", "interval_entry", "time_std"):
         np.testing.assert_array_equal(after[name], before[name])
+
+
+def test_a_sweep_with_connected_dips_is_classified_once(wire_sweep, monkeypatch):
+    # the support of the several-minima pixels is measured on the sweep's one classification
+    import shadowcam.lab.shadow_time as shadow_time
+
+    frames, _ = _disc_sweep(wire_sweep)
+    calls = []
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return classify_dips(*args, **kwargs)
+
+    monkeypatch.setattr(shadow_time, "classify_dips", counted)
+    result = _times(frames)
+    assert len(calls) == 1
+    assert np.mean(result["reason"] == OK) >= 0.98  # the connected dips were measured and timed

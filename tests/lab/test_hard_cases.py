@@ -15,8 +15,9 @@ from shadowcam.lab.dip_tracker import DipTracker
 from shadowcam.cameras.dual_coords import (dual_coords_calibration, dual_coords_uniform,
                                    fit_time_to_plane)
 from shadowcam.synthetic.sensor import SensorModel, raw_to_linear, simulate_raw
-from shadowcam.lab.shadow_time import (OK, REASONS, SATURATED, SEVERAL_MINIMA, SHADOW_TIME_METHODS,
-                                   sweep_shadow_times)
+from shadowcam.lab.dip_classification import OK, REASONS, SATURATED, SEVERAL_MINIMA
+from shadowcam.lab.shadow_time import sweep_shadow_times
+from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
 
 METHODS = sorted(SHADOW_TIME_METHODS)
 LEVEL = 0.6  # lit level of the synthetic pixels (white = 1)

@@ -5,11 +5,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from shadowcam.lab.shadow_time import (
-    LOW_CONTRAST, NEVER_SHADOWED, OK, SATURATED, SEVERAL_MINIMA, INVALID_INPUT,
-    SHADOW_TIME_METHODS, cfa_site_colours, detection_threshold, shadow_time_dataset,
-    sweep_shadow_times,
+from shadowcam.lab.dip_classification import (
+    INVALID_INPUT, LOW_CONTRAST, NEVER_SHADOWED, OK, SATURATED, SEVERAL_MINIMA, detection_threshold,
 )
+from shadowcam.lab.shadow_time import shadow_time_dataset, sweep_shadow_times
+from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
+from shadowcam.lab.site_signal import cfa_site_colours
 
 
 def run(frames, **kwargs):

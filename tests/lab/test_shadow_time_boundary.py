@@ -54,7 +54,7 @@ def _edge_sweep(wire_sweep, *, x_edge, shading, electrons=None, read_noise=6.0, 
 
 def _run(frames):
     return sweep_shadow_times([frames[i:i + 8] for i in range(0, len(frames), 8)], SHAPE,
-                              cfa_pattern="RGGB")
+                              cfa_pattern="RGGB", own_site=True)
 
 
 def test_a_lit_pixel_beside_a_shadowed_same_colour_site_is_not_a_boundary(wire_sweep):

@@ -18,9 +18,10 @@ import pytest
 from shadowcam._shared.flux_centroid import flux_centroid_shift
 from shadowcam.io.cfa import demosaic_bilinear
 from shadowcam.lab.mosaic_signal import mosaic_signal
-from shadowcam.lab.shadow_time import (OK, _site_times, cfa_site_colours, summary_shadow_times, sweep_shadow_times,
-                                       track_sweep)
-from shadowcam.lab.site_signal import blend_variance, track_site_window
+from shadowcam.lab.dip_classification import OK
+from shadowcam.lab.shadow_time import summary_shadow_times, sweep_shadow_times, track_sweep
+from shadowcam.lab.shadow_time_methods import _site_times
+from shadowcam.lab.site_signal import blend_variance, cfa_site_colours, track_site_window
 
 SHAPE = (24, 32)
 WHITE, BLACK = 4095, 256
@@ -81,7 +82,7 @@ def _blend_bias(truth, own):
 
 def test_bright_raw_is_timed_from_the_own_site_to_the_quantisation(wire_sweep):
     frames, truth, own = _raw_sweep(wire_sweep)
-    result = sweep_shadow_times(_blocks(frames), SHAPE, cfa_pattern="RGGB")
+    result = sweep_shadow_times(_blocks(frames), SHAPE, cfa_pattern="RGGB", own_site=True)
     err = _errors(result, truth)
     assert err.size > 0.9 * (SHAPE[0] - 2) * (SHAPE[1] - 2)
     # 12-bit quantisation: 1 DN in >= 1150 (the darkest site, 0.3 of 3839 DN) on each of the
@@ -99,7 +100,7 @@ def test_dim_raw_falls_back_to_the_channel_sum_without_losing_coverage(wire_swee
     frames, truth, _ = _raw_sweep(wire_sweep, electrons=30.0, read_noise=6.0, seed=3)
     summary, _, _ = track_sweep(_blocks(frames), SHAPE)
     site = track_site_window(_blocks(frames), summary, site_colour=cfa_site_colours(SHAPE, "RGGB"))
-    new = summary_shadow_times(summary, cfa_pattern="RGGB", site=site)
+    new = summary_shadow_times(summary, cfa_pattern="RGGB", own_site=True, read=lambda: _blocks(frames))
     old = summary_shadow_times(summary, cfa_pattern="RGGB")
     np.testing.assert_array_equal(new["reason"], old["reason"])  # the same pixels are timed
     assert (new["reason"] == OK).mean() > 0.9
@@ -117,7 +118,7 @@ def test_dim_raw_falls_back_to_the_channel_sum_without_losing_coverage(wire_swee
 
 def test_without_a_mosaic_the_times_are_the_channel_sum_bit_for_bit(wire_sweep):
     frames, _ = wire_sweep(shape=SHAPE, n_frames=48, px_per_frame=1.0, t0=4.0, noise=0.0)
-    listed = sweep_shadow_times(_blocks(frames), SHAPE)  # a sequence: read twice only for RAW
+    listed = sweep_shadow_times(_blocks(frames), SHAPE)
     streamed = sweep_shadow_times(iter(_blocks(frames)), SHAPE)
     for key in ("shadow_time", "time_std", "reason"):
         np.testing.assert_array_equal(listed[key], streamed[key])
@@ -170,3 +171,19 @@ def test_blend_variance_is_the_second_moment_of_the_channel_sums_taps(row, col):
     for own, weights in ((True, taps), (False, np.where((r == 0) & (np.arange(14) == col), 0.0, taps))):
         moment = (weights * r**2).sum() / weights.sum()
         assert blend_variance(colour, own=own)[row, col] == pytest.approx(moment, abs=1e-6)
+
+
+def test_own_site_timing_asked_for_where_it_cannot_be_done_is_an_error(wire_sweep):
+    frames, _, _ = _raw_sweep(wire_sweep)
+    with pytest.raises(ValueError, match="one-shot iterator"):
+        sweep_shadow_times(iter(_blocks(frames)), SHAPE, cfa_pattern="RGGB", own_site=True)
+    with pytest.raises(ValueError, match="cfa_pattern"):
+        sweep_shadow_times(_blocks(frames), SHAPE, own_site=True)
+    with pytest.raises(ValueError, match="edge_fit"):
+        sweep_shadow_times(_blocks(frames), SHAPE, cfa_pattern="RGGB", method="dip_centroid", own_site=True)
+    summary, _, _ = track_sweep(_blocks(frames), SHAPE)
+    with pytest.raises(ValueError, match="read"):
+        summary_shadow_times(summary, cfa_pattern="RGGB", own_site=True)
+    # without own_site the same frames are timed from the channel sum, read once
+    once = sweep_shadow_times(iter(_blocks(frames)), SHAPE, cfa_pattern="RGGB")
+    np.testing.assert_array_equal(once["shadow_time"], _summed(frames)["shadow_time"])
