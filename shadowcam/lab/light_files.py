@@ -22,7 +22,6 @@ import xarray as xr
 
 from shadowcam.cameras.array_files import read_stack
 from shadowcam.io.decode import frame_info
-from shadowcam.lab.shadow_time import cfa_site_colours
 from shadowcam.lab.light_views import SWEEPS, light_views_dataset, sweep_light_times, view_attrs
 
 
@@ -33,6 +32,16 @@ def _captured(plan):
                          "top-level lights block over sweeps u, v); render a synthetic one with render-lights "
                          "and pass its capture.json")
     return block
+
+
+def _cfa_pattern(plan):
+    """The CFA pattern of the sweeps' camera RAW files (the first file of each, which must agree),
+    or None for other frames."""
+    patterns = {name: frame_info(plan.sweep(name).files[0])["cfa_pattern"] for name in SWEEPS}
+    if len(set(patterns.values())) > 1:
+        raise ValueError(f"plan: manifest {plan.manifest_path}: the sweeps' first files have CFA patterns "
+                         f"{patterns}; both sweeps must come from one camera")
+    return patterns[SWEEPS[0]] or None
 
 
 def _reference(plan):
@@ -72,15 +81,13 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
     """
     block = _captured(plan)
     described = block["light_along_u"] is not None
+    pattern = _cfa_pattern(plan)
     per_sweep, positions = {}, {}
     for name in SWEEPS:
-        files = plan.sweep(name).files
-        frames = read_stack(files, shape=plan.frame_shape)
-        pattern = frame_info(files[0])["cfa_pattern"]
+        frames = read_stack(plan.sweep(name).files, shape=plan.frame_shape)
         per_sweep[name], positions[name] = sweep_light_times(
             frames, block["count"], sweep=name, light_along=block[f"light_along_{name}"], half_window=half_window,
-            method=method, radius=radius, tolerance=tolerance, check_order=check_order,
-            site_colour=cfa_site_colours(frames.shape[1:3], pattern) if pattern else None)
+            method=method, radius=radius, tolerance=tolerance, check_order=check_order, cfa_pattern=pattern)
         del frames
     attrs = view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
                        check_order=check_order and described)
@@ -107,7 +114,10 @@ def light_set_capture_of_plan(plan):
         ``frames_u``, ``frames_v`` (t, y, x, channel) and ``reference`` (y, x, channel)
         decoded (white 1), ``light_along_u``, ``light_along_v`` (light,) when described,
         and the ground truth's per-light times (``t_center_<s>``, ``t_first_<s>``,
-        ``t_last_<s>``, ``share``) when the manifest names ``ground_truth``.
+        ``t_last_<s>``, ``share``) when the manifest names ``ground_truth``; attr
+        ``cfa_pattern`` for camera RAW files, so that
+        :func:`shadowcam.lab.light_views.light_set_views` times them as
+        :func:`light_set_views_of_plan` does.
     """
     block = _captured(plan)
     data = {f"frames_{name}": ((f"t_{name}", "y", "x", "channel"),
@@ -116,7 +126,9 @@ def light_set_capture_of_plan(plan):
     if block["light_along_u"] is not None:
         data.update({f"light_along_{name}": (("light",), np.asarray(block[f"light_along_{name}"]))
                      for name in SWEEPS})
-    capture = xr.Dataset(data, coords={"channel": ["R", "G", "B"], "light": np.arange(block["count"])})
+    pattern = _cfa_pattern(plan)
+    capture = xr.Dataset(data, coords={"channel": ["R", "G", "B"], "light": np.arange(block["count"])},
+                         attrs={"cfa_pattern": pattern} if pattern else {})
     if block["ground_truth"] is not None:
         with xr.open_dataset(block["ground_truth"]) as opened:
             truth = opened.load()
