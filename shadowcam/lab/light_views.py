@@ -168,13 +168,15 @@ def _edge_fit_per_light(minima, assigned):
 
 
 def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=4, method="edge_fit", radius=2,
-                      tolerance=2.0, check_order=True, cfa_pattern=None):
+                      tolerance=2.0, check_order=True, cfa_pattern=None, shape=None):
     """One sweep's minima assigned to the lights, with the lights' positions along it.
 
     Parameters
     ----------
-    frames : (T, H, W, C) array_like
-        The sweep's frames (any linear scale: radiance, or decoded files with white 1).
+    frames : (T, H, W, C) array_like, or callable
+        The sweep's frames (any linear scale: radiance, or decoded files with white 1), or
+        a callable returning an iterable of consecutive ``(t, H, W, C)`` blocks of them
+        (called twice, :func:`shadowcam.lab.minima.find_minima`; needs `shape`).
     n_lights : int
         Lights (>= 1).
     sweep : str
@@ -191,6 +193,8 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
         minimum is then timed from its own site where that dip is significant against its
         noise (:func:`shadowcam.lab.minima.find_minima`); which minima are found and assigned
         does not depend on it.
+    shape : (int, int), optional
+        ``(H, W)`` of callable `frames`.
 
     Returns
     -------
@@ -208,12 +212,18 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
         Naming the parameter, or ``light_along_<sweep>`` when the measured positions
         disagree with it (:func:`check_light_order`).
     """
-    frames = check_array(frames, "frames", ndim=4)
+    if callable(frames):
+        if shape is None:
+            raise ValueError("shape: give the frames' (H, W) with a callable of frame blocks")
+        shape = tuple(int(n) for n in shape)
+    else:
+        frames = check_array(frames, "frames", ndim=4)
+        shape = frames.shape[1:3]
     n_lights = int(check_positive(n_lights, "n_lights"))
     if light_along is not None:
         light_along = check_array(light_along, f"light_along_{sweep}", ndim=1, shape=(n_lights,))
-    site_colour = cfa_site_colours(frames.shape[1:3], cfa_pattern) if cfa_pattern and method == "edge_fit" else None
-    minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
+    site_colour = cfa_site_colours(shape, cfa_pattern) if cfa_pattern and method == "edge_fit" else None
+    minima = find_minima(frames, shape, count=n_lights, half_window=half_window,
                          method="dip_centroid" if method == "edge_fit" else method, site_colour=site_colour)
     in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
     if method == "edge_fit":
