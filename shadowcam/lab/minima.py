@@ -30,6 +30,7 @@ Offers
 ------
 MINIMUM_REASONS : reason code -> meaning, per minimum.
 BAND_PIXELS : pixels per row band of the per-pixel work.
+row_bands : the row slices of those bands.
 Minima : per-minimum times, depths, widths, uncertainties and reasons.
 select_minima : the K deepest separated minima among candidate lists.
 find_minima : two streaming passes over a sweep's frames -> :class:`Minima`.
@@ -423,8 +424,19 @@ class _Band:
         return level, variance, passing.diff_count
 
 
-def _row_bands(height, width, band_rows):
-    """Consecutive row slices of `band_rows` rows (default: :data:`BAND_PIXELS` pixels) covering `height`."""
+def row_bands(height, width, band_rows=None):
+    """Consecutive row slices covering `height` rows of `width` pixels.
+
+    Parameters
+    ----------
+    height, width : int
+    band_rows : int, optional
+        Rows per band (default: :data:`BAND_PIXELS` pixels' worth, at least one row).
+
+    Returns
+    -------
+    list of slice
+    """
     band_rows = max(1, BAND_PIXELS // max(int(width), 1)) if band_rows is None else int(band_rows)
     if band_rows < 1:
         raise ValueError(f"band_rows must be an integer >= 1; got {band_rows!r}")
@@ -546,7 +558,7 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     if site_colour is not None:
         site_colour = check_array(site_colour, "site_colour", shape=tuple(shape), dtype_kind="iu").astype(np.intp)
     count, h = int(count), int(half_window)
-    bands = _row_bands(shape[0], shape[1], band_rows)
+    bands = row_bands(shape[0], shape[1], band_rows)
     tracked = _track_bands(blocks, shape, bands, count=count, h=h, site_colour=site_colour)
     if noise_model is None:
         noise_model = fit_noise_model(*(np.concatenate(v) for v in zip(*(b.lit_statistics() for b in tracked))))
