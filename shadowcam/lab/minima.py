@@ -36,7 +36,7 @@ select_minima : the K deepest separated minima among candidate lists.
 find_minima : two streaming passes over a sweep's frames -> :class:`Minima`.
 """
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields, is_dataclass, replace
 
 import numpy as np
 from scipy.special import ndtri
@@ -411,9 +411,9 @@ class _Band:
     n_frames: int
     rows: int
     cols: int
-    passing: "_WindowPass" = None
-    own_pass: "_WindowPass" = None
-    rest_pass: "_WindowPass" = None
+    passing: _WindowPass = None
+    own_pass: _WindowPass = None
+    rest_pass: _WindowPass = None
 
     def lit_statistics(self):
         """Lit level, variance of one sample (first differences) and its degrees of freedom, each (P,)."""
@@ -492,7 +492,7 @@ def _join_rows(parts):
         values = [getattr(part, f.name) for part in parts]
         if isinstance(values[0], np.ndarray) and values[0].ndim >= 2:
             joined[f.name] = np.concatenate(values, axis=values[0].ndim - 2)
-        elif values[0] is not None and hasattr(values[0], "__dataclass_fields__"):
+        elif is_dataclass(values[0]):
             joined[f.name] = _join_rows(values)
         else:
             joined[f.name] = values[0]
