@@ -12,8 +12,10 @@ accurate) says which defaults the data justify.
   second of that total; error is the absolute time error (frames) over the
   lit pixels with a true time, p50/p95, and coverage.
 * Several minima (a capture lit by several lights, paper Fig. 11): each timing
-  method the minima accept finds, times and assigns every pixel's minima to the
-  lights (:func:`shadowcam.lab.light_views.light_set_views`); throughput is
+  method finds, times and assigns every pixel's minima to the lights as the
+  stage does (:func:`shadowcam.lab.light_views.light_set_views`: ``edge_fit`` over
+  each light's own map, camera RAW from each pixel's own mosaic site by the
+  capture's ``cfa_pattern``); throughput is
   pixel-frames per second of both sweeps; error is the absolute time error
   pooled over lights and sweeps on the scored pixels, p50/p95, and coverage.
 * Dual view: each resampling method maps the camera colours to the dual grid;
@@ -130,8 +132,10 @@ def compare_shadow_time_methods(sweeps, *, methods=None, half_window=4, cfa_patt
     return rows
 
 
-#: timing methods a minimum accepts (edge_fit mixes neighbours' times, possibly of other minima)
-MINIMA_METHODS = tuple(m for m in SHADOW_TIME_METHODS if m != "edge_fit")
+#: timing methods of the several lights' minima: each method times every minimum, ``edge_fit``
+#: (the stage's) dip centroids refined over each light's own time map, demosaiced RAW from each
+#: pixel's own mosaic site (:func:`shadowcam.lab.light_views.light_set_views`)
+MINIMA_METHODS = tuple(SHADOW_TIME_METHODS)
 
 
 def compare_minima_methods(capture, *, methods=None, half_window=4):
@@ -141,8 +145,8 @@ def compare_minima_methods(capture, *, methods=None, half_window=4):
     ----------
     capture : xarray.Dataset
         A several-lights capture with its per-light truth (see
-        :func:`shadowcam.lab.light_views.light_set_views` and
-        :func:`~shadowcam.lab.light_views.light_set_errors`).
+        :func:`shadowcam.lab.light_views.light_set_views`, whose attr ``cfa_pattern`` it
+        follows, and :func:`~shadowcam.lab.light_views.light_set_errors`).
     methods : sequence of str, optional
         Default: every method of :data:`MINIMA_METHODS`.
     half_window : int, optional

@@ -57,7 +57,18 @@ _FROM_MINIMUM = {_m.OK: OK, _m.MISSING: MINIMA_COUNT, _m.LOW_CONTRAST: LOW_CONTR
 
 
 def _neighbour_median(time, radius):
-    """Median of the finite times within `radius` pixels (the pixel itself excluded), (L, H, W)."""
+    """Median of the finite times within `radius` pixels (the pixel itself excluded), (L, H, W);
+    in row bands with a `radius`-row halo (bounding the neighbours' stack)."""
+    out = np.empty(time.shape)
+    height = time.shape[1]
+    for rows in _m.row_bands(*time.shape[1:]):
+        top, bottom = max(rows.start - radius, 0), min(rows.stop + radius, height)
+        out[:, rows] = _band_neighbour_median(time[:, top:bottom], radius)[:, rows.start - top:rows.stop - top]
+    return out
+
+
+def _band_neighbour_median(time, radius):
+    """:func:`_neighbour_median` of one block of rows (its outside NaN)."""
     pad = np.pad(time, ((0, 0), (radius, radius), (radius, radius)), constant_values=np.nan)
     rows, cols = time.shape[1:]
     stack = np.stack([pad[:, radius + dy:radius + dy + rows, radius + dx:radius + dx + cols]
@@ -287,6 +298,20 @@ def place_noise_probability(window, noise, *, tolerance, width=None):
     return np.where(np.isfinite(window[window.shape[0] // 2]), out, np.nan)
 
 
+def _place(window, noise, pick, contrast, width, *, tolerance, false_alarm):
+    """:func:`place_noise_probability` of each light's minimum `pick` (L, h, W) from the minima's
+    normalised windows (S, K, h, W) and noise (K, h, W); 1 where it cannot be judged."""
+    index = np.maximum(pick, 0)
+    window = np.take_along_axis(window, index[None], 1)
+    noise = np.take_along_axis(np.asarray(noise, np.float64), index, 0)
+    # the half-depth span is the dip's own only where no sample of the window reaches
+    # half the depth by noise (at false_alarm); else it is noise's and not used
+    with np.errstate(invalid="ignore", divide="ignore"):
+        crossings_own = contrast / (2.0 * noise) > -ndtri(false_alarm / window.shape[0])
+    width = np.where(crossings_own, width, np.nan)
+    return np.nan_to_num(place_noise_probability(window, noise, tolerance=tolerance, width=width), nan=1.0)
+
+
 def _shown(resolved, crossed, false_alarm):
     """Per light: its resolved dips are more than noise alone gives, (L,) bool.
 
@@ -397,16 +422,11 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None,
     reason[jump | ((reason == OK) & (2 * agree <= total))] = AMBIGUOUS_ORDER
     contrast, std, snr = (_gather(a, pick) for a in (minima.contrast, minima.time_std, minima.depth_snr))
     place = np.zeros(pick.shape)
-    if minima.summary is not None:  # each light's minimum's window, normalised by its level
-        index = np.maximum(pick, 0)
-        window = np.take_along_axis(minima.summary.window, index[None], 1)
-        noise = np.take_along_axis(np.asarray(minima.summary.noise, np.float64), index, 0)
-        # the half-depth span is the dip's own only where no sample of the window reaches
-        # half the depth by noise (at false_alarm); else it is noise's and not used
-        with np.errstate(invalid="ignore", divide="ignore"):
-            crossings_own = contrast / (2.0 * noise) > -ndtri(false_alarm / window.shape[0])
-        width = np.where(crossings_own, _gather(minima.width, pick), np.nan)
-        place = np.nan_to_num(place_noise_probability(window, noise, tolerance=tolerance, width=width), nan=1.0)
+    if minima.summary is not None:
+        width = _gather(minima.width, pick)
+        for rows in _m.row_bands(*pick.shape[1:]):  # per pixel: in row bands, bounding the temporaries
+            place[:, rows] = _place(minima.summary.window[:, :, rows], minima.summary.noise[:, rows], pick[:, rows],
+                                    contrast[:, rows], width[:, rows], tolerance=tolerance, false_alarm=false_alarm)
     reason[(reason == OK) & (place > false_alarm)] = UNRESOLVED
     shown = _shown(reason == OK, inside | (pick >= 0), false_alarm)
     reason[~shown[:, None, None] & (reason == OK)] = UNRESOLVED

@@ -3,15 +3,17 @@
 A several-lights capture (docs/contracts.md) is a standard lab capture, sweeps ``u`` and
 ``v`` of frame files and a reference frame, shot under several lights at once, with a
 top-level ``lights`` block (``kinds``, optional ``light_along_u``, ``light_along_v``); its
-plan (:func:`shadowcam.io.capture_plan.capture_plan`) lists them. Each sweep is decoded by
-the lab sweeps' decoder (:func:`shadowcam.cameras.array_files.read_stack` over
-:func:`shadowcam.io.decode.iter_frames`: camera RAW, TIFF, PNG, EXR to linear RGB) into
-one float32 stack, whose minima :func:`shadowcam.lab.light_views.sweep_light_times` assigns
-to the lights (camera RAW: timed from each pixel's own mosaic site where its noise allows),
-and is freed before the next is read.
+plan (:func:`shadowcam.io.capture_plan.capture_plan`) lists them. Each sweep is streamed
+twice through the lab sweeps' decoder (:func:`shadowcam.io.decode.iter_frames`: camera RAW,
+TIFF, PNG, EXR to linear RGB), a block of frames at a time (:data:`BLOCK_BYTES`), into
+the two passes of :func:`shadowcam.lab.minima.find_minima` (per-pixel work in row bands),
+whose minima :func:`shadowcam.lab.light_views.sweep_light_times` assigns to the lights
+(camera RAW: timed from each pixel's own mosaic site where its noise allows): memory
+follows the frame size, not the sweep's length.
 
 Offers
 ------
+BLOCK_BYTES : the most decoded frames held at once, in bytes (at least one frame).
 light_set_views_of_plan : a several-lights capture plan -> the per-light views dataset.
 light_set_capture_of_plan : the capture's frames, reference and ground truth as one dataset
     (what :func:`shadowcam.lab.light_views.light_set_views` and the methods comparison read).
@@ -21,9 +23,37 @@ import numpy as np
 import xarray as xr
 
 from shadowcam.cameras.array_files import read_stack
-from shadowcam.io.decode import frame_info
-from shadowcam.lab.shadow_time import cfa_site_colours
+from shadowcam.io.decode import frame_info, iter_frames
 from shadowcam.lab.light_views import SWEEPS, light_views_dataset, sweep_light_times, view_attrs
+
+
+#: the most decoded frames (float32 RGB) held at once while a sweep streams, in bytes
+BLOCK_BYTES = 16 * 2 ** 20
+
+
+def _frame_blocks(paths, shape):
+    """A callable streaming the files' decoded frames anew on each call, in consecutive
+    ``(t, H, W, 3)`` float32 blocks of at most :data:`BLOCK_BYTES` (one frame at least).
+
+    Raises (when streamed) ValueError for a frame of another size than `shape`.
+    """
+    per_block = max(1, BLOCK_BYTES // (int(shape[0]) * int(shape[1]) * 3 * 4))
+
+    def blocks():
+        block = []
+        for path, image, _ in iter_frames(paths):
+            if tuple(image.shape[:2]) != tuple(shape):
+                raise ValueError(f"frame {path} has size {image.shape[0]}x{image.shape[1]} (rows x cols) but the "
+                                 f"capture's frames are {shape[0]}x{shape[1]}; every frame must come from one "
+                                 "camera at one size (remove or crop the odd file)")
+            block.append(image)
+            if len(block) == per_block:
+                yield np.stack(block)
+                block = []
+        if block:
+            yield np.stack(block)
+
+    return blocks
 
 
 def _captured(plan):
@@ -35,6 +65,16 @@ def _captured(plan):
     return block
 
 
+def _cfa_pattern(plan):
+    """The CFA pattern of the sweeps' camera RAW files (the first file of each, which must agree),
+    or None for other frames."""
+    patterns = {name: frame_info(plan.sweep(name).files[0])["cfa_pattern"] for name in SWEEPS}
+    if len(set(patterns.values())) > 1:
+        raise ValueError(f"plan: manifest {plan.manifest_path}: the sweeps' first files have CFA patterns "
+                         f"{patterns}; both sweeps must come from one camera")
+    return patterns[SWEEPS[0]] or None
+
+
 def _reference(plan):
     """The mean of the capture's reference frames, (H, W, 3) float32."""
     return read_stack(plan.reference, shape=plan.frame_shape).mean(axis=0)
@@ -43,8 +83,8 @@ def _reference(plan):
 def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2, tolerance=2.0, check_order=True):
     """Per-light shadow times and dual views of a captured (or rendered and written) several-lights capture.
 
-    The sweeps are decoded one after the other, each freed once its minima are assigned.
-    Camera RAW sweeps are timed from each pixel's own mosaic site where its noise allows
+    The sweeps are streamed one after the other, each twice (the minima's two passes), a
+    block of frames at a time. Camera RAW sweeps are timed from each pixel's own mosaic site where its noise allows
     (the CFA pattern of the sweep's first file, :func:`shadowcam.io.decode.frame_info`).
 
     Parameters
@@ -72,16 +112,13 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
     """
     block = _captured(plan)
     described = block["light_along_u"] is not None
+    pattern = _cfa_pattern(plan)
     per_sweep, positions = {}, {}
     for name in SWEEPS:
-        files = plan.sweep(name).files
-        frames = read_stack(files, shape=plan.frame_shape)
-        pattern = frame_info(files[0])["cfa_pattern"]
         per_sweep[name], positions[name] = sweep_light_times(
-            frames, block["count"], sweep=name, light_along=block[f"light_along_{name}"], half_window=half_window,
-            method=method, radius=radius, tolerance=tolerance, check_order=check_order,
-            site_colour=cfa_site_colours(frames.shape[1:3], pattern) if pattern else None)
-        del frames
+            _frame_blocks(plan.sweep(name).files, plan.frame_shape), block["count"], sweep=name,
+            light_along=block[f"light_along_{name}"], half_window=half_window, method=method, radius=radius,
+            tolerance=tolerance, check_order=check_order, cfa_pattern=pattern, shape=plan.frame_shape)
     attrs = view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
                        check_order=check_order and described)
     attrs.update(kinds=list(block["kinds"]), light_order="described" if described else "shadows")
@@ -107,7 +144,10 @@ def light_set_capture_of_plan(plan):
         ``frames_u``, ``frames_v`` (t, y, x, channel) and ``reference`` (y, x, channel)
         decoded (white 1), ``light_along_u``, ``light_along_v`` (light,) when described,
         and the ground truth's per-light times (``t_center_<s>``, ``t_first_<s>``,
-        ``t_last_<s>``, ``share``) when the manifest names ``ground_truth``.
+        ``t_last_<s>``, ``share``) when the manifest names ``ground_truth``; attr
+        ``cfa_pattern`` for camera RAW files, so that
+        :func:`shadowcam.lab.light_views.light_set_views` times them as
+        :func:`light_set_views_of_plan` does.
     """
     block = _captured(plan)
     data = {f"frames_{name}": ((f"t_{name}", "y", "x", "channel"),
@@ -116,7 +156,9 @@ def light_set_capture_of_plan(plan):
     if block["light_along_u"] is not None:
         data.update({f"light_along_{name}": (("light",), np.asarray(block[f"light_along_{name}"]))
                      for name in SWEEPS})
-    capture = xr.Dataset(data, coords={"channel": ["R", "G", "B"], "light": np.arange(block["count"])})
+    pattern = _cfa_pattern(plan)
+    capture = xr.Dataset(data, coords={"channel": ["R", "G", "B"], "light": np.arange(block["count"])},
+                         attrs={"cfa_pattern": pattern} if pattern else {})
     if block["ground_truth"] is not None:
         with xr.open_dataset(block["ground_truth"]) as opened:
             truth = opened.load()

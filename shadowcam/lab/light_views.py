@@ -30,7 +30,7 @@ import xarray as xr
 from shadowcam._shared.validation import check_array, check_positive
 from shadowcam.cameras.dual_view import resample_dual_view
 from shadowcam.lab.light_assignment import LIGHT_REASONS, OK, assign_minima
-from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS
+from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, cfa_site_colours
 from shadowcam.lab.minima import find_minima
 
 SWEEPS = ("u", "v")
@@ -168,13 +168,15 @@ def _edge_fit_per_light(minima, assigned):
 
 
 def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=4, method="edge_fit", radius=2,
-                      tolerance=2.0, check_order=True, site_colour=None):
+                      tolerance=2.0, check_order=True, cfa_pattern=None, shape=None):
     """One sweep's minima assigned to the lights, with the lights' positions along it.
 
     Parameters
     ----------
-    frames : (T, H, W, C) array_like
-        The sweep's frames (any linear scale: radiance, or decoded files with white 1).
+    frames : (T, H, W, C) array_like, or callable
+        The sweep's frames (any linear scale: radiance, or decoded files with white 1), or
+        a callable returning an iterable of consecutive ``(t, H, W, C)`` blocks of them
+        (called twice, :func:`shadowcam.lab.minima.find_minima`; needs `shape`).
     n_lights : int
         Lights (>= 1).
     sweep : str
@@ -185,12 +187,14 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
         later). None: light k is the k-th shadow to pass (nothing to check).
     half_window, method, radius, tolerance, check_order
         See :func:`light_set_views`.
-    site_colour : (H, W) int ndarray, optional
-        Demosaiced RAW frames: the CFA channel of each site
-        (:func:`shadowcam.lab.shadow_time.cfa_site_colours`). With ``edge_fit`` each assigned
+    cfa_pattern : str, optional
+        Demosaiced camera RAW frames: the CFA pattern of their mosaic (e.g. ``"RGGB"``,
+        :func:`shadowcam.lab.shadow_time.cfa_site_colours`). With ``edge_fit`` each assigned
         minimum is then timed from its own site where that dip is significant against its
         noise (:func:`shadowcam.lab.minima.find_minima`); which minima are found and assigned
         does not depend on it.
+    shape : (int, int), optional
+        ``(H, W)`` of callable `frames`.
 
     Returns
     -------
@@ -208,13 +212,19 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
         Naming the parameter, or ``light_along_<sweep>`` when the measured positions
         disagree with it (:func:`check_light_order`).
     """
-    frames = check_array(frames, "frames", ndim=4)
+    if callable(frames):
+        if shape is None:
+            raise ValueError("shape: give the frames' (H, W) with a callable of frame blocks")
+        shape = tuple(int(n) for n in shape)
+    else:
+        frames = check_array(frames, "frames", ndim=4)
+        shape = frames.shape[1:3]
     n_lights = int(check_positive(n_lights, "n_lights"))
     if light_along is not None:
         light_along = check_array(light_along, f"light_along_{sweep}", ndim=1, shape=(n_lights,))
-    minima = find_minima(frames, frames.shape[1:3], count=n_lights, half_window=half_window,
-                         method="dip_centroid" if method == "edge_fit" else method,
-                         site_colour=site_colour if method == "edge_fit" else None)
+    site_colour = cfa_site_colours(shape, cfa_pattern) if cfa_pattern and method == "edge_fit" else None
+    minima = find_minima(frames, shape, count=n_lights, half_window=half_window,
+                         method="dip_centroid" if method == "edge_fit" else method, site_colour=site_colour)
     in_order = assign_minima(minima, n_lights, radius=radius, tolerance=tolerance)
     if method == "edge_fit":
         in_order = _edge_fit_per_light(minima, in_order)
@@ -284,8 +294,10 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         ``light`` coordinate and optionally ``light_along_u``, ``light_along_v`` (light,):
         each light's position along the sweep's wire motion, which orders its shadows
         (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`);
-        without them light k is the k-th shadow to pass in both sweeps. A capture's
-        files: :func:`shadowcam.lab.light_files.light_set_views_of_plan`.
+        without them light k is the k-th shadow to pass in both sweeps; attr ``cfa_pattern``
+        for demosaiced camera RAW frames (timed as :func:`sweep_light_times` times them). A
+        capture's files: :func:`shadowcam.lab.light_files.light_set_views_of_plan`, or
+        :func:`~shadowcam.lab.light_files.light_set_capture_of_plan` for this dataset.
     half_window : int
         Of :func:`~shadowcam.lab.minima.find_minima`: at least half the widest dip (a tube
         across the wire spreads its shadow over its projection).
@@ -326,7 +338,8 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         along = capture[f"light_along_{name}"].values if f"light_along_{name}" in capture else None
         per_sweep[name], positions[name] = sweep_light_times(
             capture[f"frames_{name}"].values, n_lights, sweep=name, light_along=along, half_window=half_window,
-            method=method, radius=radius, tolerance=tolerance, check_order=check_order)
+            method=method, radius=radius, tolerance=tolerance, check_order=check_order,
+            cfa_pattern=capture.attrs.get("cfa_pattern"))
     return light_views_dataset(
         per_sweep, positions, capture["reference"].values, shape=(capture.sizes["t_v"], capture.sizes["t_u"]),
         lights=capture["light"].values, channels=capture["channel"].values,

@@ -2,7 +2,10 @@
 
 Under several lights (paper Fig. 11) or a mask of several wires (paper Fig. 6) a
 pixel's signal dips once per shadow. The minima are found in two streaming
-passes over the frames, memory independent of their number:
+passes over the frames, memory independent of their number; each block of frames
+is split into row bands (:data:`BAND_PIXELS` pixels each), whose per-pixel work is
+done band by band, so that the temporaries scale with a band, not the frame (only
+the noise model pools every pixel; the result does not depend on the bands):
 
 1. the :class:`~shadowcam.lab.dip_tracker.DipTracker` keeps each pixel's deepest
    smoothed local minima (its candidate list); the ``count`` deepest that lie
@@ -26,12 +29,14 @@ passed to a timing method of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHOD
 Offers
 ------
 MINIMUM_REASONS : reason code -> meaning, per minimum.
+BAND_PIXELS : pixels per row band of the per-pixel work.
+row_bands : the row slices of those bands.
 Minima : per-minimum times, depths, widths, uncertainties and reasons.
 select_minima : the K deepest separated minima among candidate lists.
 find_minima : two streaming passes over a sweep's frames -> :class:`Minima`.
 """
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields, is_dataclass, replace
 
 import numpy as np
 from scipy.special import ndtri
@@ -187,11 +192,6 @@ def _as_blocks(frames):
         raise ValueError(f"frames must be (T, H, W[, C]) or a callable giving such blocks; got "
                          f"shape {array.shape}")
     return lambda: (array[i:i + 64] for i in range(0, array.shape[0], 64))
-
-
-def _signal(block):
-    block = np.asarray(block, dtype=np.float32)
-    return block.sum(axis=-1) if block.ndim == 4 else block
 
 
 def _lit_noise(passing):
@@ -392,9 +392,120 @@ def _depth_snr(level, smoothed, noise, model, outside_sequence):
         return (level - smoothed) / sigma
 
 
+#: pixels per row band of :func:`find_minima`'s per-pixel work (bounds its temporaries)
+BAND_PIXELS = 2 ** 14
+
+
+def _signal(block):
+    block = np.asarray(block, dtype=np.float32)
+    return block.sum(axis=-1) if block.ndim == 4 else block
+
+
+@dataclass
+class _Band:
+    """One row band's two passes: each pixel's candidate minima, their raw windows and its lit
+    statistics (the channel sum's; with RAW sites also the own sites' and the rest's)."""
+
+    centres: np.ndarray  # (K + 1, P) int64, -1 = none
+    smoothed: np.ndarray  # (K + 1, P)
+    n_frames: int
+    rows: int
+    cols: int
+    passing: _WindowPass = None
+    own_pass: _WindowPass = None
+    rest_pass: _WindowPass = None
+
+    def lit_statistics(self):
+        """Lit level, variance of one sample (first differences) and its degrees of freedom, each (P,)."""
+        passing = self.passing
+        with np.errstate(invalid="ignore", divide="ignore"):
+            variance = passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0
+            level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
+        return level, variance, passing.diff_count
+
+
+def row_bands(height, width, band_rows=None):
+    """Consecutive row slices covering `height` rows of `width` pixels.
+
+    Parameters
+    ----------
+    height, width : int
+    band_rows : int, optional
+        Rows per band (default: :data:`BAND_PIXELS` pixels' worth, at least one row).
+
+    Returns
+    -------
+    list of slice
+    """
+    band_rows = max(1, BAND_PIXELS // max(int(width), 1)) if band_rows is None else int(band_rows)
+    if band_rows < 1:
+        raise ValueError(f"band_rows must be an integer >= 1; got {band_rows!r}")
+    return [slice(r, min(r + band_rows, int(height))) for r in range(0, int(height), band_rows)]
+
+
+def _track_bands(blocks, shape, bands, *, count, h, site_colour):
+    """The two streaming passes over the frames, each block split into the row `bands`: one
+    :class:`_Band` per band (memory per pixel, not per frame)."""
+    cols = int(shape[1])
+    trackers = [DipTracker((rows.stop - rows.start, cols), half_window=h) for rows in bands]
+    for block in blocks():
+        signal = _signal(block)
+        for rows, tracker in zip(bands, trackers):
+            tracker.update(signal[:, rows])
+    out = []
+    for rows, tracker in zip(bands, trackers):
+        partial = tracker.partial()
+        p = (rows.stop - rows.start) * cols
+        chosen, smoothed = select_minima(partial.top_value.reshape(p, -1), partial.top_frame.reshape(p, -1),
+                                         count + 1, separation=h)
+        # the K deepest in order along the sweep (missing last), then the extra one
+        order = np.argsort(np.where(chosen[:, :count] < 0, np.iinfo(np.int64).max, chosen[:, :count]), axis=1)
+        order = np.concatenate([order, np.full((p, 1), count)], axis=1)
+        centres = np.take_along_axis(chosen, order, 1).T  # (K + 1, P)
+        # the second pass keeps twice the tracker's half window: a flat-bottomed dip's minimum
+        # is its first lowest frame, and its whole width must still fit
+        band = _Band(centres, np.take_along_axis(smoothed, order, 1).T, partial.end, rows.stop - rows.start, cols,
+                     _WindowPass(centres, 2 * h, h))
+        if site_colour is not None:
+            band.own_pass, band.rest_pass = _WindowPass(centres, 2 * h, h), _WindowPass(centres, 2 * h, h)
+        out.append(band)
+    del trackers
+    for block in blocks():
+        signal = _signal(block)
+        own = None if site_colour is None else own_site_samples(np.asarray(block, dtype=np.float32), site_colour)
+        for rows, band in zip(bands, out):
+            band.passing.update(signal[:, rows])
+            if own is not None:
+                band.own_pass.update(own[:, rows])
+                band.rest_pass.update(signal[:, rows] - own[:, rows])
+    return out
+
+
+def _join_rows(parts):
+    """Row bands' records (:class:`Minima`, and its nested summaries) joined into one: arrays
+    along their row axis (the second to last), scalars from the first band."""
+    first = parts[0]
+    if len(parts) == 1:
+        return first
+    joined = {}
+    for f in fields(first):
+        values = [getattr(part, f.name) for part in parts]
+        if isinstance(values[0], np.ndarray) and values[0].ndim >= 2:
+            joined[f.name] = np.concatenate(values, axis=values[0].ndim - 2)
+        elif is_dataclass(values[0]):
+            joined[f.name] = _join_rows(values)
+        else:
+            joined[f.name] = values[0]
+    return replace(first, **joined)
+
+
 def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", false_alarm=1e-3,
-                steady_level=True, noise_model=None, site_colour=None):
+                steady_level=True, noise_model=None, site_colour=None, band_rows=None):
     """The `count` deepest separated minima of each pixel, timed and classified.
+
+    The frames are read twice (two passes), each block split into row bands whose per-pixel
+    work (candidates, windows, timing) is done band by band; only the noise model is fitted
+    over every pixel. The result does not depend on the bands, bit for bit.
 
     Parameters
     ----------
@@ -428,6 +539,8 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         (:class:`~shadowcam.lab.site_signal.SiteWindow`, in the units of its normalised
         window), from which ``edge_fit`` times it where its own dip is significant. Minima,
         their reasons and the other methods' times do not depend on it.
+    band_rows : int, optional
+        Rows per band (default: :data:`BAND_PIXELS` pixels' worth).
 
     Returns
     -------
@@ -445,42 +558,29 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
     if site_colour is not None:
         site_colour = check_array(site_colour, "site_colour", shape=tuple(shape), dtype_kind="iu").astype(np.intp)
     count, h = int(count), int(half_window)
-    tracker = DipTracker(tuple(shape), half_window=h)
-    for block in blocks():
-        tracker.update(_signal(block))
-    partial = tracker.partial()
-    n_frames = partial.end
-    rows, cols = partial.top_value.shape[:2]
-    p = rows * cols
-    chosen, smoothed = select_minima(partial.top_value.reshape(p, -1), partial.top_frame.reshape(p, -1),
-                                     count + 1, separation=h)
-    # the K deepest in order along the sweep (missing last), then the extra one
-    order = np.argsort(np.where(chosen[:, :count] < 0, np.iinfo(np.int64).max, chosen[:, :count]), axis=1)
-    order = np.concatenate([order, np.full((p, 1), count)], axis=1)
-    centres = np.take_along_axis(chosen, order, 1).T  # (K + 1, P)
-    smoothed = np.take_along_axis(smoothed, order, 1).T
-    # the second pass keeps twice the tracker's half window: a flat-bottomed dip's minimum
-    # is its first lowest frame, and its whole width must still fit
-    w = 2 * h
-    passing = _WindowPass(centres, w, h)
-    own_pass = rest_pass = None
-    if site_colour is not None:
-        own_pass, rest_pass = _WindowPass(centres, w, h), _WindowPass(centres, w, h)
-    for block in blocks():
-        signal = _signal(block)
-        passing.update(signal)
-        if site_colour is not None:
-            own = own_site_samples(np.asarray(block, dtype=np.float32), site_colour)
-            own_pass.update(own)
-            rest_pass.update(signal - own)
+    bands = row_bands(shape[0], shape[1], band_rows)
+    tracked = _track_bands(blocks, shape, bands, count=count, h=h, site_colour=site_colour)
+    if noise_model is None:
+        noise_model = fit_noise_model(*(np.concatenate(v) for v in zip(*(b.lit_statistics() for b in tracked))))
+    parts = []
+    for index, rows in enumerate(bands):
+        parts.append(_finish_band(tracked[index], count=count, h=h, method=method, false_alarm=false_alarm,
+                                  steady_level=steady_level, noise_model=noise_model,
+                                  site_colour=None if site_colour is None else site_colour[rows]))
+        tracked[index] = None  # the band's raw windows are no longer needed
+    return _join_rows(parts)
+
+
+def _finish_band(band, *, count, h, method, false_alarm, steady_level, noise_model, site_colour):
+    """One band's minima from its passes (:class:`_Band`) under the sweep's `noise_model`: merged,
+    cut, normalised, timed and classified, as a :class:`Minima` over the band's rows."""
+    centres, smoothed, n_frames, passing = band.centres, band.smoothed, band.n_frames, band.passing
+    own_pass, rest_pass, rows, cols = band.own_pass, band.rest_pass, band.rows, band.cols
+    p, w = rows * cols, 2 * h
     window = passing.window
     slot_frame = centres[:, None, :] - w + np.arange(2 * w + 1)[None, :, None]  # (K+1, W, P)
     outside_sequence = (slot_frame < 0) | (slot_frame >= n_frames)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        own_variance = passing.diff_sq / np.maximum(passing.diff_count, 1) / 2.0
-        far_level = np.where(passing.lit_count > 0, passing.lit_sum / np.maximum(passing.lit_count, 1), np.nan)
-    if noise_model is None:
-        noise_model = fit_noise_model(far_level, own_variance, passing.diff_count)
+    far_level, own_variance, _ = band.lit_statistics()
     noise = pixel_noise(far_level, own_variance, passing.diff_count, model=noise_model,
                         false_alarm=false_alarm)
     significance = detection_threshold(n_frames, false_alarm=false_alarm)

@@ -10,7 +10,7 @@ import yaml
 
 from shadowcam.io.capture_plan import capture_plan
 from shadowcam.lab.light_files import light_set_capture_of_plan, light_set_views_of_plan
-from shadowcam.lab.light_views import light_set_accuracy, light_set_views
+from shadowcam.lab.light_views import light_set_accuracy, light_set_errors, light_set_views
 from shadowcam.synthetic.capture_options import capture_options
 from shadowcam.synthetic.lab.light_set_capture import render_light_set_capture, write_light_set_capture
 
@@ -113,10 +113,16 @@ def test_the_capture_in_memory_holds_the_decoded_frames_and_the_truth(rendered, 
     np.testing.assert_allclose(capture["light_along_u"].values, 1e3 * truth["light_along_u"].values)
 
 
-def test_a_noisy_12_bit_dng_capture_is_a_mosaic_read_through_the_files(tmp_path):
+@pytest.fixture(scope="module")
+def rendered_raw(tmp_path_factory):
+    """A rendered several-lights capture folder (noisy 12-bit RGGB DNG)."""
+    return _render(tmp_path_factory.mktemp("lights_raw"), format="dng", bit_depth=12, noise=True)
+
+
+def test_a_noisy_12_bit_dng_capture_is_a_mosaic_read_through_the_files(rendered_raw):
     from shadowcam.io.raw_mosaic import read_mosaic
 
-    capture = _render(tmp_path, format="dng", bit_depth=12, noise=True)
+    capture = rendered_raw
     mosaic, levels = read_mosaic(capture / "frames_u/000000.dng")
     assert mosaic.shape == (32, 32) and levels["cfa_pattern"] == "RGGB"  # one CFA site per pixel
     described = json.loads((capture / "capture.json").read_text())
@@ -129,6 +135,28 @@ def test_a_noisy_12_bit_dng_capture_is_a_mosaic_read_through_the_files(tmp_path)
         assert entry["p95_error"] < 0.8   # frames: shot and read noise on a demosaiced mosaic
     # the tube lies along the v wire: its shadow is too shallow and long to be placed
     assert not acc[2]["v"]["dip_shown"] and acc[2]["v"]["coverage"] == 0
+
+
+def test_raw_in_memory_and_from_the_files_is_timed_on_one_path(rendered_raw):
+    """The capture in memory (what the methods comparison reads) carries the CFA pattern, and
+    its views are those of the stage: each pixel timed from its own mosaic site, bit for bit."""
+    from shadowcam.evaluate.methods_comparison import compare_minima_methods
+
+    plan = capture_plan(rendered_raw / "capture.json")
+    capture = light_set_capture_of_plan(plan)
+    assert capture.attrs["cfa_pattern"] == "RGGB"
+    staged, in_memory = light_set_views_of_plan(plan), light_set_views(capture)
+    for name in ("time", "time_std", "confidence", "reason"):
+        np.testing.assert_array_equal(in_memory[name].values, staged[name].values)
+    # the channel sum times them otherwise: the pattern is what makes the two paths one
+    summed = light_set_views(capture.assign_attrs(cfa_pattern=""))
+    assert not np.array_equal(summed["time"].values, staged["time"].values, equal_nan=True)
+    # and the methods comparison's edge_fit row scores exactly the stage's times
+    errors = light_set_errors(staged, capture)
+    err = np.concatenate([error[scored] for error, scored in errors.values()])
+    row, = compare_minima_methods(capture, methods=["edge_fit"])
+    assert row["p95"] == pytest.approx(np.percentile(err[np.isfinite(err)], 95), rel=1e-12)
+    assert row["coverage"] == pytest.approx(np.isfinite(err).mean(), rel=1e-12)
 
 
 def _plan_error(tmp_path, write_manifest, doc):

@@ -188,8 +188,7 @@ def _raw_errors(times, truth):
 
 def test_raw_lights_are_timed_from_the_own_site_to_the_quantisation(wire_sweep):
     frames, truth = _raw_two_shadow_sweep(wire_sweep)
-    colour = cfa_site_colours(RAW_SHAPE, "RGGB")
-    new, _ = sweep_light_times(frames, 2, sweep="u", site_colour=colour)
+    new, _ = sweep_light_times(frames, 2, sweep="u", cfa_pattern="RGGB")
     old, _ = sweep_light_times(frames, 2, sweep="u")  # the channel sum's times
     np.testing.assert_array_equal(new["reason"], old["reason"])
     for err_new, err_old in zip(_raw_errors(new, truth), _raw_errors(old, truth)):
@@ -205,7 +204,7 @@ def test_dim_raw_lights_fall_back_to_the_channel_sum_without_losing_coverage(wir
     # 60 electrons at full scale: some own-site dips are not significant on their own
     frames, truth = _raw_two_shadow_sweep(wire_sweep, electrons=60.0)
     colour = cfa_site_colours(RAW_SHAPE, "RGGB")
-    new, _ = sweep_light_times(frames, 2, sweep="u", site_colour=colour)
+    new, _ = sweep_light_times(frames, 2, sweep="u", cfa_pattern="RGGB")
     old, _ = sweep_light_times(frames, 2, sweep="u")
     for key in ("reason", "minimum", "shown"):  # the same minima, lights and timed pixels
         np.testing.assert_array_equal(new[key], old[key])
