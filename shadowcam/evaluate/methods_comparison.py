@@ -1,6 +1,6 @@
 """Speed against error of every shadow-time, several-minima and dual-view resampling method.
 
-Every method of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS` and
+Every method of :data:`shadowcam.lab.shadow_time_methods.SHADOW_TIME_METHODS` and
 :data:`shadowcam.cameras.dual_view.DUAL_VIEW_METHODS` runs on the same scene and is
 measured for wall time, throughput, peak memory and error against the exact
 ground truth; the Pareto front (no other method both faster and more

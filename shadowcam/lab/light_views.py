@@ -30,7 +30,8 @@ import xarray as xr
 from shadowcam._shared.validation import check_array, check_positive
 from shadowcam.cameras.dual_view import resample_dual_view
 from shadowcam.lab.light_assignment import LIGHT_REASONS, OK, assign_minima
-from shadowcam.lab.shadow_time import SHADOW_TIME_METHODS, cfa_site_colours
+from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
+from shadowcam.lab.site_signal import cfa_site_colours
 from shadowcam.lab.minima import find_minima
 
 SWEEPS = ("u", "v")
@@ -143,13 +144,13 @@ def _gather_light(record, index, ok):
 def _edge_fit_per_light(minima, assigned):
     """Each light's ok times re-timed by ``edge_fit`` over that light's own time map.
 
-    ``edge_fit`` (:func:`shadowcam.lab.shadow_time.time_edge_fit`) weighs each pixel's
+    ``edge_fit`` (:func:`shadowcam.lab.shadow_time_methods.time_edge_fit`) weighs each pixel's
     dip centroid against its neighbours' local plane by their variances; given the
     windows of one light's minima (:attr:`shadowcam.lab.minima.Minima.summary`, gathered
     at ``assigned["minimum"]``) its neighbours are that light's, never another light's.
     Flagged pixels neither get a time nor take part. With the minima's own-site samples
     (demosaiced RAW, ``summary.site``) each is timed from its own site where that dip is
-    significant (:func:`shadowcam.lab.shadow_time.time_edge_fit`).
+    significant (:func:`shadowcam.lab.shadow_time_methods.time_edge_fit`).
     """
     summary = minima.summary
     out = dict(assigned)
@@ -189,7 +190,7 @@ def sweep_light_times(frames, n_lights, *, sweep, light_along=None, half_window=
         See :func:`light_set_views`.
     cfa_pattern : str, optional
         Demosaiced camera RAW frames: the CFA pattern of their mosaic (e.g. ``"RGGB"``,
-        :func:`shadowcam.lab.shadow_time.cfa_site_colours`). With ``edge_fit`` each assigned
+        :func:`shadowcam.lab.site_signal.cfa_site_colours`). With ``edge_fit`` each assigned
         minimum is then timed from its own site where that dip is significant against its
         noise (:func:`shadowcam.lab.minima.find_minima`); which minima are found and assigned
         does not depend on it.

@@ -24,7 +24,7 @@ the noise model pools every pixel; the result does not depend on the bands):
 Each minimum is then timed like a single dip: its window is cut where it meets
 the next minimum's (each sample belongs to the nearest minimum), normalised by
 the lit level interpolated between the window's ends (a straight line), and
-passed to a timing method of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS`.
+passed to a timing method of :data:`shadowcam.lab.shadow_time_methods.SHADOW_TIME_METHODS`.
 
 Offers
 ------
@@ -44,7 +44,8 @@ from scipy.special import ndtri
 from shadowcam._shared.validation import check_array, check_in, check_positive
 from shadowcam.lab.dip_tracker import DipSummary, DipTracker
 from shadowcam.lab.sensor_noise import fit_noise_model, pixel_noise
-from shadowcam.lab.shadow_time import _SMOOTHED_NOISE, SHADOW_TIME_METHODS, detection_threshold
+from shadowcam.lab.dip_classification import _SMOOTHED_NOISE, detection_threshold
+from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
 from shadowcam.lab.site_signal import SiteWindow, own_site_samples
 
 #: reason code -> meaning, per minimum (0 = a reliable time)
@@ -520,7 +521,7 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         Minima closer than this many frames are one; each minimum is timed over the
         ``2 * half_window`` frames on each side of its smoothed minimum.
     method : str
-        A key of :data:`shadowcam.lab.shadow_time.SHADOW_TIME_METHODS` other than
+        A key of :data:`shadowcam.lab.shadow_time_methods.SHADOW_TIME_METHODS` other than
         ``edge_fit`` (which mixes neighbours' times, possibly of other minima).
     false_alarm : float
         Probability that pure noise makes a minimum (sets ``significance``), and that a
@@ -534,7 +535,7 @@ def find_minima(frames, shape, *, count, half_window=4, method="dip_centroid", f
         The sensor's Poisson-Gaussian model (default: fitted to the sweep).
     site_colour : (H, W) int ndarray, optional
         Demosaiced RAW frames: the CFA channel of each site
-        (:func:`shadowcam.lab.shadow_time.cfa_site_colours`). The second pass also keeps
+        (:func:`shadowcam.lab.site_signal.cfa_site_colours`). The second pass also keeps
         each site's own samples, and each minimum's summary carries them as its ``site``
         (:class:`~shadowcam.lab.site_signal.SiteWindow`, in the units of its normalised
         window), from which ``edge_fit`` times it where its own dip is significant. Minima,

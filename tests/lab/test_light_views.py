@@ -11,7 +11,8 @@ from shadowcam.lab.light_views import (
     sweep_light_times,
 )
 from shadowcam.lab.minima import OK, find_minima
-from shadowcam.lab.shadow_time import _site_times, cfa_site_colours
+from shadowcam.lab.shadow_time_methods import _site_times
+from shadowcam.lab.site_signal import cfa_site_colours
 from shadowcam.synthetic.lab.light_set_capture import render_light_set_capture
 
 BASE = {"scene": "tabletop", "seed": 2, "height": 32, "width": 32, "frames": 40, "supersample": 2}

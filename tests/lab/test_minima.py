@@ -226,7 +226,7 @@ def test_row_bands_give_the_whole_frames_minima_bit_for_bit(band_rows):
     """Demosaiced-RAW-like frames (three channels, own sites), two dips per pixel whose times
     drift across the image, shot and read noise: the per-pixel work done in row bands (one
     noise model fitted over every pixel) gives the whole frame's record, every field."""
-    from shadowcam.lab.shadow_time import cfa_site_colours
+    from shadowcam.lab.site_signal import cfa_site_colours
 
     rng = np.random.default_rng(11)
     shape = (10, 9)
