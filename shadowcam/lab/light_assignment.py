@@ -165,32 +165,12 @@ def _gather(values, pick):
 
 
 def _confirmed(seed, estimate, tolerance, radius):
-    """Seeds whose every assigned time neighbouring seeds confirm (:func:`_agreement`).
-
-    A light's shadow crosses a surface as a continuous time map, so its neighbours show
-    the same dip; a spurious dip does not. One agreeing neighbour is weak evidence: among
-    the ``(2 radius + 1)**2 - 1`` neighbours, one spurious dip within `tolerance` of
-    another happens by chance where spurious dips are a few percent of the pixels. So a
-    seed needs two, and more than the neighbours with no significant minimum at all
-    (pixels that see no light's shadow in the sweep deny that one passes their
-    neighbour in mid-sweep). Others (a spurious dip one gap from a real one, a small
-    cluster of spurious dips where every light is outside the sweep) are dropped; the
-    propagation may still give their minima to a light their neighbours predict.
-    """
+    """Seeds whose every assigned time a neighbouring seed confirms (:func:`_agreement`):
+    a lone seed (a spurious dip that happens to sit one gap from a real one) is dropped."""
     time = _gather(estimate, seed)
     _, agree = _agreement(time, tolerance, radius)
-    empty = (~np.isfinite(estimate)).all(axis=0)
-    n_empty = _neighbour_count(empty, radius)
-    lone = ((seed >= 0) & ((agree < 2) | (agree <= n_empty[None]))).any(axis=0)
+    lone = ((seed >= 0) & (agree == 0)).any(axis=0)
     return np.where(lone[None], -1, seed)
-
-
-def _neighbour_count(mask, radius):
-    """Number of `mask` pixels within `radius` pixels (the pixel itself excluded), (H, W)."""
-    pad = np.pad(mask.astype(np.int32), radius)
-    rows, cols = mask.shape
-    return sum(pad[radius + dy:radius + dy + rows, radius + dx:radius + dx + cols]
-               for dy in range(-radius, radius + 1) for dx in range(-radius, radius + 1) if dy or dx)
 
 
 def _propagate(seed, estimate, timed, radius, tolerance, iterations):
