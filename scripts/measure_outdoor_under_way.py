@@ -86,7 +86,7 @@ def _rows(dataset, rows):
 
 
 def _with_curves(photometry, source):
-    """`photometry` with the per-frame curves (:data:`FRAME_CURVES`) of `source` (its cloud shade as a uniform field)."""
+    """`photometry` with the per-frame curves (:data:`FRAME_CURVES`) of `source` (its cloud shade: a uniform field)."""
     out = photometry.copy()
     for name in FRAME_CURVES:
         if name in out.coords:

@@ -49,6 +49,8 @@ def photometry_dataset(result, time_s, *, exposure_gain=None, sky_source="auto")
         (:func:`shadowcam.outdoor.normalise.cloud_shade`; not in a part), ``exposure_gain`` over ``time`` (coords
         ``time_s``, ``shift_row``, ``shift_col``, ``gain``); ``sky``,
         ``lit_at_start``, ``lit_level``, ``shadow_level`` over ``(row, col)``;
+        ``shade_levels`` and ``shade_field`` (not in a part) over ``(time, block_row, block_col)`` with
+        ``shade_rows``, ``shade_cols`` (:mod:`shadowcam.outdoor.shade_field`);
         ``reference (row, col, channel)``; attrs ``shadow_ratio``, ``sky_source``.
     """
     n_frames = len(result["gain_lit"])

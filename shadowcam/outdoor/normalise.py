@@ -360,7 +360,8 @@ class PartMerger:
         return {
             **curves,
             "cloud_shade": shade,
-            "shade_field": np.where((curves["gain_source"] == 1)[:, None, None], shade[:, None, None].astype(np.float32),
+            "shade_field": np.where((curves["gain_source"] == 1)[:, None, None],
+                                    shade[:, None, None].astype(np.float32),
                                     shade_field(curves["shade_levels"], curves["gain_lit"], shadow_ratio=ratio)),
             "shade_rows": self._grid[0],
             "shade_cols": self._grid[1],
