@@ -86,13 +86,16 @@ def _rows(dataset, rows):
 
 
 def _with_curves(photometry, source):
-    """`photometry` with the per-frame curves (:data:`FRAME_CURVES`) of `source`."""
+    """`photometry` with the per-frame curves (:data:`FRAME_CURVES`) of `source` (its cloud shade: a uniform field)."""
     out = photometry.copy()
     for name in FRAME_CURVES:
         if name in out.coords:
             out = out.assign_coords({name: source[name]})
         else:
             out[name] = source[name]
+    if "shade_field" in out:  # the band's median cloud shade over the whole frame, as before the field
+        shade = np.asarray(source["cloud_shade"].values, dtype=np.float32)[:, None, None]
+        out["shade_field"] = out["shade_field"].dims, np.broadcast_to(shade, out["shade_field"].shape).copy()
     return out
 
 

@@ -49,6 +49,8 @@ def photometry_dataset(result, time_s, *, exposure_gain=None, sky_source="auto")
         (:func:`shadowcam.outdoor.normalise.cloud_shade`; not in a part), ``exposure_gain`` over ``time`` (coords
         ``time_s``, ``shift_row``, ``shift_col``, ``gain``); ``sky``,
         ``lit_at_start``, ``lit_level``, ``shadow_level`` over ``(row, col)``;
+        ``shade_levels`` and ``shade_field`` (not in a part) over ``(time, block_row, block_col)`` with
+        ``shade_rows``, ``shade_cols`` (:mod:`shadowcam.outdoor.shade_field`);
         ``reference (row, col, channel)``; attrs ``shadow_ratio``, ``sky_source``.
     """
     n_frames = len(result["gain_lit"])
@@ -75,6 +77,18 @@ def photometry_dataset(result, time_s, *, exposure_gain=None, sky_source="auto")
     if "cloud_shade" in result:
         data["cloud_shade"] = ("time", np.asarray(result["cloud_shade"]),
                                {"units": "1", "long_name": "sun-term transmittance of a cloud over every lit pixel (1: none)"})
+    blocks = ("time", "block_row", "block_col")
+    if "shade_levels" in result:
+        data["shade_levels"] = (blocks, np.asarray(result["shade_levels"], dtype=np.float32),
+                                {"units": "1", "long_name": "brightest ratio frame / first frame of the lit pixels per "
+                                 "block (NaN: none)"})
+        data["shade_rows"] = ("block_row", np.asarray(result["shade_rows"], dtype=np.float64),
+                              {"units": "pixel", "long_name": "block centre row (pixel centres at i + 0.5)"})
+        data["shade_cols"] = ("block_col", np.asarray(result["shade_cols"], dtype=np.float64),
+                              {"units": "pixel", "long_name": "block centre column"})
+    if "shade_field" in result:
+        data["shade_field"] = (blocks, np.asarray(result["shade_field"], dtype=np.float32),
+                               {"units": "1", "long_name": "sun-term transmittance of a cloud per block (1: none)"})
     coords = _frame_coords(time_s, result)
     coords["channel"] = _CHANNELS[: np.shape(result["reference"])[2]]
     dataset = xr.Dataset(data, coords=coords)
@@ -89,6 +103,8 @@ def photometry_arrays(dataset):
         "gain_lit": dataset["gain"].values,
         "gain_sky": dataset["gain_sky"].values,
         "cloud_shade": dataset["cloud_shade"].values if "cloud_shade" in dataset else None,
+        **({key: dataset[key].values for key in ("shade_field", "shade_rows", "shade_cols")}
+           if "shade_field" in dataset else {}),
         "sky": dataset["sky"].values.astype(bool),
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),
         "lit_level": dataset["lit_level"].values,
@@ -142,6 +158,9 @@ def photometry_part_arrays(dataset):
         "kept_lit": dataset["kept_lit"].values,
         "gain_source": dataset["gain_source"].values,
         "gain_median": dataset["gain_median"].values,
+        "shade_levels": dataset["shade_levels"].values,
+        "shade_rows": dataset["shade_rows"].values,
+        "shade_cols": dataset["shade_cols"].values,
         "shadow_min": dataset["shadow_min"].values,
         "sky": dataset["sky"].values.astype(bool),
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),

@@ -33,6 +33,9 @@ PartMerger : the same, one part at a time (memory independent of the number of p
 aligned_luminance : one frame's registered luminance from the pass's results.
 GAIN_SOURCES : where a frame's lit gain comes from (the pass's ``gain_source`` codes).
 cloud_shade : the sun term's transmittance under a cloud over every lit pixel, per frame.
+
+Each frame also gives its blocks' lit level (:func:`shadowcam.outdoor.shade_field.block_levels`);
+the merge turns them into the cloud's shade field over the frame (``shade_field``).
 """
 
 import numpy as np
@@ -40,14 +43,15 @@ import numpy as np
 from shadowcam._shared.validation import check_array, check_same_shape
 from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
 from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
-                                    shift_coarse_to_fine, static_weight)
+                                    shift_coarse_to_fine, soft_shadow, static_weight)
+from shadowcam.outdoor.shade_field import block_grid, block_levels, shade_field, unclouded_blocks
 from shadowcam.outdoor.sky_mask import auto_sky_mask
 from shadowcam.outdoor.translation import translate
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
 #: per-frame results of the pass, concatenated over time parts
-_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source", "gain_median")
+_CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source", "gain_median", "shade_levels")
 #: ``gain_source`` codes: where a frame's lit gain comes from
 GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before",
                 2: "median of the lit pixels (no sky-lit pixels)"}
@@ -82,6 +86,11 @@ class SequenceNormaliser:
         whose width (penumbra, optics blur, upsampling) is measured in each frame
         (:func:`shadowcam.outdoor.registration.soft_shadow`): the band-pass response of a
         moved edge reaches about twice its outer scale (6) beyond it.
+    shade_block : int, optional
+        Side of the cloud shade field's blocks in frame pixels
+        (:mod:`shadowcam.outdoor.shade_field`; on the reduced frames, rounded): several times the
+        ridge penumbra's width, so that what is left of it stays a minority of a block, and well
+        below a cloud's scale.
     reference : (H, W, C) ndarray, optional
         The first frame of the time-lapse, required when `first_index` > 0
         (a time part: the frames fed start later).
@@ -97,7 +106,8 @@ class SequenceNormaliser:
     """
 
     def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
-                 registration_levels=2, registration_margin=6, reference=None, first_index=0, record_from=0):
+                 registration_levels=2, registration_margin=6, shade_block=96, reference=None, first_index=0,
+                 record_from=0):
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
@@ -108,12 +118,16 @@ class SequenceNormaliser:
         if self._registration_margin < 1:
             raise ValueError(f"registration_margin must be >= 1 pixel; got {registration_margin}")
         pyramid_levels((1, 1), levels=self._registration_levels)  # validates the option
+        self._shade_block = int(shade_block)
+        if self._shade_block < 1:
+            raise ValueError(f"shade_block must be >= 1 pixel; got {shade_block}")
         self._k, self.record_from = int(first_index), int(record_from)
         if self._k < 0 or (self._k > 0 and self.record_from - self._k < 2) or self.record_from < self._k:
             raise ValueError(f"first_index {first_index} and record_from {record_from}: need "
                              "0 <= first_index <= record_from - 2 (two warm-up frames), or both 0")
         self.shifts, self.gain_lit, self.gain_sky, self.kept_lit, self.gain_source = [], [], [], [], []
         self.gain_median = []  # median ratio of every lit pixel: follows a cloud (its shade, see result)
+        self.shade_levels = []  # (By, Bx) per frame: the blocks' lit level (the cloud's shade field)
         self._recent = []
         self._last = None  # (shift, gain_lit, gain_sky) of the previous frame processed
         self._lit_to_sky = 1.0  # gain_lit / gain_sky of the previous frame (None: not known yet)
@@ -145,6 +159,17 @@ class SequenceNormaliser:
         self._small_lit = block_all(self.lit_at_start, self.factor)
         self._small_valid = block_all(~self._sky, self.factor)
         self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
+        self._row_edges, self._col_edges, self.shade_rows, self.shade_cols = block_grid(
+            self._small_reference.shape, block=max(1, round(self._shade_block / self.factor)), factor=self.factor)
+
+    def _penumbra_reach(self, small, rough):
+        """Reduced pixels the ridge's penumbra may reach beyond its core and beyond the ground shadowed
+        from the start: twice the soft edge's width measured in this frame
+        (:func:`shadowcam.outdoor.registration.soft_shadow`, as its registration weights take it), 0
+        before the shadow has a core."""
+        _, width = soft_shadow(small, self._small_reference, lit_reference=self._small_lit, gain=rough,
+                               valid=self._small_valid)
+        return int(np.ceil(2 * width)) if np.isfinite(width) else 0
 
     def _prior(self, previous, k):
         if self._exposure is not None and k < self._exposure.size and np.isfinite(self._exposure[k]):
@@ -152,15 +177,27 @@ class SequenceNormaliser:
                                               if np.isfinite(self._exposure[k - 1]) else 1.0)
         return previous
 
-    def _gains(self, small, rough, last_gain, last_sky):
+    def _gains(self, small, rough, last_gain, last_sky, levels):
         """Sky gain, then the lit gain where the sky gain and the lit-to-sky ratio put it
-        (:func:`shadowcam.outdoor.photometric.estimate_lit_gain`); see :data:`GAIN_SOURCES`."""
+        (:func:`shadowcam.outdoor.photometric.estimate_lit_gain`) on the lit pixels of the
+        blocks no cloud clearly dims (:func:`shadowcam.outdoor.shade_field.unclouded_blocks`
+        of the blocks' `levels`); see :data:`GAIN_SOURCES`."""
         ref = self._small_reference
         if not self._small_shadowed.any():
             gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
             return gain_lit, gain_lit, kept, 2
         gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed, prior=last_sky * rough / last_gain)
         expected = None if self._lit_to_sky is None else gain_sky * self._lit_to_sky
+        unclouded = unclouded_blocks(levels)
+        if unclouded.any() and not unclouded[np.isfinite(levels)].all():  # part of the frame under a cloud
+            # no cloud brightens a block: the brightest block's level is the unclouded one, where
+            # the unclouded blocks hold a population at or above the expected level
+            blocks = np.repeat(np.repeat(unclouded, np.diff(self._row_edges), axis=0), np.diff(self._col_edges), axis=1)
+            _, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit & blocks, expected=expected)
+            if found:
+                gain_lit = float(np.nanmax(levels))
+                self._lit_to_sky = gain_lit / gain_sky
+                return gain_lit, gain_sky, kept, 0
         gain_lit, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit, expected=expected)
         if not np.isfinite(gain_lit):  # too few lit pixels and no ratio yet
             gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
@@ -188,6 +225,9 @@ class SequenceNormaliser:
             self._start(frame)
             shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
             kept, source, rough = int(self._small_lit.sum()), 0, 1.0
+            levels = block_levels(self._small_reference, self._small_reference, pixels=self._small_lit,
+                                  row_edges=self._row_edges, col_edges=self._col_edges,
+                                  reached_below=SHADOWED_CONTRAST)
         else:
             if frame.shape[:2] != self.reference.shape[:2] or frame.shape[2:] not in ((), self.reference.shape[2:]):
                 raise ValueError(f"frame {k} has shape {frame.shape}, the first frame {self.reference.shape}")
@@ -204,7 +244,10 @@ class SequenceNormaliser:
             luma = translate(raw, shift, method="opencv_cubic")
             del raw, small
             small = block_mean(luma, factor)
-            gain_lit, gain_sky, kept, source = self._gains(small, rough, last_gain, last_sky)
+            levels = block_levels(small, ref, pixels=self._small_lit, row_edges=self._row_edges,
+                                  col_edges=self._col_edges, reached_below=SHADOWED_CONTRAST * rough,
+                                  dark=self._small_valid & ~self._small_lit, reach=self._penumbra_reach(small, rough))
+            gain_lit, gain_sky, kept, source = self._gains(small, rough, last_gain, last_sky, levels)
         self._last = (np.asarray(shift, dtype=np.float64), float(gain_lit), float(gain_sky))
         if k >= self.record_from:
             self.shifts.append(self._last[0])
@@ -213,6 +256,7 @@ class SequenceNormaliser:
             self.kept_lit.append(int(kept))
             self.gain_source.append(int(source))
             self.gain_median.append(float(rough))
+            self.shade_levels.append(levels.astype(np.float32))
         if luma is not self.reference_luma:
             luma /= np.float32(gain_sky)  # a fresh array (translate); in place saves a frame-sized copy
         else:
@@ -236,6 +280,7 @@ class SequenceNormaliser:
         dict
             ``first_frame`` (index of the first recorded frame), ``shift (T_part, 2)``,
             ``gain_lit``, ``gain_sky``, ``kept_lit``, ``gain_source (T_part,)`` (:data:`GAIN_SOURCES`),
+            ``shade_levels (T_part, By, Bx)`` with ``shade_rows (By,)``, ``shade_cols (Bx,)``,
             ``shadow_min (H, W)``
             (running minimum over the part's 3-frame windows), ``sky``, ``lit_at_start``
             ``(H, W)`` and ``reference (H, W, C)`` (frame 0; the same in every part).
@@ -250,6 +295,9 @@ class SequenceNormaliser:
             "kept_lit": np.array(self.kept_lit),
             "gain_source": np.array(self.gain_source, dtype=np.int8),
             "gain_median": np.array(self.gain_median),
+            "shade_levels": np.array(self.shade_levels),
+            "shade_rows": self.shade_rows,
+            "shade_cols": self.shade_cols,
             "shadow_min": self._shadow_min,
             "sky": self._sky,
             "lit_at_start": self.lit_at_start,
@@ -289,6 +337,7 @@ class PartMerger:
             np.minimum(self._shadow_min, part["shadow_min"], out=self._shadow_min)
         if self._reference is None and part.get("reference") is not None:
             self._reference = part["reference"]
+        self._grid = (np.asarray(part["shade_rows"]), np.asarray(part["shade_cols"]))
 
     def result(self):
         """Return the merged result (a dict; see :func:`normalise_frames`)."""
@@ -307,10 +356,15 @@ class PartMerger:
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
         lit_level = np.where(lit, ref, shadow_min / ratio)
         curves = {key: np.concatenate(values) for key, values in self._curves.items()}
+        shade = cloud_shade(curves["gain_median"], curves["gain_lit"], curves["gain_source"], shadow_ratio=ratio)
         return {
             **curves,
-            "cloud_shade": cloud_shade(curves["gain_median"], curves["gain_lit"], curves["gain_source"],
-                                       shadow_ratio=ratio),
+            "cloud_shade": shade,
+            "shade_field": np.where((curves["gain_source"] == 1)[:, None, None],
+                                    shade[:, None, None].astype(np.float32),
+                                    shade_field(curves["shade_levels"], curves["gain_lit"], shadow_ratio=ratio)),
+            "shade_rows": self._grid[0],
+            "shade_cols": self._grid[1],
             "sky": sky,
             "lit_at_start": lit,
             "lit_level": lit_level.astype(np.float32),
@@ -326,9 +380,9 @@ def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
     A lit pixel whose sky light is ``rho`` of its lit luminance reads ``rho + T (1 - rho)``
     of the lit gain under a cloud of transmittance ``T``; the median ratio of the lit
     pixels over the lit gain, with ``rho`` the pass's shadow-to-lit ratio, gives the median
-    ``T``. Only in frames without an unclouded lit population (``gain_source`` 1): where
-    part of the lit pixels is unclouded the cloud's shade varies over the frame and is
-    measured at the edge by the tracker (:mod:`shadowcam.outdoor.shade`).
+    ``T``. Only in frames without an unclouded lit population (``gain_source`` 1), where it is
+    the frame's shade field; where part of the lit pixels is unclouded the cloud's shade varies
+    over the frame (:mod:`shadowcam.outdoor.shade_field`).
 
     Parameters
     ----------
@@ -394,7 +448,10 @@ def normalise_frames(frames, **options):
         ``shift (T, 2)`` (row, col; pixels), ``gain_lit (T,)``, ``gain_sky (T,)``,
         ``kept_lit (T,)`` (pixels used for the lit gain), ``gain_source (T,)`` (int8, where
         the lit gain comes from: :data:`GAIN_SOURCES`), ``gain_median (T,)`` (median ratio of
-        every lit pixel), ``cloud_shade (T,)`` (:func:`cloud_shade`), ``sky``,
+        every lit pixel), ``cloud_shade (T,)`` (:func:`cloud_shade`), ``shade_levels`` and
+        ``shade_field (T, By, Bx)`` with ``shade_rows (By,)``, ``shade_cols (Bx,)`` (block centres,
+        frame pixels; :mod:`shadowcam.outdoor.shade_field`: ``cloud_shade`` where ``gain_source``
+        is 1), ``sky``,
         ``lit_at_start (H, W)`` bool, ``lit_level``, ``shadow_level (H, W)``
         (luminance of the reference frame's scale: lit in the reference, and
         sky-lit, normalised by ``gain_sky``), ``shadow_ratio`` (median

@@ -149,8 +149,11 @@ def strip_window(cols, halo, width):
 
 def _window_photometry(photometry, window):
     a, b = window
-    return {key: (value[:, a:b] if np.ndim(value) == 2 and key not in ("shift",) else value)
-            for key, value in photometry.items()}
+    cut = {key: (value[:, a:b] if np.ndim(value) == 2 and key not in ("shift",) else value)
+           for key, value in photometry.items()}
+    if cut.get("shade_cols") is not None:  # the shade field's block centres in the window's columns
+        cut["shade_cols"] = np.asarray(cut["shade_cols"], dtype=np.float64) - a
+    return cut
 
 
 def track_strip(frames, photometry, time_s, *, cols, halo=None, **options):

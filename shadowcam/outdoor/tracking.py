@@ -2,8 +2,9 @@
 
 With the shifts, gains and per-pixel levels of the first pass
 (:mod:`shadowcam.outdoor.normalise`), each frame becomes a coverage image
-(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`), from which a passing
-cloud's shade, measured just above each column's last edge, is divided out
+(lit fraction, :func:`shadowcam.outdoor.photometric.coverage`), from which a cloud's shade
+measured over the frame by the first pass (:mod:`shadowcam.outdoor.shade_field`) and a passing
+cloud's shade measured just above each column's last edge are divided out
 (:mod:`shadowcam.outdoor.shade`); frame differencing against the previous coverage
 gives the band where the edge moved (:mod:`shadowcam.outdoor.frame_difference`); the
 edge of every column is located with sub-pixel precision
@@ -37,6 +38,7 @@ from shadowcam.outdoor.episodes import ShadowEpisodes
 from shadowcam.outdoor.frame_difference import difference_band
 from shadowcam.outdoor.photometric import coverage, luminance
 from shadowcam.outdoor.shade import remove_shade, shade_above_edge
+from shadowcam.outdoor.shade_field import interpolate_field
 from shadowcam.outdoor.translation import translate
 
 
@@ -58,8 +60,10 @@ class EdgeTracker:
         ``shadow_ratio`` (the result of :func:`shadowcam.outdoor.normalise.normalise_frames`):
         with it the final descents keep their exposure-normalised luminance too and the long
         ramps are timed by their half-level crossing (:mod:`shadowcam.outdoor.half_level`);
-        optionally ``cloud_shade (T,)`` (:func:`shadowcam.outdoor.normalise.cloud_shade`),
-        divided out of the frame's coverage where below 1.
+        optionally ``shade_field (T, By, Bx)`` with ``shade_rows``, ``shade_cols`` (the cloud's
+        shade over the frame, :mod:`shadowcam.outdoor.shade_field`; block centres in the
+        columns of the frames given), interpolated and divided out of the frame's coverage where
+        below 1.
     time_s : (T,) ndarray
         Frame times in seconds.
     half_window : int, optional
@@ -98,8 +102,10 @@ class EdgeTracker:
         self.shift = np.asarray(photometry["shift"], dtype=np.float64)
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
-        shade = photometry.get("cloud_shade")
-        self.cloud_shade = np.ones_like(self.gain_lit) if shade is None else np.asarray(shade, dtype=np.float64)
+        field = photometry.get("shade_field")
+        self.shade_field = None if field is None else np.asarray(field, dtype=np.float32)
+        self.shade_grid = None if field is None else (np.asarray(photometry["shade_rows"], dtype=np.float64),
+                                                      np.asarray(photometry["shade_cols"], dtype=np.float64))
         self.time_s = np.asarray(time_s, dtype=np.float64)
         n_frames = self.time_s.size
         if not (self.shift.shape == (n_frames, 2) and self.gain_lit.shape == self.gain_sky.shape == (n_frames,)):
@@ -150,8 +156,9 @@ class EdgeTracker:
         luma = translate(luminance(frame), self.shift[k], method="cubic_Keys1981") / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
-        if self.cloud_shade[k] < 1:  # a cloud over every lit pixel: its median shade divided out
-            cover /= np.float32(self.cloud_shade[k])
+        if self.shade_field is not None and (self.shade_field[k] < 1).any():  # a cloud's shade over the frame
+            cover /= interpolate_field(self.shade_field[k], row_centres=self.shade_grid[0],
+                                       col_centres=self.shade_grid[1], shape=cover.shape)
         if k:  # a passing cloud's shade at the edge (measured above the last edge found)
             shade = shade_above_edge(cover, self._last_edge, valid=self.lit_at_start & self.valid, gap=self._shade_gap)
             cover = remove_shade(cover, shade, self._last_edge, gap=self._shade_gap)

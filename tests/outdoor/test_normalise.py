@@ -24,6 +24,7 @@ from shadowcam.cli import main
 from shadowcam.io.datasets import write_netcdf
 from shadowcam.outdoor.datasets import photometry_part_dataset
 from shadowcam.outdoor.normalise import merge_parts, normalise_frames, normalise_part, part_frames
+from shadowcam.outdoor.shade_field import interpolate_field
 from shadowcam.outdoor.translation import translate
 from shadowcam.outdoor.registration import (block_all, block_mean, registration_factor,
                                     shift_lucas_kanade_LucasKanade1981)
@@ -290,3 +291,50 @@ def test_cloud_shade_needs_one_value_per_frame():
 
     with pytest.raises(ValueError, match="gain_source"):
         cloud_shade(np.ones(4), np.ones(4), np.ones(3, int), shadow_ratio=0.15)
+
+
+def _partly_clouded_sequence():
+    """Lit rows 0-239, sky-lit rows 240-319; a soft cloud over all but the top rows of the lit
+    ground deepens (transmittance 1 at row 8 and above, falling linearly to 1 - depth at row 128),
+    with exposure steps; the truth's lit gain is the exposure (no fading sun)."""
+    rng = np.random.default_rng(5)
+    shape = (320, 96)
+    texture = _texture(shape, seed=6)
+    sun_term, sky_term = 0.8 * texture, 0.12 * texture
+    lit = np.zeros(shape, bool)
+    lit[:240] = True
+    rows = np.arange(shape[0])[:, None] + 0.5
+    exposure = np.array([1.0, 1.0, 1.2, 1.2, 1.5, 1.5, 1.5, 1.5])
+    depth = [0.0, 0.0, 0.1, 0.3, 0.5, 0.5, 0.5, 0.5]
+    frames, transmittance = [], []
+    for gain, d in zip(exposure, depth):
+        t = np.broadcast_to(1.0 - d * np.clip((rows - 8.0) / 120.0, 0.0, 1.0), shape)
+        frame = gain * np.where(lit, t * sun_term + sky_term, sky_term)
+        frame = frame * (1.0 + 0.005 * rng.standard_normal(shape)) if frames else frame
+        frames.append(np.repeat(frame[..., None], 3, axis=2).astype(np.float32))
+        transmittance.append(t)
+    return frames, np.array(transmittance), exposure, lit, sun_term / (sun_term + sky_term)
+
+
+def test_lit_gain_is_the_unclouded_block_where_a_cloud_covers_most_lit_pixels():
+    # the unclouded lit pixels are the top 8 rows (3 %): the first pass's lit-gain search slid
+    # into the clouded ones below (40-43 % low in frames 6-7). The brightest 96-row block's upper
+    # quartile is the lit level of its row 24: low by the cloud's shade there, no more (plus the
+    # upper quartile's noise, 2/3 of the 0.5 % noise)
+    frames, transmittance, exposure, lit, sun_share = _partly_clouded_sequence()
+    result = normalise_frames(frames, sky=np.zeros(lit.shape, bool))
+    share = float(np.median(sun_share[lit]))
+    quartile_row = 24  # the upper quartile of the block's rows 0-95 (the cloud falls with the row)
+    bound = share * (1.0 - transmittance[:, quartile_row, 0]) + 0.004
+    error = np.abs(result["gain_lit"] / exposure - 1)
+    assert np.all(error <= bound + 1e-12), (error, bound)
+    assert np.all(result["gain_source"] == 0)
+    # the shade field: 1 in the frames without a cloud, below 1 over the clouded rows where deep
+    assert np.all(result["shade_field"][:2] == 1.0)
+    rows = result["shade_rows"]
+    for k in range(4, 8):
+        field = interpolate_field(result["shade_field"][k], row_centres=rows, col_centres=result["shade_cols"],
+                                  shape=lit.shape)
+        deep = lit & (transmittance[k] < 0.6)
+        # within the cloud's variation over half a block (48 rows: 0.2) of the truth
+        assert np.all(np.abs(field[deep] - transmittance[k][deep]) < 0.2), k
