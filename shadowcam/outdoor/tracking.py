@@ -63,7 +63,8 @@ class EdgeTracker:
         optionally ``shade_field (T, By, Bx)`` with ``shade_rows``, ``shade_cols`` (the cloud's
         shade over the frame, :mod:`shadowcam.outdoor.shade_field`; block centres in the
         columns of the frames given), interpolated and divided out of the frame's coverage where
-        below 1.
+        below 1; without it, ``cloud_shade (T,)`` (a first pass written before the field) divided
+        out uniformly.
     time_s : (T,) ndarray
         Frame times in seconds.
     half_window : int, optional
@@ -103,9 +104,14 @@ class EdgeTracker:
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
         field = photometry.get("shade_field")
-        self.shade_field = None if field is None else np.asarray(field, dtype=np.float32)
-        self.shade_grid = None if field is None else (np.asarray(photometry["shade_rows"], dtype=np.float64),
-                                                      np.asarray(photometry["shade_cols"], dtype=np.float64))
+        if field is None:  # a first pass without the field: its per-frame shade, uniform over the frame
+            uniform = photometry.get("cloud_shade")
+            self.shade_field = None if uniform is None else np.asarray(uniform, dtype=np.float32)[:, None, None]
+            self.shade_grid = (np.zeros(1), np.zeros(1))
+        else:
+            self.shade_field = np.asarray(field, dtype=np.float32)
+            self.shade_grid = (np.asarray(photometry["shade_rows"], dtype=np.float64),
+                               np.asarray(photometry["shade_cols"], dtype=np.float64))
         self.time_s = np.asarray(time_s, dtype=np.float64)
         n_frames = self.time_s.size
         if not (self.shift.shape == (n_frames, 2) and self.gain_lit.shape == self.gain_sky.shape == (n_frames,)):

@@ -57,3 +57,20 @@ def test_wrong_strips_and_options_are_refused(capture, tmp_path):
     np.savez(tmp_path / "other.npz", a=np.zeros(2))
     with pytest.raises(ValueError, match="missing"):
         load_strip(tmp_path / "other.npz")
+
+
+def test_a_first_pass_without_the_shade_field_divides_its_uniform_cloud_shade(capture):
+    # a photometry.nc written before the field carries one cloud shade per frame: tracked as
+    # the same shade given as a uniform field over the frame
+    scene, frames, photometry = capture
+    shade = np.ones(photometry.sizes["time"])
+    shade[8:14] = 0.6
+    old = photometry.drop_vars([name for name in ("shade_field", "shade_levels", "shade_rows", "shade_cols")
+                                if name in photometry]).assign(cloud_shade=("time", shade))
+    uniform = old.assign(shade_field=(("time", "block_row", "block_col"), shade[:, None, None].astype(np.float32)),
+                         shade_rows=("block_row", [0.0]), shade_cols=("block_col", [0.0]))
+    tracked_old, tracked_uniform = track_edges(frames, old), track_edges(frames, uniform)
+    np.testing.assert_array_equal(tracked_old["edge_row"].values, tracked_uniform["edge_row"].values)
+    # and the shade is divided out: the tracked edge differs from a pass with no shade at all
+    plain = track_edges(frames, old.assign(cloud_shade=("time", np.ones_like(shade))))
+    assert not np.array_equal(np.nan_to_num(plain["edge_row"].values), np.nan_to_num(tracked_old["edge_row"].values))
