@@ -6,7 +6,8 @@ The frames of one sweep stream through a :class:`~shadowcam.lab.dip_tracker.DipT
 to a fraction of a frame by one of the methods of
 :data:`~shadowcam.lab.shadow_time_methods.SHADOW_TIME_METHODS`. With the dips' measured
 intervals, a dip wider than the tracker's window is timed at its interval's centre
-(cut by the sweep's start or end: from its one edge and the neighbours' width), and one
+(cut by the sweep's start or end: from its one edge and the neighbours' width), a thin
+dip cut by the sweep's first or last frame from its neighbours' removed light, and one
 with several minima that never returns to the lit level between them at its removed
 light's centroid (:mod:`shadowcam.lab.connected_dips`).
 
@@ -14,6 +15,7 @@ Offers
 ------
 shadow_times : timing of one sweep's classified :class:`DipSummary`.
 footprint_spread_std : time uncertainty of a footprint that sees two surfaces' shadow times.
+cut_by_sweep : pixels whose dip the sweep's first or last frame cuts.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
 summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
@@ -70,9 +72,11 @@ def shadow_times(summary, reason, contrast, *, method="edge_fit", method_params=
         The measured dip intervals (:func:`shadowcam.lab.dip_tracker.track_intervals`):
         a dip wider than the window is then timed at its interval's centre
         (``dip_at_sweep_end`` when the interval reaches the sweep's start or
-        end, ``invalid_input`` with a non-finite sample inside), the
-        ``interval_*`` variables are returned, and ``time_std`` adds the
-        footprint's excess span (:func:`footprint_spread_std`).
+        end, ``invalid_input`` with a non-finite sample inside), a thin dip cut by
+        the sweep's first or last frame (:func:`cut_by_sweep`) from its neighbours'
+        removed light (``dip_at_sweep_end_timed``, or ``dip_at_sweep_end`` when its
+        centre is outside the sweep), the ``interval_*`` variables are returned, and
+        ``time_std`` adds the footprint's excess span (:func:`footprint_spread_std`).
     support : DipSupport, optional
         The dips' excursions below the lit level (:func:`support_intervals` of `reason`):
         a ``several_minima`` or ``wide_dip`` pixel whose minima lie in one excursion
