@@ -98,18 +98,10 @@ def shadow_times(summary, reason, contrast, *, method="edge_fit", method_params=
         )
     if support is not None and interval is None:
         raise ValueError("support needs the interval it was measured with")
-    by_window = reason == OK
-    if interval is not None:
-        # a dip cut by the sweep's first or last frame is timed from its interval or its
-        # neighbours' removed light (_time_wide_dips); its window time, late or early, is
-        # left out so that it takes no part in its neighbours' edge refinement
-        cut_start, cut_end = cut_by_sweep(summary, interval)
-        by_window &= cut_start == cut_end
-    masked = _masked_summary(summary, by_window)
+    masked = _masked_summary(summary, reason == OK)
     time, entry, exit_, std = SHADOW_TIME_METHODS[method](masked, **(method_params or {}))
     if interval is not None:
-        reason, time, entry, exit_, std, extra = _time_wide_dips(summary, interval, (cut_start, cut_end), reason,
-                                                                 time, entry, exit_, std)
+        reason, time, entry, exit_, std, extra = _time_wide_dips(summary, interval, reason, time, entry, exit_, std)
         std = np.hypot(std, footprint_spread_std(interval, reason == OK))
         if support is not None:
             reason, time, entry, exit_, std, extra = time_connected_dips(
@@ -170,11 +162,9 @@ def footprint_spread_std(interval, timed):
     return 0.5 * np.nan_to_num(excess, nan=0.0, posinf=0.0)
 
 
-def _time_wide_dips(summary, interval, cut, reason, time, entry, exit_, std):
+def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     """Time the ``wide_dip`` and ``ok`` pixels whose half-depth interval reaches the window's
-    edge at the centre of their measured interval, and the thin dips cut by the sweep.
-
-    `cut` is :func:`cut_by_sweep`'s ``(cut_start, cut_end)``.
+    edge at the centre of their measured interval.
 
     Returns the updated ``reason, time, entry, exit, std`` and the
     ``interval_*`` variables (noise over the crossing's slope for the
@@ -195,7 +185,7 @@ def _time_wide_dips(summary, interval, cut, reason, time, entry, exit_, std):
         beyond = (interval.entry < summary.minimum_frame - h + 1) | (interval.exit > summary.minimum_frame + h - 1)
     # a flagged wide dip open at the sweep's start or end has no time; a thin dip the window
     # holds that the sweep cuts is timed from its samples below (_time_cut_thin_dips)
-    cut_start, cut_end = cut
+    cut_start, cut_end = cut_by_sweep(summary, interval)
     cut_thin = (reason == OK) & ~beyond & (cut_start != cut_end)
     wide = ((reason == WIDE_DIP) & (beyond | opened)) | ((reason == OK) & beyond)
     at_end = wide & opened
