@@ -96,7 +96,9 @@ def shadow_time_errors(estimate, truth, *, lit, time_std=None):
     dict
         ``n_truth`` (lit pixels with a GT time), ``n_evaluated``, ``coverage``,
         ``median``, ``p95``, ``rmse``, ``max`` (absolute error, frames),
-        ``frac_gt_1_frame``, ``n_unlit``, ``false_time_rate``, ``mean_signed``; with
+        ``frac_gt_1_frame``, ``n_unlit``, ``false_time_rate``, ``mean_signed``,
+        ``n_unswept`` (lit pixels the shadow does not cross within the sweep: no GT time)
+        and ``unswept_time_rate`` (the fraction of them given a time); with
         `time_std` also ``n_uncertain`` (evaluated pixels whose std exceeds
         :data:`CONFIDENT_STD`; they stay in every statistic above) and ``p95_confident``
         (p95 over the other evaluated pixels).
@@ -124,6 +126,9 @@ def shadow_time_errors(estimate, truth, *, lit, time_std=None):
         "n_unlit": n_unlit,
         "false_time_rate": float((has_est & ~lit).sum() / n_unlit) if n_unlit else 0.0,
     }
+    unswept = lit & ~np.isfinite(truth)
+    out["n_unswept"] = int(unswept.sum())
+    out["unswept_time_rate"] = float((has_est & unswept).sum() / out["n_unswept"]) if out["n_unswept"] else 0.0
     if time_std is not None:
         std = np.asarray(time_std, dtype=np.float64)
         if std.shape != truth.shape:
@@ -559,6 +564,7 @@ TABLE_ROWS = {
         "frac_gt_1_frame": ("shadow time |error| > 1 frame", "%", 100.0),
         "mean_signed": ("shadow time mean signed error", "frame", 1.0),
         "false_time_rate": ("false times (unlit pixels given a time)", "%", 100.0),
+        "unswept_time_rate": ("false times (lit pixels the sweep's shadow does not cross given a time)", "%", 100.0),
         "n_evaluated": ("pixels evaluated (lit, timed)", "pixel", 1.0),
         "n_uncertain": (f"pixels evaluated with time std > {CONFIDENT_STD:g} frame", "pixel", 1.0),
         "p95_confident": (f"shadow time |error| p95, time std <= {CONFIDENT_STD:g} frame", "frame", 1.0),

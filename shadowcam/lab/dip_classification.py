@@ -39,8 +39,9 @@ REASONS = {
 }
 (OK, NEVER_SHADOWED, LOW_CONTRAST, SATURATED, SEVERAL_MINIMA, INVALID_INPUT, WIDE_DIP, DIP_AT_SWEEP_END,
  DIP_AT_SWEEP_END_TIMED) = range(9)
-#: codes of the pixels with a time: a reliable one, and one from a dip's one edge and its
-#: neighbours' shadow width (its uncertainty in ``time_std``)
+#: codes of the pixels with a time: a reliable one, and one of a dip cut by the sweep's first
+#: or last frame, from its part in the sweep and its neighbours' dip width or removed light
+#: (their spread in ``time_std``)
 TIMED = (OK, DIP_AT_SWEEP_END_TIMED)
 #: standard deviation of a [1, 2, 1]/4-smoothed sample relative to a raw one
 _SMOOTHED_NOISE = float(np.sqrt(0.25**2 * 2 + 0.5**2))

@@ -6,7 +6,8 @@ The frames of one sweep stream through a :class:`~shadowcam.lab.dip_tracker.DipT
 to a fraction of a frame by one of the methods of
 :data:`~shadowcam.lab.shadow_time_methods.SHADOW_TIME_METHODS`. With the dips' measured
 intervals, a dip wider than the tracker's window is timed at its interval's centre
-(cut by the sweep's start or end: from its one edge and the neighbours' width), and one
+(cut by the sweep's start or end: from its one edge and the neighbours' width), a thin
+dip cut by the sweep's first or last frame from its neighbours' removed light, and one
 with several minima that never returns to the lit level between them at its removed
 light's centroid (:mod:`shadowcam.lab.connected_dips`).
 
@@ -14,6 +15,7 @@ Offers
 ------
 shadow_times : timing of one sweep's classified :class:`DipSummary`.
 footprint_spread_std : time uncertainty of a footprint that sees two surfaces' shadow times.
+cut_by_sweep : pixels whose dip the sweep's first or last frame cuts.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
 summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
@@ -45,8 +47,9 @@ from shadowcam.lab.site_signal import cfa_site_colours, track_site_window
 # lab.light_files, evaluate, tests): the reason codes, the detection threshold, the methods,
 # the own-site timing and the CFA site colours live in the modules above.
 from shadowcam.lab.dip_classification import (  # noqa: F401  (re-exported)
-    LOW_CONTRAST, NEVER_SHADOWED, SATURATED, SEVERAL_MINIMA, detection_threshold,
+    LOW_CONTRAST, NEVER_SHADOWED, SATURATED, SEVERAL_MINIMA,
 )
+from shadowcam.lab.dip_classification import detection_threshold
 from shadowcam.lab.shadow_time_methods import _site_times  # noqa: F401  (re-exported)
 
 log = logging.getLogger(__name__)
@@ -69,9 +72,11 @@ def shadow_times(summary, reason, contrast, *, method="edge_fit", method_params=
         The measured dip intervals (:func:`shadowcam.lab.dip_tracker.track_intervals`):
         a dip wider than the window is then timed at its interval's centre
         (``dip_at_sweep_end`` when the interval reaches the sweep's start or
-        end, ``invalid_input`` with a non-finite sample inside), the
-        ``interval_*`` variables are returned, and ``time_std`` adds the
-        footprint's excess span (:func:`footprint_spread_std`).
+        end, ``invalid_input`` with a non-finite sample inside), a thin dip cut by
+        the sweep's first or last frame (:func:`cut_by_sweep`) from its neighbours'
+        removed light (``dip_at_sweep_end_timed``, or ``dip_at_sweep_end`` when its
+        centre is outside the sweep), the ``interval_*`` variables are returned, and
+        ``time_std`` adds the footprint's excess span (:func:`footprint_spread_std`).
     support : DipSupport, optional
         The dips' excursions below the lit level (:func:`support_intervals` of `reason`):
         a ``several_minima`` or ``wide_dip`` pixel whose minima lie in one excursion
@@ -178,8 +183,10 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     opened = interval.entry_open | interval.exit_open
     with np.errstate(invalid="ignore"):
         beyond = (interval.entry < summary.minimum_frame - h + 1) | (interval.exit > summary.minimum_frame + h - 1)
-    # a flagged wide dip open at the sweep's start or end has no time; a dip the window
-    # timed keeps its time there (its centre is inside the sweep)
+    # a flagged wide dip open at the sweep's start or end has no time; a thin dip the window
+    # holds that the sweep cuts is timed from its samples below (_time_cut_thin_dips)
+    cut_start, cut_end = cut_by_sweep(summary, interval)
+    cut_thin = (reason == OK) & ~beyond & (cut_start != cut_end)
     wide = ((reason == WIDE_DIP) & (beyond | opened)) | ((reason == OK) & beyond)
     at_end = wide & opened
     broken = wide & ~at_end & ((interval.invalid > 0) | ~np.isfinite(interval.entry) | ~np.isfinite(interval.exit))
@@ -218,9 +225,129 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     entry = np.where(cut, interval_entry, entry)
     exit_ = np.where(cut, interval_exit, exit_)
     std = np.where(cut, np.hypot(edge_std, 0.5 * width_std), std)
+    # a thin dip cut by the sweep, from the removed light of its uncut neighbours' dips
+    removed = _removed_light(summary)
+    whole = (reason == OK) & ~cut_thin & ~(cut_start | cut_end) & np.isfinite(removed[0])
+    total, total_std = _local_width(removed[0], whole)
+    cut_time, cut_std = _time_cut_thin_dips(summary, cut_start, total, total_std)
+    with np.errstate(invalid="ignore"):
+        inside = cut_thin & np.isfinite(cut_time) & (cut_time >= 0) & (cut_time <= summary.n_frames - 1)
+    reason[cut_thin] = DIP_AT_SWEEP_END
+    reason[inside] = DIP_AT_SWEEP_END_TIMED
+    time = np.where(inside, cut_time, time)
+    std = np.where(inside, cut_std, std)
+    # the crossing inside the sweep mirrored about the centre gives the one beyond it
+    interval_entry = np.where(inside & cut_start, 2 * cut_time - interval_exit, interval_entry)
+    interval_exit = np.where(inside & ~cut_start, 2 * cut_time - interval_entry, interval_exit)
+    entry_std = np.where(inside & cut_start, np.hypot(exit_std, 2 * cut_std), entry_std)
+    exit_std = np.where(inside & ~cut_start, np.hypot(entry_std, 2 * cut_std), exit_std)
+    entry = np.where(inside, interval_entry, entry)
+    exit_ = np.where(inside, interval_exit, exit_)
     extra = {"interval_entry": interval_entry, "interval_exit": interval_exit,
              "interval_entry_std": entry_std, "interval_exit_std": exit_std}
     return reason, time, entry, exit_, std, extra
+
+
+def cut_by_sweep(summary, interval, *, false_alarm=1e-3):
+    """Pixels whose dip the sweep's first or last frame cuts.
+
+    A dip is cut by the sweep's start (end) when its window holds the sweep's first (last)
+    frame and the signal there is not back at the lit level: its half-depth interval is
+    open on that side, or the sample is darker than the lit level by more than pure noise
+    reaches with probability `false_alarm`.
+
+    Parameters
+    ----------
+    summary : DipSummary
+        ``window (K, H, W)``, ``window_start``, ``lit_level``, ``noise`` ``(H, W)``.
+    interval : DipInterval
+        ``entry_open``, ``exit_open`` ``(H, W)``.
+    false_alarm : float, optional
+        Probability that a lit sample of pure noise is taken for a cut dip.
+
+    Returns
+    -------
+    cut_start, cut_end : (H, W) bool ndarray
+    """
+    k = summary.window.shape[0]
+    z = detection_threshold(1, false_alarm=false_alarm)
+    rows, cols = np.indices(summary.window_start.shape)
+    cut = []
+    for frame, open_ in ((0, interval.entry_open), (summary.n_frames - 1, interval.exit_open)):
+        slot = frame - summary.window_start
+        held = (slot >= 0) & (slot < k)
+        sample = summary.window[np.clip(slot, 0, k - 1), rows, cols].astype(np.float64)
+        with np.errstate(invalid="ignore"):
+            cut.append(held & (open_ | (summary.lit_level - sample > z * summary.noise)))
+    return cut[0], cut[1]
+
+
+def _removed_light(summary):
+    """Removed light of each pixel's window, ``1 - I / I_lit`` summed, and its first moment in frames.
+
+    Not clipped, so lit samples add zero-mean noise only. Returns ``(total, moment, floor)``,
+    ``(H, W)`` each: the sum over the window's frames inside the sweep, the sum of frame
+    times the removed fraction, the largest removed fraction.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        fraction = 1.0 - summary.window.astype(np.float64) / summary.lit_level[None]
+    frames = summary.window_start[None] + np.arange(summary.window.shape[0])[:, None, None]
+    held = np.isfinite(fraction)
+    total = np.where(held, fraction, 0.0).sum(axis=0)
+    moment = np.where(held, fraction * frames, 0.0).sum(axis=0)
+    floor = np.where(held, fraction, -np.inf).max(axis=0)
+    total = np.where(held.any(axis=0), total, np.nan)
+    return total, moment, floor
+
+
+def _time_cut_thin_dips(summary, cut_start, total, total_std):
+    """Centre of each thin dip cut by the sweep's first (`cut_start`) or last frame.
+
+    A dip removes the same light summed over its frames (``1 - I / I_lit``: the wire's
+    width in frames) wherever a planar sweep's shadow passes, so the uncut neighbours'
+    `total` says how much of it lies beyond the sweep. That part is put in the frames
+    beyond the cut end, nearest first, each up to the deepest removed fraction seen (the
+    dip's floor), and the centre is the centroid of the whole dip. It is exact for a
+    hard-edged dip sampled over whole frames whose floor the sweep shows, and errs outward
+    otherwise (a floor not seen is taken shallower: the dip reaches further beyond).
+
+    Parameters
+    ----------
+    summary : DipSummary
+    cut_start : (H, W) bool ndarray
+        The cut is at the sweep's first frame (else at its last).
+    total, total_std : (H, W) ndarray
+        Removed light of the uncut neighbours' dips (frames) and its spread.
+
+    Returns
+    -------
+    time, time_std : (H, W) float64 ndarray
+        Frames; outside ``[0, n_frames - 1]`` where the centre lies beyond the sweep,
+        NaN where `total` is unknown. ``time_std`` from the samples' noise and `total_std`.
+    """
+    seen, moment, floor = _removed_light(summary)
+    floor = np.clip(floor, 1e-3, 1.0)
+    with np.errstate(invalid="ignore"):
+        missing = np.maximum(total - seen, 0.0)
+    beyond_first = np.where(cut_start, -1.0, float(summary.n_frames))
+    step = np.where(cut_start, -1.0, 1.0)
+    k = summary.window.shape[0]
+    placed, placed_moment = np.zeros(seen.shape), np.zeros(seen.shape)
+    for j in range(k):
+        mass = np.clip(missing - j * floor, 0.0, floor)
+        placed += mass
+        placed_moment += mass * (beyond_first + j * step)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        time = (moment + placed_moment) / (seen + placed)
+        # more missing than the window's length of floor: the centre is far beyond the sweep
+        time = np.where(missing > k * floor, beyond_first + k * step, time)
+        frames = summary.window_start[None] + np.arange(k)[:, None, None]
+        held = np.isfinite(summary.window)
+        lever = np.sqrt(np.where(held, (frames - beyond_first[None]) ** 2, 0.0).sum(axis=0))
+        sample_std = summary.noise / summary.lit_level * lever / total
+        time_std = np.hypot(sample_std, np.abs(time - beyond_first) * total_std / total)
+    time = np.where(np.isfinite(total), time, np.nan)
+    return time, time_std
 
 
 def _local_width(width, known, *, min_count=8):

@@ -48,6 +48,10 @@ def test_shadow_time_errors_known_offsets():
     assert out["rmse"] == pytest.approx(np.sqrt(4 * 100 / (n - 50)))
     assert out["median"] == 0.0 and out["max"] == pytest.approx(2.0)
     assert out["false_time_rate"] == pytest.approx(5 / (~lit).sum())
+    # lit pixels the shadow does not cross in the sweep: 20, none timed yet
+    assert out["n_unswept"] == 20 and out["unswept_time_rate"] == 0.0
+    est[4, :3] = 0.1  # 3 of them given a time
+    assert shadow_time_errors(est, truth, lit=lit)["unswept_time_rate"] == pytest.approx(3 / 20)
 
 
 def test_targets_pass_fail_per_noise_condition():

@@ -6,7 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from shadowcam.lab.dip_classification import (
-    INVALID_INPUT, LOW_CONTRAST, NEVER_SHADOWED, OK, SATURATED, SEVERAL_MINIMA, detection_threshold,
+    INVALID_INPUT, LOW_CONTRAST, NEVER_SHADOWED, OK, SATURATED, SEVERAL_MINIMA, TIMED, detection_threshold,
 )
 from shadowcam.lab.shadow_time import shadow_time_dataset, sweep_shadow_times
 from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
@@ -372,6 +372,40 @@ def test_a_dip_cut_by_the_sweep_is_timed_from_its_edge_and_the_neighbours_width(
     # the uncut pixels keep their reliable time
     assert np.mean(reason[np.isfinite(gt) & ~cut & (np.abs(gt - n / 2) < 10)] == OK) >= 0.98
     assert REASONS[DIP_AT_SWEEP_END_TIMED] == "dip_at_sweep_end_timed" and DIP_AT_SWEEP_END_TIMED in TIMED
+
+
+@pytest.mark.parametrize("side", ["start", "end"])
+@pytest.mark.parametrize("noise, seed", [(0.0, 0), (0.01, 1), (0.01, 2)])
+def test_a_thin_dip_cut_by_the_sweep_is_timed_inside_it_and_flagged_outside(wire_sweep, side, noise, seed):
+    # a 2-frame shadow whose centre line crosses the first columns from 3 frames before the
+    # sweep's first frame, at every quarter-frame offset (tilt 0.25 per row): the dips of
+    # the first pixels are cut by frame 0. Exact truth at the pixel centre, also where it
+    # lies before the sweep (no time there)
+    n, shape, t0, tilt = 40, (24, 24), -3.0, 0.25
+    frames, _ = wire_sweep(n_frames=n, shape=shape, width=2.0, px_per_frame=1.0, t0=t0, tilt=tilt,
+                           level=0.8, noise=noise, seed=seed)
+    rows, cols = np.indices(shape)
+    truth = t0 + cols + 0.5 + tilt * (rows + 0.5)
+    if side == "end":  # the same sweep run backwards: the dips cut by the last frame
+        frames, truth = frames[::-1].copy(), n - 1 - truth
+    from_cut = truth if side == "start" else n - 1 - truth
+    after = _interval_times(frames, method="edge_fit")
+    timed = np.isin(after["reason"], TIMED)
+    # a centre before the first frame (after the last) has no time in the sweep
+    assert not timed[from_cut < 0].any()
+    # a centre inside it is timed, within the footprint's sub-sampling without noise; the
+    # old window centroid was up to 0.26 frame late here (the dip's part before frame 0 lost)
+    near = (from_cut >= 0) & (from_cut < 1.5)
+    assert near.sum() >= 20 and timed[near].all()
+    error = np.abs(after["shadow_time"] - truth)[near]
+    assert error.max() <= (0.01 if noise == 0 else 0.2)
+    if noise:
+        # noise 1.25 % of the lit level on a 2-frame dip: the uncut pixels' 95th percentile is 0.05
+        assert np.percentile(error, 95) <= 0.12
+        assert np.all(error <= 3 * after["time_std"][near] + 0.02)
+    # the uncut dips keep their window time
+    far = (from_cut >= 3) & (from_cut <= n - 4)
+    assert np.mean(after["reason"][far] == OK) >= 0.98
 
 
 def test_a_cut_dip_without_uncut_neighbours_stays_untimed(wire_sweep):
