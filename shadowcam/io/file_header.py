@@ -14,7 +14,8 @@ header_metadata : exposure and capture time (and bits per sample) of one file.
 
 import datetime as _dt
 
-_CFA = 32803  # PhotometricInterpretation: colour filter array
+from shadowcam.io.mosaic_reader import raw_page
+
 _EXPOSURE_TIME, _DATE_TIME_ORIGINAL, _SUBSEC_TIME_ORIGINAL = 33434, 36867, 37521
 
 
@@ -91,9 +92,7 @@ def _tiff_header(path):
         stamp = _parse_exif_datetime(tag(_DATE_TIME_ORIGINAL, "DateTimeOriginal"),
                                      tag(_SUBSEC_TIME_ORIGINAL, "SubsecTimeOriginal"))
         exposure = tag(_EXPOSURE_TIME, "ExposureTime")
-        raw = next((page for page in [first] + list(first.pages or [])
-                    if page.photometric == _CFA and int(page.tags.valueof(254, 0)) & 1 == 0), first)
-        bits = raw.bitspersample
+        bits = (raw_page(tif) or first).bitspersample
         return {"exposure_s": _seconds(exposure) if exposure is not None else None,
                 "capture_time": stamp.isoformat() if stamp is not None else None,
                 "bits_per_sample": int(bits) if bits else None}

@@ -13,6 +13,7 @@ with rawpy.
 Offers
 ------
 MosaicReader : read the mosaics of one sweep (fast path verified on its first frame).
+raw_page : the full-resolution CFA page of a DNG.
 """
 
 import numpy as np
@@ -31,7 +32,7 @@ _LAYOUT_TAGS = (
 )
 
 
-def _raw_page(tif):
+def raw_page(tif):
     """The full-resolution CFA page of a DNG (IFD 0 or one of its SubIFDs), or None."""
     first = tif.pages[0]
     for page in [first] + list(first.pages or []):
@@ -102,7 +103,7 @@ class MosaicReader:
 
         try:
             with tifffile.TiffFile(path) as tif:
-                page = _raw_page(tif)
+                page = raw_page(tif)
                 layout = _direct_layout(page)
                 return (layout, _read_direct(page)) if layout is not None else (None, None)
         except (tifffile.TiffFileError, OSError, ValueError, KeyError, RuntimeError, NotImplementedError):
@@ -124,7 +125,7 @@ class MosaicReader:
 
             try:
                 with tifffile.TiffFile(path) as tif:
-                    page = _raw_page(tif)
+                    page = raw_page(tif)
                     if _direct_layout(page) == self._layout:
                         return _read_direct(page), self._direct_levels
             except (tifffile.TiffFileError, OSError, ValueError, KeyError, RuntimeError, NotImplementedError):
