@@ -35,22 +35,13 @@ from shadowcam._shared.progress import Progress
 from shadowcam._shared.validation import check_in_interval
 from shadowcam.lab.connected_dips import support_intervals, time_connected_dips
 from shadowcam.lab.dip_classification import (
-    _SMOOTHED_NOISE, DIP_AT_SWEEP_END, DIP_AT_SWEEP_END_TIMED, INVALID_INPUT, OK, REASONS, TIMED, WIDE_DIP,
-    classify_dips, neighbour_offsets, supported_by_neighbours,
+    _SMOOTHED_NOISE, DIP_AT_SWEEP_END, DIP_AT_SWEEP_END_TIMED, INVALID_INPUT, NEVER_SHADOWED, OK, REASONS, TIMED,
+    WIDE_DIP, classify_dips, detection_threshold, neighbour_offsets, supported_by_neighbours,
 )
 from shadowcam.lab.dip_tracker import DipTracker, lit_colour
 from shadowcam.lab.edge_refine import shifted
 from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
 from shadowcam.lab.site_signal import cfa_site_colours, track_site_window
-
-# Names other modules and wings still import from here (lab.minima, lab.light_views,
-# lab.light_files, evaluate, tests): the reason codes, the detection threshold, the methods,
-# the own-site timing and the CFA site colours live in the modules above.
-from shadowcam.lab.dip_classification import (  # noqa: F401  (re-exported)
-    LOW_CONTRAST, NEVER_SHADOWED, SATURATED, SEVERAL_MINIMA,
-)
-from shadowcam.lab.dip_classification import detection_threshold
-from shadowcam.lab.shadow_time_methods import _site_times  # noqa: F401  (re-exported)
 
 log = logging.getLogger(__name__)
 

@@ -219,7 +219,8 @@ def _interval_times(frames, **options):
 def test_a_dip_wider_than_the_window_is_timed_at_its_interval(wire_sweep, width):
     # a shadow 10 / 24 frames wide with 4-frame penumbrae (an area source), noise free:
     # the window of 9 frames sees only its floor, the interval all of it
-    from shadowcam.lab.shadow_time import NEVER_SHADOWED, OK, WIDE_DIP, sweep_shadow_times
+    from shadowcam.lab.dip_classification import NEVER_SHADOWED, OK, WIDE_DIP
+    from shadowcam.lab.shadow_time import sweep_shadow_times
 
     frames, gt = wire_sweep(n_frames=90, shape=(24, 32), width=width, ramp=4.0, px_per_frame=1.0,
                             t0=20.0, tilt=0.3, level=1.0)
@@ -241,7 +242,7 @@ def test_a_dip_wider_than_the_window_is_timed_at_its_interval(wire_sweep, width)
 
 def test_a_noisy_wide_floor_is_one_dip_not_several(wire_sweep):
     # the floor of a 30-frame dip holds many local minima: inside the interval they are the same dip
-    from shadowcam.lab.shadow_time import OK, SEVERAL_MINIMA
+    from shadowcam.lab.dip_classification import OK, SEVERAL_MINIMA
 
     frames, gt = wire_sweep(n_frames=120, shape=(16, 16), width=30.0, ramp=4.0, px_per_frame=1.0,
                             t0=40.0, tilt=0.0, level=1.0, noise=0.02, seed=2)
