@@ -34,7 +34,10 @@ def shade_above_edge(cover, edge_row, *, valid, gap=4, rows=8):
     edge_row : (W,) ndarray
         The columns' edge rows (pixel-edge coordinates; NaN: none, no correction).
     valid : (H, W) bool ndarray
-        Pixels that may serve as reference (lit at start, not sky).
+        Pixels that may serve as reference: sunlit as far as the ridge is concerned (the
+        tracker: lit at start, not sky, and lit in the previous frame once its shade was divided
+        out; rows the ridge's shadow has reached read near 0, which no division should take for
+        a cloud's shade).
     gap, rows : int, keyword-only
         The reference rows are the `rows` rows ending `gap` rows above the edge.
 

@@ -4,9 +4,9 @@ With the shifts, gains and per-pixel levels of the first pass
 (:mod:`shadowcam.outdoor.normalise`), each frame becomes a coverage image
 (lit fraction, :func:`shadowcam.outdoor.photometric.coverage`), from which a cloud's shade
 measured over the frame by the first pass (:mod:`shadowcam.outdoor.shade_field`) and a passing
-cloud's shade measured just above each column's last edge are divided out
-(:mod:`shadowcam.outdoor.shade`); frame differencing against the previous coverage
-gives the band where the edge moved (:mod:`shadowcam.outdoor.frame_difference`); the
+cloud's shade measured just above each column's last edge (on the rows the previous frame
+left lit) are divided out (:mod:`shadowcam.outdoor.shade`); frame differencing against the
+previous coverage gives the band where the edge moved (:mod:`shadowcam.outdoor.frame_difference`); the
 edge of every column is located with sub-pixel precision
 (:mod:`shadowcam.outdoor.edge_tracking`), preferring transitions in the band, then near
 the column's most recent edge (tracking), and the dark episodes of every pixel are
@@ -166,7 +166,9 @@ class EdgeTracker:
             cover /= interpolate_field(self.shade_field[k], row_centres=self.shade_grid[0],
                                        col_centres=self.shade_grid[1], shape=cover.shape)
         if k:  # a passing cloud's shade at the edge (measured above the last edge found)
-            shade = shade_above_edge(cover, self._last_edge, valid=self.lit_at_start & self.valid, gap=self._shade_gap)
+            # rows the previous frame left dark (its shade divided out) are in the ridge's shadow
+            lit = self.lit_at_start & self.valid & (self._previous >= self.episodes.level)
+            shade = shade_above_edge(cover, self._last_edge, valid=lit, gap=self._shade_gap)
             cover = remove_shade(cover, shade, self._last_edge, gap=self._shade_gap)
         band = None
         if self._previous is not None:

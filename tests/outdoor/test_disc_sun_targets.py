@@ -10,7 +10,7 @@ pixel centre): median <= 0.5, p95 <= 2 intervals, under 1% of the class-3 pixels
 import numpy as np
 import pytest
 
-from shadowcam.outdoor.accuracy import PRIMARY_DEFINITION, evaluate_arrivals, map_to_truth_camera
+from shadowcam.outdoor.accuracy import PRIMARY_DEFINITION, arrival_errors, evaluate_arrivals, map_to_truth_camera
 from shadowcam.outdoor.arrival import arrival_map
 from shadowcam.outdoor.edges import track_edges
 from shadowcam.outdoor.photometry import photometry_from_frames
@@ -66,3 +66,35 @@ def test_long_penumbrae_at_a_photographers_cadence():
     stats = report["errors"]["combined"][PRIMARY_DEFINITION]
     assert stats["median_abs"] <= 1.0 and stats["p95_abs"] <= 12.0 and stats["frac_over_5"] <= 0.125
     assert stats["coverage"] >= 0.5
+
+
+def test_ramps_under_way_at_the_first_frame_keep_their_shadow_under_a_cloud_over_the_whole_window():
+    # a 400x64 window of the 24 MP strip (the sun 8.0 -> 6.4 deg in 96 frames, penumbrae of tens of
+    # intervals) under the drifting cloud, which covers all its lit ground in frames ~55-85: the
+    # tracker took an edge found at the foot of the ridge's shadow (the ground shadowed from the
+    # start below it) for the shadow's front, measured the shadowed rows above it as a passing
+    # cloud's shade of 0.01-0.1 and divided it out, so those pixels relit and their lit level sank
+    # to their shadow: the pixels under way at the first frame had p95 94 intervals, 50 % beyond 5
+    # (docs/benchmarks.md, issue 15). Rows the previous frame left dark are no cloud's reference.
+    scene = make_outdoor_scene(seed=3, height=4000, width=6000, start_elevation_deg=8.0, end_elevation_deg=6.4,
+                               window=(1500, 3000, 400, 64))
+    capture = render_outdoor_capture(scene, frames=96, supersample=1, seed=3, sun_diameter_deg=SUN_DIAMETER_DEG,
+                                     cloud=True, shake_px=2.0)
+    truth = capture.ground_truth
+    store = noisy_frame_store(capture, seed=3)
+    photometry = photometry_from_frames(store)
+    arrival = arrival_map(photometry, track_edges(store, photometry))
+    estimate = map_to_truth_camera(arrival["arrival_time_s"].values, shift_row=float(truth["shake_dy_px"][0]),
+                                   shift_col=float(truth["shake_dx_px"][0]))
+    interval = float(np.median(np.diff(capture.times_s)))
+    class3 = truth["shadow_class"].values == 3
+    begun = np.isfinite(truth["penumbra_start_time_s"].values)
+    ended = np.isfinite(truth["penumbra_end_time_s"].values)
+    true_arrival = truth["arrival_time_s"].values
+    under_way = arrival_errors(estimate, true_arrival, evaluate=class3 & ~begun, interval_s=interval)
+    whole = arrival_errors(estimate, true_arrival, evaluate=class3 & begun & ended, interval_s=interval)
+    # bounds at the 4000-row strip's figures before the shade field (p95 12.4, 7.8 % beyond 5; this
+    # window: 5.3 and 7.3 %) and at its whole penumbra's (0.45 / 2.2 / 0.1 % here)
+    assert under_way["n_evaluated"] > 1000 and under_way["coverage"] > 0.1
+    assert under_way["p95_abs"] <= 12.0 and under_way["frac_over_5"] <= 0.10, under_way
+    assert whole["median_abs"] <= 1.0 and whole["p95_abs"] <= 3.0 and whole["frac_over_5"] <= 0.01, whole
