@@ -209,12 +209,13 @@ def _confirmed(seed, estimate, timed, gaps, n_frames, tolerance, radius):
     light's shifted by the median `gaps` (outside the sweep where its seed leaves light k
     out). It confirms where that time lies within ``tolerance (1 + gaps crossed)`` of t' and
     denies otherwise: the seeds' assignments of minima to lights must agree. A neighbour
-    without a seed denies where t' lies inside the sweep (by `tolerance`) and none of its
-    significant minima lies within `tolerance` of t' (a shadow passing there would have been
-    seen), else says nothing. More denials than confirmations: that minimum is no light's
-    (a spurious dip one gap from a real one, spurious dips side by side where no shadow
-    falls), so the pixel's minima are not its lights in order and its whole seed goes. As
-    many: that light's part goes, the others stand. A minimum that is not `timed` (wide,
+    without a seed denies where t' lies inside the sweep and none of its significant minima
+    lies within `tolerance` of t' (a shadow passing there would have been seen; one cut by
+    the sweep's first or last frame is still a significant minimum), else says nothing.
+    More denials than confirmations: that minimum is no light's (a spurious dip one gap
+    from a real one, spurious dips side by side where no shadow falls), so the pixel's
+    minima are not its lights in order and its whole seed goes. As many: that light's part
+    goes, the others stand. A minimum that is not `timed` (wide,
     overlapping, cut by the sweep) has no time to judge: its part goes, the others stand,
     and the propagation may give it back.
 
@@ -255,7 +256,7 @@ def _confirmed(seed, estimate, timed, gaps, n_frames, tolerance, radius):
             seen = np.zeros(time.shape, bool)
             for minimum in other_minima:
                 seen |= np.abs(minimum[None] - carried) <= tolerance
-            inside = (carried > tolerance) & (carried < n_frames - 1 - tolerance)
+            inside = (carried >= 0) & (carried <= n_frames - 1)
             deny += other_unseeded[None] & inside & ~seen
     denied = (deny > confirm).any(axis=0)
     return np.where((confirm > deny) & ~denied[None], seed, -1)
