@@ -191,6 +191,13 @@ def test_tube_across_the_wire_has_lower_contrast_and_confidence_than_along(scene
 # three spurious dips side by side where both lights' shadows fall outside the sweep: once
 # seeded as light 0, confirming each other, the empty pixels around them not heard
 @example(n_lights=2, gap=11.508, slope=0.7545, start=-18.601, spurious=0.04754, seed=49286)
+# light 0 always before the sweep: two pixels with a spurious third dip were the only full
+# seeds and shifted every time by one light
+@example(n_lights=3, gap=14.340108689874686, slope=0.30091127264343287, start=-17.214693822825918,
+         spurious=0.04967520799028201, seed=3644)
+# two spurious dips at frames 0.03 and 1.75 where both lights fall before the sweep
+@example(n_lights=2, gap=9.181076664017095, slope=0.8619955424481673, start=-14.778892895533524,
+         spurious=0.04387418453177374, seed=61500)
 def test_no_time_is_given_to_the_wrong_light(n_lights, gap, slope, start, spurious, seed):
     """Lights `gap` frames apart over a 48-frame sweep, time maps sloping across the image
     (lights leave the sweep at either end), and a fraction `spurious` of pixels with a
