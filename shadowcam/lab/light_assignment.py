@@ -9,14 +9,19 @@ neighbouring pixels (a spurious dip, another light's shadow, or a depth edge
 where the order cannot be checked) is ``ambiguous_order``.
 Pixels with another number of minima (a light hidden from the point, two
 shadows merged, a spurious dip) get ``minima_count``, except minima that match
-exactly one light's neighbourhood within `tolerance`, which are kept.
+exactly one light's neighbourhood within `tolerance`, which are kept. The order is
+taken only from seeds the neighbourhood confirms light by light: a neighbour denies a
+seed's time where its own seed puts that light elsewhere (its own time, or its nearest
+light's shifted by the median gaps), or where it has no seed and sees no minimum at a
+time inside the sweep (a shadow passing there would have been seen).
 
 A dip is timed over a window around its minimum's place. Under the sweep's
 Poisson-Gaussian noise (:mod:`shadowcam.lab.sensor_noise`) that window is the shadow's
 only where no sample so far from the minimum that the window around it would miss the
 dip could have been as deep by noise alone (:func:`place_noise_probability`): a long shallow shadow (a tube lying along
 the wire: a few percent of the light over many frames) has a floor whose noise minima fall anywhere on
-it. A time whose probability exceeds `false_alarm` is ``unresolved_dip``. A light whose
+it. A time whose probability exceeds `false_alarm` is ``unresolved_dip`` (over any continuity
+flag: its place is not measured, so neither is its agreement). A light whose
 resolved dips in a sweep are no more than noise alone gives at `false_alarm` (the
 binomial upper `false_alarm` quantile over the pixels its shadow crosses) is not shown by
 that sweep: ``shown`` is False and its times that passed are ``unresolved_dip`` too.
@@ -69,60 +74,80 @@ def _neighbour_median(time, radius):
 
 def _band_neighbour_median(time, radius):
     """:func:`_neighbour_median` of one block of rows (its outside NaN)."""
-    pad = np.pad(time, ((0, 0), (radius, radius), (radius, radius)), constant_values=np.nan)
-    rows, cols = time.shape[1:]
-    stack = np.stack([pad[:, radius + dy:radius + dy + rows, radius + dx:radius + dx + cols]
-                      for dy in range(-radius, radius + 1) for dx in range(-radius, radius + 1)
-                      if dy or dx])
+    stack = np.stack([other for _, _, other in _neighbour_views(time, radius, np.nan)])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         return np.nanmedian(stack, axis=0)
 
 
-def _agreement(time, tolerance, radius):
-    """Neighbours with a time for the same light, and those within `tolerance` of the pixel's
-    time carried to them along the local slope (median differences of adjacent pixels), (L, H, W)."""
+def _neighbour_views(values, radius, fill):
+    """Each neighbour offset within `radius` pixels (the pixel itself excluded) and `values`
+    (..., H, W) at that neighbour of every pixel (`fill` beyond the image): (dy, dx, (..., H, W))."""
+    lead = ((0, 0),) * (values.ndim - 2)
+    pad = np.pad(values, lead + ((radius, radius), (radius, radius)), constant_values=fill)
+    rows, cols = values.shape[-2:]
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            if dy or dx:
+                yield dy, dx, pad[..., radius + dy:radius + dy + rows, radius + dx:radius + dx + cols]
+
+
+def _local_slopes(time, radius):
+    """Each light's time step per pixel along x and y: the median differences of adjacent
+    pixels within `radius` (0 where none), two (L, H, W)."""
     step_x = np.concatenate([np.diff(time, axis=2), np.full(time[:, :, :1].shape, np.nan)], axis=2)
     step_y = np.concatenate([np.diff(time, axis=1), np.full(time[:, :1].shape, np.nan)], axis=1)
-    slope_x, slope_y = (np.nan_to_num(_neighbour_median(d, radius)) for d in (step_x, step_y))
-    pad = np.pad(time, ((0, 0), (radius, radius), (radius, radius)), constant_values=np.nan)
-    rows, cols = time.shape[1:]
+    return tuple(np.nan_to_num(_neighbour_median(d, radius)) for d in (step_x, step_y))
+
+
+def _agreement(time, tolerance, radius):
+    """Neighbours with a time for the same light, and those within `tolerance` of the pixel's
+    time carried to them along the local slope (:func:`_local_slopes`), (L, H, W)."""
+    slope_x, slope_y = _local_slopes(time, radius)
     total = np.zeros(time.shape)
     agree = np.zeros(time.shape)
     with np.errstate(invalid="ignore"):
-        for dy in range(-radius, radius + 1):
-            for dx in range(-radius, radius + 1):
-                if dy or dx:
-                    other = pad[:, radius + dy:radius + dy + rows, radius + dx:radius + dx + cols]
-                    total += np.isfinite(other)
-                    agree += np.abs(other - time - slope_x * dx - slope_y * dy) <= tolerance
+        for dy, dx, other in _neighbour_views(time, radius, np.nan):
+            total += np.isfinite(other)
+            agree += np.abs(other - time - slope_x * dx - slope_y * dy) <= tolerance
     return total, agree
 
 
-def _gaps(time):
-    """Median time from light k to light k + 1 over the pixels with both, (L - 1,) (NaN where none)."""
+def _gaps(time, measured=None):
+    """Median time from light k to light k + 1 over the pixels with both, (L - 1,); where no
+    pixel has both, `measured` ((L - 1,), the gaps of the seeds before their confirmation),
+    else NaN."""
     out = []
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
         for k in range(time.shape[0] - 1):
             out.append(float(np.nanmedian(time[k + 1] - time[k])))
-    return np.array(out)
+    out = np.array(out)
+    return out if measured is None else np.where(np.isfinite(out), out, measured)
 
 
-def _predict(time, radius, gaps):
-    """Each light's expected time at each pixel: its neighbours' median, else the nearest
-    light's neighbours' median shifted by the median gaps between the lights, (L, H, W)."""
-    median = _neighbour_median(time, radius)
+def _from_nearest_light(time, gaps):
+    """Each light's time where it has one, else the nearest light's (fewest gaps away; the
+    earlier at a tie) shifted by the median `gaps` between them; and the number of gaps
+    crossed (0 = its own, -1 = none), (L, H, W) each."""
     offset = np.concatenate([[0.0], np.cumsum(gaps)])
-    out = median.copy()
+    out = time.copy()
+    crossed = np.where(np.isfinite(time), 0, -1)
     n = time.shape[0]
     for k in range(n):
         for distance in range(1, n):
             for j in (k - distance, k + distance):
                 if 0 <= j < n and np.isfinite(offset[k] - offset[j]):
-                    fill = ~np.isfinite(out[k]) & np.isfinite(median[j])
-                    out[k][fill] = median[j][fill] + offset[k] - offset[j]
-    return out
+                    fill = ~np.isfinite(out[k]) & np.isfinite(time[j])
+                    out[k][fill] = time[j][fill] + offset[k] - offset[j]
+                    crossed[k][fill] = distance
+    return out, crossed
+
+
+def _predict(time, radius, gaps):
+    """Each light's expected time at each pixel: its neighbours' median, else the nearest
+    light's neighbours' median shifted by the median gaps between them, (L, H, W)."""
+    return _from_nearest_light(_neighbour_median(time, radius), gaps)[0]
 
 
 def _match(estimate, predicted, tolerance, gaps, timed):
@@ -164,23 +189,88 @@ def _gather(values, pick):
     return np.where(pick >= 0, out, np.nan)
 
 
-def _confirmed(seed, estimate, tolerance, radius):
-    """Seeds whose every assigned time a neighbouring seed confirms (:func:`_agreement`):
-    a lone seed (a spurious dip that happens to sit one gap from a real one) is dropped."""
+def _spaced(seed, estimate, gaps, tolerance):
+    """Seeds whose consecutive lights' times lie the median `gaps` ((L - 1,)) apart within
+    `tolerance`: the shadows of lights k and k + 1 pass a point one light spacing apart, so a
+    seed that gives them two minima further off (a spurious dip beside a real one) is dropped."""
     time = _gather(estimate, seed)
-    _, agree = _agreement(time, tolerance, radius)
-    lone = ((seed >= 0) & (agree == 0)).any(axis=0)
-    return np.where(lone[None], -1, seed)
+    with np.errstate(invalid="ignore"):
+        off = np.abs(np.diff(time, axis=0) - np.asarray(gaps)[:, None, None]) > tolerance
+    return np.where(off.any(axis=0)[None], -1, seed)
 
 
-def _propagate(seed, estimate, timed, radius, tolerance, iterations):
+def _confirmed(seed, estimate, timed, gaps, n_frames, tolerance, radius):
+    """Per light, the seeds their neighbours confirm; a seed a neighbourhood denies in one
+    light is dropped whole.
+
+    A seed gives light k the time t of a `timed` minimum at a pixel; carried to a neighbour
+    within `radius` along the local slope of light k's seed times (:func:`_local_slopes`) it
+    is t'. A seeded neighbour holds a time for light k too: its own, or its nearest seeded
+    light's shifted by the median `gaps` (outside the sweep where its seed leaves light k
+    out). It confirms where that time lies within ``tolerance (1 + gaps crossed)`` of t' and
+    denies otherwise: the seeds' assignments of minima to lights must agree. A neighbour
+    without a seed denies where t' lies inside the sweep and none of its significant minima
+    lies within `tolerance` of t' (a shadow passing there would have been seen; one cut by
+    the sweep's first or last frame is still a significant minimum), else says nothing.
+    More denials than confirmations: that minimum is no light's (a spurious dip one gap
+    from a real one, spurious dips side by side where no shadow falls), so the pixel's
+    minima are not its lights in order and its whole seed goes. As many: that light's part
+    goes, the others stand. A minimum that is not `timed` (wide,
+    overlapping, cut by the sweep) has no time to judge: its part goes, the others stand,
+    and the propagation may give it back.
+
+    Parameters
+    ----------
+    seed : (L, H, W) int ndarray
+        Index of each light's minimum, -1 = none.
+    estimate : (K, H, W) float ndarray
+        The minima's times, NaN = not significant.
+    timed : (K, H, W) bool ndarray
+        Minima whose time is the dip's (``reason`` ok).
+    gaps : (L - 1,) float ndarray
+    n_frames : int
+    tolerance : float
+    radius : int
+
+    Returns
+    -------
+    (L, H, W) int ndarray
+        `seed` with the parts not confirmed set to -1, and the pixels with a denied part all -1.
+    """
+    time = np.where(_gather(timed, seed) == 1, _gather(estimate, seed), np.nan)
+    held, crossed = _from_nearest_light(time, gaps)
+    unseeded = ~np.isfinite(time).any(axis=0)
+    held = np.where(unseeded[None], np.nan, held)
+    allowed = np.where(crossed >= 0, tolerance * (1.0 + crossed), np.nan)
+    slope_x, slope_y = _local_slopes(time, radius)
+    views = zip(_neighbour_views(held, radius, np.nan), _neighbour_views(allowed, radius, np.nan),
+                _neighbour_views(unseeded, radius, False), _neighbour_views(estimate, radius, np.nan))
+    confirm = np.zeros(time.shape)
+    deny = np.zeros(time.shape)
+    with np.errstate(invalid="ignore"):
+        for (dy, dx, other), (_, _, other_allowed), (_, _, other_unseeded), (_, _, other_minima) in views:
+            carried = time + slope_x * dx + slope_y * dy
+            miss = np.abs(other - carried)
+            confirm += miss <= other_allowed
+            deny += miss > other_allowed
+            seen = np.zeros(time.shape, bool)
+            for minimum in other_minima:
+                seen |= np.abs(minimum[None] - carried) <= tolerance
+            inside = (carried >= 0) & (carried <= n_frames - 1)
+            deny += other_unseeded[None] & inside & ~seen
+    denied = (deny > confirm).any(axis=0)
+    return np.where((confirm > deny) & ~denied[None], seed, -1)
+
+
+def _propagate(seed, estimate, timed, radius, tolerance, iterations, measured):
     """Seeds grown by continuity: per light, the prediction from the neighbours and the
     matching of each pixel's minima to it (:func:`_match`), repeated until nothing
-    changes; (L, H, W)."""
+    changes; a light no seed kept is predicted from the others by the `measured` gaps
+    ((L - 1,)); (L, H, W)."""
     pick = seed
     for _ in range(int(iterations)):
         time = _gather(estimate, pick)
-        gaps = _gaps(time)
+        gaps = _gaps(time, measured)
         predicted = _predict(time, radius, gaps)
         matched = _match(estimate, predicted, tolerance, gaps, timed)
         # a seed stands unless its neighbours give one of its minima to another light;
@@ -329,7 +419,9 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None,
 
     Seeds are the pixels with exactly `n_lights` significant minima whose gaps agree with
     the image's median gaps between the lights (within `tolerance`): minimum k is light
-    k's. Then, `iterations` times, each light's time is predicted at every pixel from its
+    k's; a light's part of a seed stands where its neighbours confirm it more than they deny
+    it, and a part they deny drops the pixel's whole seed (:func:`_confirmed`). Then,
+    `iterations` times, each light's time is predicted at every pixel from its
     neighbours (median within `radius`; where light k has no neighbours, another light's
     median shifted by the median gap between them) and each pixel's significant minima
     go to the light whose prediction lies within `tolerance` (the nearest): a minimum
@@ -391,24 +483,25 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None,
     # seeds: the k-th significant minimum along the sweep is light k's
     rank = np.argsort(~significant, axis=0, kind="stable")[:n_lights]
     seed = np.where(ordered[None], rank, -1)
-    seed_time = _gather(estimate, seed)
-    gaps = _gaps(seed_time)
-    with np.errstate(invalid="ignore"):
-        off = np.abs(np.diff(seed_time, axis=0) - gaps[:, None, None]) > tolerance
-    seed[:, off.any(axis=0)] = -1
-    seed = _confirmed(seed, estimate, tolerance, radius)
-    pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
+    gaps = _gaps(_gather(estimate, seed))
+    timed_minima = minima.reason == _m.OK
+    seed = _confirmed(_spaced(seed, estimate, gaps, tolerance), estimate, timed_minima, gaps, minima.n_frames,
+                      tolerance, radius)
+    pick = _propagate(seed, estimate, timed_minima, radius, tolerance, iterations, gaps)
     # a light seen in most pixels where its shadow falls inside the sweep: its absence
     # there is evidence, and seeds pixels with fewer minima (:func:`_seed_partial`)
     time = _gather(estimate, pick)
-    predicted = _predict(time, radius, _gaps(time))
+    predicted = _predict(time, radius, _gaps(time, gaps))
     with np.errstate(invalid="ignore"):
         inside = (predicted > tolerance) & (predicted < minima.n_frames - 1 - tolerance)
     timed = (pick >= 0) & (np.take_along_axis(minima.reason, np.maximum(pick, 0), 0) == _m.OK)
     seen = (inside & timed).sum(axis=(1, 2)) / np.maximum(inside.sum(axis=(1, 2)), 1)
-    seed = _seed_partial(seed, estimate, gaps, minima.n_frames, tolerance, informative=seen > 0.5)
-    seed = _confirmed(seed, estimate, tolerance, radius)
-    pick = _propagate(seed, estimate, minima.reason == _m.OK, radius, tolerance, iterations)
+    partial = _spaced(_seed_partial(seed, estimate, gaps, minima.n_frames, tolerance, informative=seen > 0.5),
+                      estimate, gaps, tolerance)
+    # the confirmed seeds stand; the partial ones are put to the same vote, among all
+    seed = np.where(seed >= 0, seed,
+                    _confirmed(partial, estimate, timed_minima, gaps, minima.n_frames, tolerance, radius))
+    pick = _propagate(seed, estimate, timed_minima, radius, tolerance, iterations, gaps)
     time = _gather(estimate, pick)
     total, agree = _agreement(time, tolerance, radius)
     median = _neighbour_median(time, radius)
@@ -427,7 +520,9 @@ def assign_minima(minima, n_lights, *, radius=2, tolerance=2.0, iterations=None,
         for rows in _m.row_bands(*pick.shape[1:]):  # per pixel: in row bands, bounding the temporaries
             place[:, rows] = _place(minima.summary.window[:, :, rows], minima.summary.noise[:, rows], pick[:, rows],
                                     contrast[:, rows], width[:, rows], tolerance=tolerance, false_alarm=false_alarm)
-    reason[(reason == OK) & (place > false_alarm)] = UNRESOLVED
+    # a minimum whose place noise could have set is not a measured time, whatever its
+    # neighbours say: unresolved before (and over) any continuity flag
+    reason[(pick >= 0) & (own == _m.OK) & (place > false_alarm)] = UNRESOLVED
     shown = _shown(reason == OK, inside | (pick >= 0), false_alarm)
     reason[~shown[:, None, None] & (reason == OK)] = UNRESOLVED
     ok = reason == OK

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import example, given, settings, strategies as st
 
 from shadowcam.lab.light_assignment import (
     AMBIGUOUS_ORDER, MINIMA_COUNT, OK, assign_minima, light_summary,
@@ -185,6 +185,19 @@ def test_tube_across_the_wire_has_lower_contrast_and_confidence_than_along(scene
 @settings(max_examples=20, deadline=None)
 @given(n_lights=st.integers(2, 3), gap=st.floats(9.0, 16.0), slope=st.floats(0.3, 0.9),
        start=st.floats(-20.0, 10.0), spurious=st.floats(0.0, 0.05), seed=st.integers(0, 2**16))
+# a spurious dip 0.3 frame from light 2's, lights 0 and 1 before the sweep: once seeded as
+# lights 1 and 2 (0.3 frame apart, not one gap)
+@example(n_lights=3, gap=9.0, slope=0.5, start=-12.0, spurious=0.0390625, seed=1)
+# three spurious dips side by side where both lights' shadows fall outside the sweep: once
+# seeded as light 0, confirming each other, the empty pixels around them not heard
+@example(n_lights=2, gap=11.508, slope=0.7545, start=-18.601, spurious=0.04754, seed=49286)
+# light 0 always before the sweep: two pixels with a spurious third dip were the only full
+# seeds and shifted every time by one light
+@example(n_lights=3, gap=14.340108689874686, slope=0.30091127264343287, start=-17.214693822825918,
+         spurious=0.04967520799028201, seed=3644)
+# two spurious dips at frames 0.03 and 1.75 where both lights fall before the sweep
+@example(n_lights=2, gap=9.181076664017095, slope=0.8619955424481673, start=-14.778892895533524,
+         spurious=0.04387418453177374, seed=61500)
 def test_no_time_is_given_to_the_wrong_light(n_lights, gap, slope, start, spurious, seed):
     """Lights `gap` frames apart over a 48-frame sweep, time maps sloping across the image
     (lights leave the sweep at either end), and a fraction `spurious` of pixels with a
