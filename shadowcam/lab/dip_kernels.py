@@ -26,7 +26,7 @@ split_square : float samples -> (hi, lo) float64 parts of their squares (numpy, 
 track_block : feed a block of frames to the state (in place).
 finish_centres : test the last centres of a sequence that ended.
 window_sums : the exact sums of stored windows (to take the dip out of the running sums).
-select_dips : the deepest and second dip of each pixel among candidate lists (merging chunks).
+merge_dips : the deepest and second dip of each pixel among its chunks' candidates, with its window and sums.
 interval_block : compare smoothed frames with a threshold around each pixel's deepest minimum (the dip's interval).
 interval_from_window : the same for pixels whose crossings lie in their stored window (no pass over the frames).
 """
@@ -492,6 +492,25 @@ def finish_centres(first, last, end, half_window, raw, smooth, top_value, top_fr
                       slots[centre - first])
 
 
+@nb.njit(cache=True, inline="always")
+def _window_sum(samples):
+    """Count, fixed-point sum and square parts of the finite `samples` ``(K,)``, in order."""
+    count = 0
+    fixed_sum = 0
+    square_hi = 0.0
+    square_lo = 0.0
+    for k in range(samples.shape[0]):
+        x = np.float64(samples[k])
+        if np.isfinite(x):
+            count += 1
+            fixed_sum += _fixed(x)
+            sq = x * x
+            hi = (sq + _SQ_HI) - _SQ_HI
+            square_hi += hi
+            square_lo += ((sq - hi) + _SQ_LO) - _SQ_LO
+    return count, fixed_sum, square_hi, square_lo
+
+
 @nb.njit(cache=True, parallel=True)
 def window_sums(window, keep):
     """Exact sums of each kept pixel's window samples, as the running sums hold them.
@@ -510,76 +529,105 @@ def window_sums(window, keep):
     square_hi, square_lo : (P,) float64 ndarray
         Sums of the two parts of their squares (as :func:`split_square`).
     """
-    n_k, n_p = window.shape
+    n_p = window.shape[1]
     count = np.zeros(n_p, np.int64)
     fixed_sum = np.zeros(n_p, np.int64)
     square_hi = np.zeros(n_p)
     square_lo = np.zeros(n_p)
     for p in nb.prange(n_p):
-        if not keep[p]:
-            continue
-        for k in range(n_k):
-            x = np.float64(window[k, p])
-            if np.isfinite(x):
-                count[p] += 1
-                fixed_sum[p] += _fixed(x)
-                sq = x * x
-                hi = (sq + _SQ_HI) - _SQ_HI
-                square_hi[p] += hi
-                square_lo[p] += ((sq - hi) + _SQ_LO) - _SQ_LO
+        if keep[p]:
+            count[p], fixed_sum[p], square_hi[p], square_lo[p] = _window_sum(window[:, p])
     return count, fixed_sum, square_hi, square_lo
 
 
 @nb.njit(cache=True, inline="always")
-def _before(values, frames, p, i, j):
-    """Whether entry `i` of pixel `p` precedes entry `j` in (value, frame) order."""
-    return values[p, i] < values[p, j] or (values[p, i] == values[p, j] and frames[p, i] < frames[p, j])
+def _before(value, frame, other_value, other_frame):
+    """Whether ``(value, frame)`` precedes ``(other_value, other_frame)``."""
+    return value < other_value or (value == other_value and frame < other_frame)
 
 
 @nb.njit(cache=True, parallel=True)
-def select_dips(values, frames, half_window):
-    """The deepest and the second dip of each pixel among candidate lists.
+def merge_dips(values, frames, windows, half_window):
+    """The deepest and the second dip of each pixel among its time chunks' candidates, with the window.
+
+    The chunks' lists are read side by side (entry ``i`` is chunk ``i // TOP``'s slot
+    ``i % TOP``): the deepest dip is the smallest finite (value, frame), the earliest
+    entry among equals; the second the smallest one further than `half_window`
+    frames from it. The deepest dip's window is its chunk's, and its samples' exact
+    sums are those :func:`window_sums` gives.
 
     Parameters
     ----------
-    values : (P, N) float32 ndarray
-        Candidate minima (non-finite = empty), e.g. the time chunks' lists side by side.
-    frames : (P, N) int64 ndarray
+    values : tuple of (P, TOP) float32 ndarray
+        Each chunk's candidate minima (non-finite = empty).
+    frames : tuple of (P, TOP) int64 ndarray
         Their frames.
+    windows : tuple of (P, K) float32 ndarray
+        Each chunk's samples around its deepest candidate.
     half_window : int
-        The second dip lies more than this many frames from the first.
 
     Returns
     -------
-    first, second : (P,) int64 ndarray
-        Index of the smallest finite (value, frame) (earliest index among
-        equals), and of the smallest one further than `half_window` frames
-        from it; 0 where there is none.
-    found, has_second : (P,) bool ndarray
+    minimum_value : (P,) float32 ndarray
+        The deepest dip's value (the first chunk's first entry where there is none).
+    minimum_frame : (P,) int64 ndarray
+        Its frame, -1 where there is none.
+    second_value, second_frame : (P,) float32 and int64 ndarray
+        The second dip (``+inf`` and ``-(K + 1)`` where there is none).
+    found : (P,) bool ndarray
+        Whether there is a deepest dip.
+    window : (K, P) float32 ndarray
+        The deepest dip's window (NaN where there is none).
+    count, fixed_sum, square_hi, square_lo : (P,) ndarray
+        Its finite samples' :func:`window_sums` (zeros where there is none).
     """
-    n_p, n = values.shape
-    first = np.zeros(n_p, np.int64)
-    second = np.zeros(n_p, np.int64)
+    n_p, k = windows[0].shape
+    minimum_value = np.empty(n_p, np.float32)
+    minimum_frame = np.full(n_p, -1, np.int64)
+    second_value = np.full(n_p, np.inf, np.float32)
+    second_frame = np.full(n_p, -(k + 1), np.int64)
     found = np.zeros(n_p, np.bool_)
-    has_second = np.zeros(n_p, np.bool_)
+    window = np.empty((k, n_p), np.float32)
+    count = np.zeros(n_p, np.int64)
+    fixed_sum = np.zeros(n_p, np.int64)
+    square_hi = np.zeros(n_p)
+    square_lo = np.zeros(n_p)
     for p in nb.prange(n_p):
         best = -1
-        for i in range(n):
-            if np.isfinite(values[p, i]) and (best < 0 or _before(values, frames, p, i, best)):
-                best = i
+        best_value = np.float32(0.0)
+        best_frame = 0
+        for c in range(len(values)):
+            chunk_values = values[c]
+            chunk_frames = frames[c]
+            for slot in range(TOP):
+                value = chunk_values[p, slot]
+                frame = chunk_frames[p, slot]
+                if np.isfinite(value) and (best < 0 or _before(value, frame, best_value, best_frame)):
+                    best, best_value, best_frame = c * TOP + slot, value, frame
         if best < 0:
+            minimum_value[p] = values[0][p, 0]
+            window[:, p] = np.nan
             continue
-        first[p], found[p] = best, True
-        frame = frames[p, best]
-        other = -1
-        for i in range(n):
-            if (np.isfinite(values[p, i]) and abs(frames[p, i] - frame) > half_window
-                    and (other < 0 or _before(values, frames, p, i, other))):
-                other = i
-        if other >= 0:
-            second[p], has_second[p] = other, True
-    return first, second, found, has_second
-
+        found[p] = True
+        minimum_value[p] = best_value
+        minimum_frame[p] = best_frame
+        samples = windows[best // TOP][p]
+        window[:, p] = samples
+        count[p], fixed_sum[p], square_hi[p], square_lo[p] = _window_sum(samples)
+        other = False
+        for c in range(len(values)):
+            chunk_values = values[c]
+            chunk_frames = frames[c]
+            for slot in range(TOP):
+                value = chunk_values[p, slot]
+                frame = chunk_frames[p, slot]
+                if (np.isfinite(value) and abs(frame - best_frame) > half_window
+                        and (not other or _before(value, frame, second_value[p], second_frame[p]))):
+                    other = True
+                    second_value[p] = value
+                    second_frame[p] = frame
+    return (minimum_value, minimum_frame, second_value, second_frame, found, window, count, fixed_sum,
+            square_hi, square_lo)
 
 
 @nb.njit(cache=True, parallel=True)

@@ -382,28 +382,19 @@ def merge_partials(partials, *, n_frames):
     _check_tiling(partials, n_frames)
     h = partials[0].half_window
     k = 2 * h + 1
-    values = np.concatenate([p.top_value for p in partials], axis=-1)
-    frames = np.concatenate([p.top_frame for p in partials], axis=-1)
-    shape = values.shape[:2]
-    first, second, found, has_second = (
-        part.reshape(shape) for part in _k.select_dips(values.reshape(-1, values.shape[2]),
-                                                        frames.reshape(-1, frames.shape[2]), h))
-    pick = first[..., None]
-    minimum_value = np.take_along_axis(values, pick, -1)[..., 0]
-    minimum_frame = np.where(found, np.take_along_axis(frames, pick, -1)[..., 0], -1)
-    second_value = np.where(has_second, np.take_along_axis(values, second[..., None], -1)[..., 0], np.inf)
-    second_frame = np.where(has_second, np.take_along_axis(frames, second[..., None], -1)[..., 0], -(k + 1))
-    owner = first // _k.TOP
-    window = np.full(partials[0].window.shape, np.nan, np.float32)
-    for index, part in enumerate(partials):
-        np.copyto(window, part.window, where=(found & (owner == index))[..., None])
-    window = np.ascontiguousarray(np.moveaxis(window, -1, 0))
+    shape = partials[0].top_value.shape[:2]
+
+    def flat(name, width):
+        return tuple(np.ascontiguousarray(getattr(p, name)).reshape(-1, width) for p in partials)
+
+    merged = list(_k.merge_dips(flat("top_value", _k.TOP), flat("top_frame", _k.TOP), flat("window", k), h))
+    window = merged.pop(5).reshape((k,) + shape)
+    minimum_value, minimum_frame, second_value, second_frame, found, win_count, win_sum, win_hi, win_lo = (
+        part.reshape(shape) for part in merged)
 
     def total(name):
         return sum(getattr(p, name) for p in partials)
 
-    win_count, win_sum, win_hi, win_lo = (
-        part.reshape(found.shape) for part in _k.window_sums(window.reshape(k, -1), found.ravel()))
     lit_count = total("count") - win_count
     lit_sum = (total("signal_sum") - win_sum) / _k.SUM_SCALE
     lit_sumsq = (total("square_hi") - win_hi) + (total("square_lo") - win_lo)

@@ -106,21 +106,162 @@ def _load(normal, rhs, n, work):
 
 
 @nb.njit(cache=True, nogil=True, inline="always")
-def _accumulate(normal, rhs, n_fit, wgt, basis, t_n):
-    """Add one neighbour of weight `wgt` to the leading ``n_fit`` normal equations.
+def _range_weight(dr, dc, t_n, iv, c0, c1, c2, range_sigma, inv_sigma):
+    """A neighbour's range kernel on its residual from the plane ``c0 + c1*dr + c2*dc``, and its weight.
 
-    Entries are ``(wgt * basis_i) * basis_j`` and ``(wgt * basis_i) * t_n``
-    for the basis ``1, dr, dc, dr^2, dr dc, dc^2`` (the plane is its first three).
+    The residual is in units of `range_sigma`: multiplied by `inv_sigma` where that is
+    exact (a power-of-two `range_sigma`, see :func:`_exact_inverse`; 0 otherwise), else
+    divided. The weight is `iv` times the kernel, or 0 where that is not positive and
+    finite (the neighbour then takes no part).
     """
-    for i in range(n_fit):
-        wb = wgt * basis[i]
-        rhs[i] += wb * t_n
-        for j in range(n_fit):
-            normal[i, j] += wb * basis[j]
+    offset = t_n - c0 - c1 * dr - c2 * dc
+    residual = offset * inv_sigma if inv_sigma > 0 else offset / range_sigma
+    kernel = np.exp(-0.5 * residual**2)
+    wgt = iv * kernel
+    if not wgt > 0 or not np.isfinite(wgt):
+        return kernel, 0.0
+    return kernel, wgt
+
+
+def _exact_inverse(value):
+    """``1 / value`` where multiplying by it equals dividing by `value` for every double, else 0.
+
+    For a power of two the inverse is exact, so ``x * (1 / value)`` and ``x / value`` are the
+    same real number, each correctly rounded; in general the inverse itself is rounded.
+    """
+    mantissa, _ = np.frexp(value)
+    inverse = 1.0 / value
+    return inverse if mantissa == 0.5 and np.isfinite(inverse) and inverse > 0 else 0.0
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _plane_pass(n_dr, n_dc, n_t, n_iv, count, c0, c1, c2, range_sigma, inv_sigma, normal, rhs):
+    """One reweighting pass: the plane's 3 x 3 normal equations into `normal`, `rhs`; returns the weight sum.
+
+    Entries ``(w * b_i) * b_j`` and ``(w * b_i) * t`` for the basis ``1, dr, dc``, each summed
+    in a register in neighbour order (``b_0 = 1``: the first column equals the first row).
+    """
+    s_w = n01 = n02 = n11 = n12 = n21 = n22 = r0 = r1 = r2 = 0.0
+    for k in range(count):
+        dr = n_dr[k]
+        dc = n_dc[k]
+        t_n = n_t[k]
+        _, wgt = _range_weight(dr, dc, t_n, n_iv[k], c0, c1, c2, range_sigma, inv_sigma)
+        if wgt == 0.0:
+            continue
+        s_w += wgt
+        w_r = wgt * dr
+        w_c = wgt * dc
+        n01 += wgt * dr
+        n02 += wgt * dc
+        n11 += w_r * dr
+        n12 += w_r * dc
+        n21 += w_c * dr
+        n22 += w_c * dc
+        r0 += wgt * t_n
+        r1 += w_r * t_n
+        r2 += w_c * t_n
+    normal[0, 0] = s_w
+    normal[0, 1] = normal[1, 0] = n01
+    normal[0, 2] = normal[2, 0] = n02
+    normal[1, 1] = n11
+    normal[1, 2] = n12
+    normal[2, 1] = n21
+    normal[2, 2] = n22
+    rhs[0] = r0
+    rhs[1] = r1
+    rhs[2] = r2
+    return s_w
+
+
+@nb.njit(cache=True, nogil=True, inline="always")
+def _quadratic_pass(n_dr, n_dc, n_t, n_iv, count, c0, c1, c2, range_sigma, inv_sigma, normal, rhs):
+    """The last pass: the quadratic's 6 x 6 normal equations into `normal`, `rhs`.
+
+    Entries ``(w * b_i) * b_j`` and ``(w * b_i) * t`` for the basis ``1, dr, dc, dr^2, dr dc,
+    dc^2``, each summed in a register in neighbour order (``b_0 = 1``: the first column
+    equals the first row). Returns the sums of the weights, of the range kernels and of
+    ``w * t**2``.
+    """
+    s_w = s_k = s_tt = 0.0
+    q01 = q02 = q03 = q04 = q05 = 0.0
+    q11 = q12 = q13 = q14 = q15 = 0.0
+    q21 = q22 = q23 = q24 = q25 = 0.0
+    q31 = q32 = q33 = q34 = q35 = 0.0
+    q41 = q42 = q43 = q44 = q45 = 0.0
+    q51 = q52 = q53 = q54 = q55 = 0.0
+    r0 = r1 = r2 = r3 = r4 = r5 = 0.0
+    for k in range(count):
+        b1 = n_dr[k]
+        b2 = n_dc[k]
+        t_n = n_t[k]
+        kernel, wgt = _range_weight(b1, b2, t_n, n_iv[k], c0, c1, c2, range_sigma, inv_sigma)
+        if wgt == 0.0:
+            continue
+        b3 = b1 * b1
+        b4 = b1 * b2
+        b5 = b2 * b2
+        s_w += wgt
+        s_k += kernel
+        s_tt += wgt * t_n * t_n
+        q01 += wgt * b1
+        q02 += wgt * b2
+        q03 += wgt * b3
+        q04 += wgt * b4
+        q05 += wgt * b5
+        r0 += wgt * t_n
+        w = wgt * b1
+        q11 += w * b1
+        q12 += w * b2
+        q13 += w * b3
+        q14 += w * b4
+        q15 += w * b5
+        r1 += w * t_n
+        w = wgt * b2
+        q21 += w * b1
+        q22 += w * b2
+        q23 += w * b3
+        q24 += w * b4
+        q25 += w * b5
+        r2 += w * t_n
+        w = wgt * b3
+        q31 += w * b1
+        q32 += w * b2
+        q33 += w * b3
+        q34 += w * b4
+        q35 += w * b5
+        r3 += w * t_n
+        w = wgt * b4
+        q41 += w * b1
+        q42 += w * b2
+        q43 += w * b3
+        q44 += w * b4
+        q45 += w * b5
+        r4 += w * t_n
+        w = wgt * b5
+        q51 += w * b1
+        q52 += w * b2
+        q53 += w * b3
+        q54 += w * b4
+        q55 += w * b5
+        r5 += w * t_n
+    normal[0, 0] = s_w
+    normal[0, 1] = normal[1, 0] = q01
+    normal[0, 2] = normal[2, 0] = q02
+    normal[0, 3] = normal[3, 0] = q03
+    normal[0, 4] = normal[4, 0] = q04
+    normal[0, 5] = normal[5, 0] = q05
+    normal[1, 1], normal[1, 2], normal[1, 3], normal[1, 4], normal[1, 5] = q11, q12, q13, q14, q15
+    normal[2, 1], normal[2, 2], normal[2, 3], normal[2, 4], normal[2, 5] = q21, q22, q23, q24, q25
+    normal[3, 1], normal[3, 2], normal[3, 3], normal[3, 4], normal[3, 5] = q31, q32, q33, q34, q35
+    normal[4, 1], normal[4, 2], normal[4, 3], normal[4, 4], normal[4, 5] = q41, q42, q43, q44, q45
+    normal[5, 1], normal[5, 2], normal[5, 3], normal[5, 4], normal[5, 5] = q51, q52, q53, q54, q55
+    rhs[0], rhs[1], rhs[2], rhs[3], rhs[4], rhs[5] = r0, r1, r2, r3, r4, r5
+    return s_w, s_k, s_tt
 
 
 @nb.njit(cache=True, nogil=True, parallel=True)
-def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
+def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations, inv_sigma):
     """Per pixel: the neighbours' IRLS plane and its variances (see :func:`refine_times`).
 
     The pixel itself is left out. Each pass fits ``t = a + b*dr + c*dc`` to the
@@ -131,8 +272,10 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
 
     A pixel's usable neighbours (finite time, positive inverse variance) are
     gathered once; each pass then only evaluates the range kernel and adds
-    to the normal equations (the plane's in scalars), and the solves work in
-    preallocated buffers. Rows run in parallel (``prange``).
+    to the normal equations, summed in registers (:func:`_plane_pass`,
+    :func:`_quadratic_pass`), and the solves work in preallocated buffers.
+    `inv_sigma`: :func:`_exact_inverse` of `range_sigma` (0: divide by it).
+    Rows run in parallel (``prange``).
 
     Returns, each ``(H, W)`` float64, NaN where the pixel has no time or no
     plane: the plane's value ``a`` at the pixel and its variance under the
@@ -155,7 +298,6 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
     for row in nb.prange(h):
         normal = np.empty((6, 6))
         rhs = np.empty(6)
-        basis = np.empty(6)
         work = np.empty((6, 10))
         n_dr = np.empty(size)
         n_dc = np.empty(size)
@@ -189,54 +331,11 @@ def _robust_plane_fit(t64, inv_var, radius, range_sigma, iterations):
             s_w = s_k = s_tt = 0.0
             for it in range(iterations + 1):
                 last = it == iterations  # the quadratic only with the last weights
-                s_w = s_k = s_tt = 0.0
-                n01 = n02 = n11 = n12 = n21 = n22 = r0 = r1 = r2 = 0.0
                 if last:
-                    normal[:] = 0.0
-                    rhs[:] = 0.0
-                for k in range(count):
-                    dr = n_dr[k]
-                    dc = n_dc[k]
-                    t_n = n_t[k]
-                    residual = (t_n - c0 - c1 * dr - c2 * dc) / range_sigma
-                    kernel = np.exp(-0.5 * residual**2)
-                    wgt = n_iv[k] * kernel
-                    if not wgt > 0 or not np.isfinite(wgt):
-                        continue
-                    s_w += wgt
-                    if last:
-                        basis[0] = 1.0
-                        basis[1] = dr
-                        basis[2] = dc
-                        basis[3] = dr * dr
-                        basis[4] = dr * dc
-                        basis[5] = dc * dc
-                        _accumulate(normal, rhs, 6, wgt, basis, t_n)
-                        s_k += kernel
-                        s_tt += wgt * t_n * t_n
-                    else:  # the plane's 3 x 3 system, as _accumulate would add it
-                        w_r = wgt * dr
-                        w_c = wgt * dc
-                        n01 += wgt * dr
-                        n02 += wgt * dc
-                        n11 += w_r * dr
-                        n12 += w_r * dc
-                        n21 += w_c * dr
-                        n22 += w_c * dc
-                        r0 += wgt * t_n
-                        r1 += w_r * t_n
-                        r2 += w_c * t_n
-                if not last:
-                    normal[0, 0] = s_w
-                    normal[0, 1] = normal[1, 0] = n01
-                    normal[0, 2] = normal[2, 0] = n02
-                    normal[1, 1] = n11
-                    normal[1, 2] = n12
-                    normal[2, 1] = n21
-                    normal[2, 2] = n22
-                    rhs[0] = r0
-                    rhs[1] = r1
-                    rhs[2] = r2
+                    s_w, s_k, s_tt = _quadratic_pass(n_dr, n_dc, n_t, n_iv, count, c0, c1, c2, range_sigma,
+                                                     inv_sigma, normal, rhs)
+                else:
+                    s_w = _plane_pass(n_dr, n_dc, n_t, n_iv, count, c0, c1, c2, range_sigma, inv_sigma, normal, rhs)
                 if s_w == 0.0:
                     ok = False
                     break
@@ -346,7 +445,7 @@ def _plane(t64, inv_var, radius, range_sigma, iterations):
     ``plane_var`` is ``phi * var(a) + tau**2`` and ``slope_var`` is ``phi * var(b, c)``.
     """
     plane, plane_var, slope, slope_var, local_phi, quad, quad_var = _robust_plane_fit(
-        t64, inv_var, int(radius), float(range_sigma), max(int(iterations), 1))
+        t64, inv_var, int(radius), float(range_sigma), max(int(iterations), 1), _exact_inverse(float(range_sigma)))
     phi = dispersion(local_phi)
     tau2 = _squared_bias(plane - quad, phi * (quad_var - plane_var), int(radius))
     return plane, phi * plane_var + tau2, slope, phi * slope_var, phi

@@ -156,7 +156,7 @@ def _reference_fit(times, inv_var, row, col, *, radius=3, range_sigma=0.5, itera
 def test_kernel_solves_the_stated_normal_equations(seed):
     # curved noisy map with a 4-frame step, missing pixels and unequal variances: every
     # pixel's outputs against numpy least squares on its own neighbours (borders included)
-    from shadowcam.lab.edge_refine import _robust_plane_fit
+    from shadowcam.lab.edge_refine import _exact_inverse, _robust_plane_fit
 
     rng = np.random.default_rng(seed)
     rows, cols = np.mgrid[0:14, 0:17].astype(float)
@@ -164,7 +164,7 @@ def test_kernel_solves_the_stated_normal_equations(seed):
     times[:, 9:] += 4.0
     times[rng.random(times.shape) < 0.08] = np.nan
     inv_var = np.where(np.isfinite(times), 1.0 / rng.uniform(0.1, 0.3, times.shape) ** 2, 0.0)
-    plane, plane_var, slope, slope_var, phi, quad, quad_var = _robust_plane_fit(times, inv_var, 3, 0.5, 3)
+    plane, plane_var, slope, slope_var, phi, quad, quad_var = _robust_plane_fit(times, inv_var, 3, 0.5, 3, _exact_inverse(0.5))
     got = (plane, plane_var, slope[..., 0], slope[..., 1], slope_var[..., 0], slope_var[..., 1], phi, quad,
            quad_var)
     names = ("plane", "plane_var", "slope_r", "slope_c", "slope_r_var", "slope_c_var", "phi", "quad", "quad_var")
@@ -177,3 +177,30 @@ def test_kernel_solves_the_stated_normal_equations(seed):
                 continue
             tol = 1e-9 if name in ("plane", "quad", "slope_r", "slope_c") else 1e-9 * abs(expected)
             assert abs(value - expected) <= tol, (name, row, col, value, expected)
+
+
+@pytest.mark.parametrize("range_sigma", [0.5, 0.25, 2.0])
+def test_power_of_two_range_scale_multiplies_without_changing_a_bit(range_sigma):
+    # a power-of-two range_sigma is applied as a product with its exact inverse: every
+    # output equal to the division's, NaN placement included
+    from shadowcam.lab.edge_refine import _exact_inverse, _robust_plane_fit
+
+    rng = np.random.default_rng(3)
+    rows, cols = np.mgrid[0:20, 0:23].astype(float)
+    times = 1.0 + 0.37 * cols + 0.11 * rows + 0.02 * rows * cols / 7 + rng.normal(0, 0.2, cols.shape)
+    times[:, 12:] -= 3.0
+    times[rng.random(times.shape) < 0.1] = np.nan
+    inv_var = np.where(np.isfinite(times), 1.0 / rng.uniform(0.05, 0.4, times.shape) ** 2, 0.0)
+    inverse = _exact_inverse(range_sigma)
+    assert inverse == 1.0 / range_sigma
+    by_product = _robust_plane_fit(times, inv_var, 3, range_sigma, 3, inverse)
+    by_division = _robust_plane_fit(times, inv_var, 3, range_sigma, 3, 0.0)
+    for got, want in zip(by_product, by_division):
+        assert np.array_equal(got, want, equal_nan=True)
+
+
+@pytest.mark.parametrize("value", [0.3, 0.75, 1e-320, np.inf])
+def test_no_exact_inverse_for_other_scales(value):
+    from shadowcam.lab.edge_refine import _exact_inverse
+
+    assert _exact_inverse(value) == 0.0
