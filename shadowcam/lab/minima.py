@@ -153,7 +153,7 @@ def select_minima(values, frames, count, *, separation):
     Notes
     -----
     Greedy in (value, frame) order, like
-    :func:`shadowcam.lab.dip_kernels.select_dips` for ``count = 2``: equal values
+    :func:`shadowcam.lab.dip_kernels.merge_dips` for ``count = 2``: equal values
     go to the earlier frame.
     """
     values = np.asarray(values, dtype=np.float64)
