@@ -27,6 +27,7 @@ cfa_site_colours : the CFA channel measured at each pixel of a Bayer mosaic.
 
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 from shadowcam._shared.validation import check_array
@@ -140,7 +141,7 @@ def site_window_sums(samples, window_start, k, *, first=0):
     -------
     SiteSums
     """
-    start = np.asarray(window_start)
+    start = np.ascontiguousarray(window_start, np.int64)
     shape = start.shape
     window = np.full((k,) + shape, np.nan, np.float32)
     total, square = np.zeros(shape), np.zeros(shape)
@@ -148,21 +149,48 @@ def site_window_sums(samples, window_start, k, *, first=0):
     count = np.zeros(shape, np.int64)
     frame = int(first)
     for own, signal in samples:
-        slot = frame + np.arange(own.shape[0])[:, None, None] - start[None]
-        inside = (slot >= 0) & (slot < k)
-        t, r, c = np.nonzero(inside)
-        window[slot[t, r, c], r, c] = own[t, r, c]
-        lit = ~inside & np.isfinite(own)
-        values = np.where(lit, own, 0.0).astype(np.float64)
-        total += values.sum(axis=0)
-        square += (values**2).sum(axis=0)
-        rest = np.where(lit, signal - own, 0.0).astype(np.float64)
-        rest_total += rest.sum(axis=0)
-        rest_square += (rest**2).sum(axis=0)
-        count += lit.sum(axis=0)
-        frame += own.shape[0]
+        n = own.shape[0]
+        if own.shape[1:] != shape or signal.shape != own.shape:
+            raise ValueError(f"samples must be two (T, {shape[0]}, {shape[1]}) arrays; got {own.shape} "
+                             f"and {signal.shape}")
+        _accumulate_block(np.ascontiguousarray(own, np.float32).reshape(n, -1),
+                          np.ascontiguousarray(signal, np.float32).reshape(n, -1), frame, start.ravel(), int(k),
+                          window.reshape(k, -1), total.ravel(), square.ravel(), rest_total.ravel(),
+                          rest_square.ravel(), count.ravel())
+        frame += n
     return SiteSums(window=window, total=total, square=square, rest_total=rest_total, rest_square=rest_square,
                     count=count, n_frames=frame - int(first))
+
+
+@nb.njit(cache=True)
+def _accumulate_block(own, signal, first, start, k, window, total, square, rest_total, rest_square, count):
+    """Add one block of frames ``(T, P)`` to the per-pixel window and lit sums (in place).
+
+    Each pixel's samples of the block are summed first and the block's sums then added
+    (the order of numpy's sums over a block's time axis).
+    """
+    n, pixels = own.shape
+    for p in range(pixels):
+        block_total = block_square = block_rest = block_rest_square = 0.0
+        block_count = 0
+        for t in range(n):
+            value = own[t, p]
+            slot = first + t - start[p]
+            if 0 <= slot < k:
+                window[slot, p] = value
+            elif np.isfinite(value):
+                own64 = np.float64(value)
+                rest = np.float64(signal[t, p] - value)
+                block_total += own64
+                block_square += own64 * own64
+                block_rest += rest
+                block_rest_square += rest * rest
+                block_count += 1
+        total[p] += block_total
+        square[p] += block_square
+        rest_total[p] += block_rest
+        rest_square[p] += block_rest_square
+        count[p] += block_count
 
 
 def site_window_of_sums(parts, summary, *, site_colour):
