@@ -31,7 +31,6 @@ import numba as nb
 import numpy as np
 
 from shadowcam._shared.validation import check_array
-from shadowcam.io.cfa import site_constants
 
 #: per-axis second moment (px^2) of the channel sum's taps, (with the own site, without it):
 #: red / blue site (own 1, the 4 edge and 4 corner neighbours 1/4 each), green site (own 1,
@@ -281,14 +280,24 @@ def mosaic_own_site(mosaic, *, pattern, black, white):
     """
     cfa_site_colours((2, 2), pattern)
     mosaic = np.asarray(mosaic)
+    if mosaic.ndim != 2 or mosaic.dtype.kind != "u":
+        raise ValueError(f"mosaic must be a 2-D unsigned-integer array; got {mosaic.dtype} {mosaic.shape}")
     white = np.asarray(white, np.float64).reshape(2, 2)
     scale = np.float32(65535 // int(white.max()))
-    black_map = site_constants(np.asarray(black, np.float64).reshape(2, 2), mosaic.shape).astype(np.float32) * scale
-    span = site_constants(white, mosaic.shape).astype(np.float32) * scale - black_map
-    own = mosaic.astype(np.float32) * scale
-    own -= black_map
-    own /= span
+    black = np.asarray(black, np.float64).reshape(2, 2).astype(np.float32) * scale
+    span = white.astype(np.float32) * scale - black
+    own = np.empty(mosaic.shape, np.float32)
+    _own_site_kernel(np.ascontiguousarray(mosaic), scale, black, span, own)
     return own
+
+
+@nb.njit(cache=True)
+def _own_site_kernel(mosaic, scale, black, span, out):
+    """``(DN * scale - black) / span`` per site in float32, the constants by CFA phase ``(2, 2)``."""
+    rows, cols = mosaic.shape
+    for r in range(rows):
+        for c in range(cols):
+            out[r, c] = (np.float32(mosaic[r, c]) * scale - black[r & 1, c & 1]) / span[r & 1, c & 1]
 
 
 def _mean_std(total, square, count):
