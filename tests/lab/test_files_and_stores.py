@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from shadowcam.io.frame_store import iter_frame_chunks, open_frames, write_frames
-from shadowcam.io.raw_writer import write_dng
+from shadowcam.io.raw_writer import write_dng, write_tiff16
 from shadowcam.lab.dip_classification import OK, SEVERAL_MINIMA, WIDE_DIP
 from shadowcam.lab.dip_tracker import track_intervals, without_interval
 from shadowcam.lab.shadow_time import shadow_time_of_stores, summary_shadow_times, track_sweep
@@ -101,3 +101,16 @@ def test_the_files_and_the_store_give_the_same_reasons_and_times(capture):
     own_error = np.percentile(np.abs(files["shadow_time"] - truth)[wire], 95)
     sum_error = np.percentile(np.abs(window_only["shadow_time"] - truth)[wire], 95)
     assert own_error < 0.05 < sum_error
+
+
+def test_tiff_files_and_their_store_give_the_same_results_bit_for_bit(wire_sweep, tmp_path):
+    # no mosaic: the files' frames and the store's are one decode, so every variable is equal
+    frames, _ = wire_sweep(shape=(24, 32), n_frames=40, px_per_frame=2.0, t0=5.0, electrons=400.0, seed=2)
+    paths = [write_tiff16(tmp_path / f"frame_{k:03d}.tif", np.round(np.clip(frame, 0, 1) * 65535).astype(np.uint16))
+             for k, frame in enumerate(frames)]
+    write_frames(paths, tmp_path / "u.zarr", times_s=np.arange(len(paths)) * 0.1)
+    files = sweep_shadow_times_from_files(paths, workers=2, block_frames=7)
+    stores = shadow_time_of_stores({"u": open_frames(tmp_path / "u.zarr")}, min_coverage=0.0).sel(sweep="u")
+    assert (files["reason"] == OK).mean() > 0.9
+    for name in stores.data_vars:
+        np.testing.assert_array_equal(files[name], stores[name].values, err_msg=name, strict=True)
