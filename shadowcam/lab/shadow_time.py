@@ -19,6 +19,8 @@ cut_by_sweep : pixels whose dip the sweep's first or last frame cuts.
 track_sweep : stream frame blocks of one sweep into a summary and per-channel colour.
 sweep_shadow_times : frames of one sweep (streamed) -> shadow times, colour, flags.
 summary_shadow_times : the same from a summary (e.g. merged time-chunk partials).
+measured_shadow_times : a tracked sweep's interval, connected dips and own sites, then its times
+    (the one path of frame stores and of files).
 shadow_time_dataset : assemble the per-sweep results into the ``shadow_time`` dataset.
 check_timed : fail with the reason counts when a sweep has (almost) no timed pixel.
 shadow_time_of_stores : frame stores of the sweeps (or their time-chunk partials) -> the ``shadow_time`` dataset.
@@ -38,7 +40,7 @@ from shadowcam.lab.dip_classification import (
     _SMOOTHED_NOISE, DIP_AT_SWEEP_END, DIP_AT_SWEEP_END_TIMED, INVALID_INPUT, NEVER_SHADOWED, OK, REASONS, TIMED,
     WIDE_DIP, classify_dips, detection_threshold, neighbour_offsets, supported_by_neighbours,
 )
-from shadowcam.lab.dip_tracker import DipTracker, lit_colour
+from shadowcam.lab.dip_tracker import DipTracker, lit_colour, track_intervals, without_interval
 from shadowcam.lab.edge_refine import shifted
 from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
 from shadowcam.lab.site_signal import cfa_site_colours, track_site_window
@@ -453,7 +455,7 @@ def sweep_shadow_times(blocks, shape, *, method="edge_fit", half_window=4, cfa_p
 
 
 def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method_params=None,
-                         classify_params=None, interval=None, read=None, own_site=False):
+                         classify_params=None, interval=None, read=None, own_site=False, site_window=None):
     """Shadow times of one sweep from its tracked :class:`DipSummary`.
 
     The second half of :func:`sweep_shadow_times`, for a summary obtained
@@ -480,6 +482,10 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
         ``edge_fit`` times each demosaiced RAW pixel from its own mosaic site where
         its noise allows (:func:`shadowcam.lab.site_signal.track_site_window`, one more
         `read`); needs `cfa_pattern`, ``edge_fit`` and `read`.
+    site_window : callable, optional
+        ``site_window(summary, site_colour)`` -> the :class:`~shadowcam.lab.site_signal.SiteWindow`
+        of `own_site` measured otherwise than from ``read()``'s demosaiced blocks (e.g.
+        straight from the mosaics, in time chunks).
 
     Returns
     -------
@@ -510,7 +516,9 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
     if interval is not None and read is not None:
         support = support_intervals(read, summary, interval, reason)
     if own_site:
-        site = track_site_window(read(), summary, site_colour=cfa_site_colours(summary.lit_level.shape, cfa_pattern))
+        colour = cfa_site_colours(summary.lit_level.shape, cfa_pattern)
+        site = (site_window(summary, colour) if site_window is not None
+                else track_site_window(read(), summary, site_colour=colour))
         summary = replace(summary, site=site)
     results = shadow_times(summary, reason, contrast, method=method, method_params=method_params,
                            interval=interval, support=support)
@@ -519,6 +527,44 @@ def summary_shadow_times(summary, *, method="edge_fit", cfa_pattern=None, method
         results["saturated"] = summary.saturated
     results["n_frames"] = summary.n_frames
     return results
+
+
+def measured_shadow_times(summary, *, read, method="edge_fit", cfa_pattern=None, measure=None, site_window=None,
+                          method_params=None, classify_params=None):
+    """Shadow times of one tracked sweep with every measurement that needs its frames again.
+
+    The one path of a sweep's frame store (:func:`shadow_time_of_stores`) and of its
+    files (:func:`shadowcam.lab.sweep_files.sweep_shadow_times_from_files`): the dip
+    interval (:func:`shadowcam.lab.dip_tracker.track_intervals`, from the windows where
+    they hold it), the lit statistics without it, the connected dips' support, and for
+    RAW (a `cfa_pattern`) with ``edge_fit`` each pixel's own mosaic site; then
+    :func:`summary_shadow_times`.
+
+    Parameters
+    ----------
+    summary : DipSummary
+    read : callable
+        ``read()`` -> the sweep's blocks of the tracked signal in time order, from its
+        first frame (``(T, H, W, C)`` demosaiced frames when `site_window` is not given
+        and the sweep is RAW); iterated only for what the windows do not hold.
+    method, cfa_pattern, method_params, classify_params
+        As :func:`summary_shadow_times`.
+    measure : callable, optional
+        As :func:`shadowcam.lab.dip_tracker.track_intervals` (e.g. time chunks in parallel).
+    site_window : callable, optional
+        As :func:`summary_shadow_times`.
+
+    Returns
+    -------
+    dict
+        As :func:`summary_shadow_times`.
+    """
+    interval = track_intervals(read(), summary, measure=measure)
+    summary, interval = without_interval(summary, interval)
+    own_site = bool(cfa_pattern) and method == "edge_fit"
+    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern or None, interval=interval,
+                                read=read, own_site=own_site, site_window=site_window if own_site else None,
+                                method_params=method_params, classify_params=classify_params)
 
 
 _VARIABLE_ATTRS = {
@@ -652,7 +698,7 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
     ValueError
         If a sweep has (almost) no timed pixel, with the reason counts.
     """
-    from shadowcam.lab.dip_tracker import DipPartial, merge_partials, track_intervals, without_interval
+    from shadowcam.lab.dip_tracker import DipPartial, merge_partials
 
     if method not in SHADOW_TIME_METHODS:
         raise ValueError(f"method: unknown {method!r}; choose from {sorted(SHADOW_TIME_METHODS)}")
@@ -675,15 +721,8 @@ def shadow_time_of_stores(stores, *, method="edge_fit", partials=None, half_wind
             progress = Progress(max(n_frames, 1), f"shadow times of sweep {sweep}")
             summary, _, _ = track_sweep(_store_blocks(frames), shape,
                                         half_window=half_window, progress=progress.update)
-        log.info("sweep %s: dip intervals", sweep)
-        interval = track_intervals(_store_blocks(frames), summary)
-        summary, interval = without_interval(summary, interval)
-        own_site = bool(options["cfa_pattern"]) and method == "edge_fit"
-        if own_site:
-            log.info("sweep %s: own-site samples of the dip windows", sweep)
-        per_sweep[sweep] = summary_shadow_times(summary, interval=interval, own_site=own_site,
-                                                read=partial(_store_blocks, frames),
-                                                **options)
+        log.info("sweep %s: dip intervals (and what needs the frames again)", sweep)
+        per_sweep[sweep] = measured_shadow_times(summary, read=partial(_store_blocks, frames), **options)
     dataset = shadow_time_dataset(per_sweep)
     check_timed(dataset, min_coverage=min_coverage)
     return dataset

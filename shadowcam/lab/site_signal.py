@@ -7,7 +7,9 @@ ones of a green site), each shadowed at its own time. The dip's window is found
 on that sum (its noise is the lowest), and the pixel is then timed from the site's
 own samples where their noise allows (:func:`shadowcam.lab.shadow_time_methods.time_edge_fit`).
 The demosaic keeps a site's own value in its own channel, so those samples are
-read from the demosaiced frames without the mosaic. Under several lights each minimum's
+read from the demosaiced frames without the mosaic, or from the mosaic without a
+demosaic (:func:`mosaic_own_site`, the same values bit for bit), and the neighbours'
+part is the tracked signal less them. Under several lights each minimum's
 window carries its own :class:`SiteWindow`, in the units of its normalised window
 (:func:`shadowcam.lab.minima.find_minima` with ``site_colour``).
 
@@ -16,12 +18,16 @@ Offers
 SiteWindow : own-site samples at the window's frames, and the site's lit level and noise.
 own_site_samples : each site's own channel of a demosaiced block.
 track_site_window : one pass over a sweep's demosaiced frames -> the :class:`SiteWindow`.
+site_window_sums, SiteSums : one pass over a range of frames' own samples and signal (time chunks).
+site_window_of_sums : the :class:`SiteWindow` from the sums of consecutive frame ranges.
+mosaic_own_site : each site's own value straight from a mosaic, bit for bit the demosaic's.
 blend_variance : per-axis second moment of the channel sum's (or its neighbours' part's) demosaic taps.
 cfa_site_colours : the CFA channel measured at each pixel of a Bayer mosaic.
 """
 
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 
 from shadowcam._shared.validation import check_array
@@ -87,6 +93,140 @@ def own_site_samples(block, site_colour):
     return block[:, rows, cols, site_colour]
 
 
+@dataclass
+class SiteSums:
+    """Own-site sums of a range of a sweep's frames (:func:`site_window_sums`); add them with
+    :func:`site_window_of_sums`.
+
+    Attributes
+    ----------
+    window : (K, H, W) float32 ndarray
+        Own-site samples at the window's frames within the range (NaN elsewhere).
+    total, square : (H, W) float64 ndarray
+        Sum and sum of squares of the own samples outside the window.
+    rest_total, rest_square : (H, W) float64 ndarray
+        The same of the neighbours' part (signal less own).
+    count : (H, W) int64 ndarray
+        Number of those frames.
+    n_frames : int
+        Frames of the range.
+    """
+
+    window: np.ndarray
+    total: np.ndarray
+    square: np.ndarray
+    rest_total: np.ndarray
+    rest_square: np.ndarray
+    count: np.ndarray
+    n_frames: int
+
+
+def site_window_sums(samples, window_start, k, *, first=0):
+    """One pass over own-site samples and the tracked signal: the :class:`SiteSums` of their frames.
+
+    Parameters
+    ----------
+    samples : iterable of ((T, H, W) ndarray, (T, H, W) float32 ndarray)
+        Each site's own value and the tracked signal (channel sum) of consecutive
+        frames, from frame `first`, in time order (any block sizes).
+    window_start : (H, W) int ndarray
+        First frame of each pixel's dip window (the summary's ``window_start``).
+    k : int
+        Frames of the window.
+    first : int, optional
+        Frame of the first sample.
+
+    Returns
+    -------
+    SiteSums
+    """
+    start = np.ascontiguousarray(window_start, np.int64)
+    shape = start.shape
+    window = np.full((k,) + shape, np.nan, np.float32)
+    total, square = np.zeros(shape), np.zeros(shape)
+    rest_total, rest_square = np.zeros(shape), np.zeros(shape)
+    count = np.zeros(shape, np.int64)
+    frame = int(first)
+    for own, signal in samples:
+        n = own.shape[0]
+        if own.shape[1:] != shape or signal.shape != own.shape:
+            raise ValueError(f"samples must be two (T, {shape[0]}, {shape[1]}) arrays; got {own.shape} "
+                             f"and {signal.shape}")
+        _accumulate_block(np.ascontiguousarray(own, np.float32).reshape(n, -1),
+                          np.ascontiguousarray(signal, np.float32).reshape(n, -1), frame, start.ravel(), int(k),
+                          window.reshape(k, -1), total.ravel(), square.ravel(), rest_total.ravel(),
+                          rest_square.ravel(), count.ravel())
+        frame += n
+    return SiteSums(window=window, total=total, square=square, rest_total=rest_total, rest_square=rest_square,
+                    count=count, n_frames=frame - int(first))
+
+
+@nb.njit(cache=True)
+def _accumulate_block(own, signal, first, start, k, window, total, square, rest_total, rest_square, count):
+    """Add one block of frames ``(T, P)`` to the per-pixel window and lit sums (in place).
+
+    Each pixel's samples of the block are summed first and the block's sums then added
+    (the order of numpy's sums over a block's time axis).
+    """
+    n, pixels = own.shape
+    for p in range(pixels):
+        block_total = block_square = block_rest = block_rest_square = 0.0
+        block_count = 0
+        for t in range(n):
+            value = own[t, p]
+            slot = first + t - start[p]
+            if 0 <= slot < k:
+                window[slot, p] = value
+            elif np.isfinite(value):
+                own64 = np.float64(value)
+                rest = np.float64(signal[t, p] - value)
+                block_total += own64
+                block_square += own64 * own64
+                block_rest += rest
+                block_rest_square += rest * rest
+                block_count += 1
+        total[p] += block_total
+        square[p] += block_square
+        rest_total[p] += block_rest
+        rest_square[p] += block_rest_square
+        count[p] += block_count
+
+
+def site_window_of_sums(parts, summary, *, site_colour):
+    """The :class:`SiteWindow` of a sweep from the :class:`SiteSums` of its consecutive frame ranges.
+
+    Parameters
+    ----------
+    parts : sequence of SiteSums
+        Covering the sweep's frames once, in time order (one part: a single pass).
+    summary : DipSummary
+        The tracked sweep.
+    site_colour : (H, W) int ndarray
+        CFA channel of each site.
+
+    Returns
+    -------
+    SiteWindow
+    """
+    shape = summary.lit_level.shape
+    colour = check_array(site_colour, "site_colour", shape=shape, dtype_kind="iu")
+    n = sum(part.n_frames for part in parts)
+    if n != summary.n_frames:
+        raise ValueError(f"blocks hold {n} frames but the summary was tracked over {summary.n_frames}")
+    window = parts[0].window
+    sums = [getattr(parts[0], name) for name in ("total", "square", "rest_total", "rest_square", "count")]
+    for part in parts[1:]:
+        window = np.where(np.isnan(window), part.window, window)
+        sums = [a + getattr(part, name) for a, name in
+                zip(sums, ("total", "square", "rest_total", "rest_square", "count"))]
+    total, square, rest_total, rest_square, count = sums
+    window[~np.isfinite(window)] = np.nan
+    level, noise = _mean_std(total, square, count)
+    rest_level, rest_noise = _mean_std(rest_total, rest_square, count)
+    return SiteWindow(window=window, level=level, noise=noise, count=count, neighbour_level=rest_level,
+                      neighbour_noise=rest_noise, colour=colour.astype(np.int8))
+
+
 def track_site_window(blocks, summary, *, site_colour):
     """Own-site samples of every pixel in its dip window, and its own lit statistics.
 
@@ -104,38 +244,60 @@ def track_site_window(blocks, summary, *, site_colour):
     -------
     SiteWindow
     """
-    k = summary.window.shape[0]
     shape = summary.lit_level.shape
     colour = check_array(site_colour, "site_colour", shape=shape, dtype_kind="iu").astype(np.intp)
-    start = np.asarray(summary.window_start)
-    window = np.full((k,) + shape, np.nan, np.float32)
-    total, square = np.zeros(shape), np.zeros(shape)
-    rest_total, rest_square = np.zeros(shape), np.zeros(shape)
-    count = np.zeros(shape, np.int64)
-    first = 0
-    for block in blocks:
-        block = np.asarray(block)
-        own = own_site_samples(block, colour)
-        slot = first + np.arange(own.shape[0])[:, None, None] - start[None]
-        inside = (slot >= 0) & (slot < k)
-        t, r, c = np.nonzero(inside)
-        window[slot[t, r, c], r, c] = own[t, r, c]
-        lit = ~inside & np.isfinite(own)
-        values = np.where(lit, own, 0.0).astype(np.float64)
-        total += values.sum(axis=0)
-        square += (values**2).sum(axis=0)
-        rest = np.where(lit, block.sum(axis=3, dtype=np.float32) - own, 0.0).astype(np.float64)
-        rest_total += rest.sum(axis=0)
-        rest_square += (rest**2).sum(axis=0)
-        count += lit.sum(axis=0)
-        first += own.shape[0]
-    if first != summary.n_frames:
-        raise ValueError(f"blocks hold {first} frames but the summary was tracked over {summary.n_frames}")
-    window[~np.isfinite(window)] = np.nan
-    level, noise = _mean_std(total, square, count)
-    rest_level, rest_noise = _mean_std(rest_total, rest_square, count)
-    return SiteWindow(window=window, level=level, noise=noise, count=count, neighbour_level=rest_level,
-                      neighbour_noise=rest_noise, colour=colour.astype(np.int8))
+
+    def samples():
+        for block in blocks:
+            block = np.asarray(block)
+            yield own_site_samples(block, colour), block.sum(axis=3, dtype=np.float32)
+
+    sums = site_window_sums(samples(), summary.window_start, summary.window.shape[0])
+    return site_window_of_sums([sums], summary, site_colour=colour)
+
+
+def mosaic_own_site(mosaic, *, pattern, black, white):
+    """Each site's own value straight from a Bayer mosaic, as the RAW decode's demosaic gives it.
+
+    :func:`shadowcam.io.decode.mosaic_image` keeps a site's own channel as
+    ``(k DN - k black) / (k white - k black)`` in float32 (``k = 65535 // max(white)``,
+    every term an exact integer); this is the same arithmetic without the other
+    channels: equal to ``own_site_samples(mosaic_image(...))`` bit for bit where the
+    levels are integers (as a DNG's usually are).
+
+    Parameters
+    ----------
+    mosaic : (M, N) ndarray of unsigned int
+        In DN.
+    pattern : str
+        CFA pattern of the top-left 2x2 block (unused by the arithmetic; checked).
+    black, white : (2, 2) array_like
+        Levels of the top-left 2x2 block's sites, DN.
+
+    Returns
+    -------
+    (M, N) float32 ndarray
+    """
+    cfa_site_colours((2, 2), pattern)
+    mosaic = np.asarray(mosaic)
+    if mosaic.ndim != 2 or mosaic.dtype.kind != "u":
+        raise ValueError(f"mosaic must be a 2-D unsigned-integer array; got {mosaic.dtype} {mosaic.shape}")
+    white = np.asarray(white, np.float64).reshape(2, 2)
+    scale = np.float32(65535 // int(white.max()))
+    black = np.asarray(black, np.float64).reshape(2, 2).astype(np.float32) * scale
+    span = white.astype(np.float32) * scale - black
+    own = np.empty(mosaic.shape, np.float32)
+    _own_site_kernel(np.ascontiguousarray(mosaic), scale, black, span, own)
+    return own
+
+
+@nb.njit(cache=True)
+def _own_site_kernel(mosaic, scale, black, span, out):
+    """``(DN * scale - black) / span`` per site in float32, the constants by CFA phase ``(2, 2)``."""
+    rows, cols = mosaic.shape
+    for r in range(rows):
+        for c in range(cols):
+            out[r, c] = (np.float32(mosaic[r, c]) * scale - black[r & 1, c & 1]) / span[r & 1, c & 1]
 
 
 def _mean_std(total, square, count):

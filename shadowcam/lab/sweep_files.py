@@ -4,7 +4,10 @@ The sweep is cut into ``workers`` time chunks: this process and ``workers - 1``
 worker processes each decode the frames of a chunk (plus the tracker's
 padding) and feed them to a :class:`~shadowcam.lab.dip_tracker.DipTracker` that
 owns the chunk; this process then merges the partials (bit for bit the
-single-pass result) and times the dips.
+single-pass result) and times the dips as the workflow times a frame store
+(:func:`shadowcam.lab.shadow_time.measured_shadow_times`: dip interval, connected
+dips, each RAW pixel's own mosaic site), reading the files again, in time chunks,
+only for what the tracked windows do not hold.
 Decode and tracking of different chunks overlap, and no frame store is
 written.
 
@@ -18,17 +21,19 @@ chunk_bounds : split ``n`` frames into contiguous owned chunks.
 import multiprocessing
 import os
 from concurrent.futures import ProcessPoolExecutor
+from functools import partial
 
 import numpy as np
 
 from shadowcam.io.cfa import site_constants
 from shadowcam.io.decode import read_frame
 from shadowcam.io.raw_mosaic import is_raw, read_mosaic
-from shadowcam.lab.dip_tracker import DipTracker, IntervalTracker, merge_partials, track_intervals, without_interval
 from shadowcam.io.mosaic_reader import MosaicReader
 from shadowcam.lab.dip_kernels import SUM_SCALE, quantise_sum
+from shadowcam.lab.dip_tracker import DipTracker, IntervalTracker, merge_partials
 from shadowcam.lab.mosaic_signal import bilinear_channels, mosaic_signal
-from shadowcam.lab.shadow_time import summary_shadow_times
+from shadowcam.lab.shadow_time import measured_shadow_times
+from shadowcam.lab.site_signal import mosaic_own_site, site_window_sums, site_window_of_sums
 
 #: worker start method: rawpy (OpenMP) may deadlock in forked processes
 _CONTEXT = multiprocessing.get_context("forkserver")
@@ -90,6 +95,14 @@ class _MosaicFrames:
             self.n_site_sum += 1
         elif owned:
             self.other_sum += quantise_sum(_normalised(mosaic, levels))
+
+    def read_site(self, path, own, signal):
+        """Each site's own value and the tracked signal of one frame, into `own` and `signal` ``(M, N)``."""
+        mosaic, levels = self.reader.read(path)
+        pattern, black, white = levels["cfa_pattern"], levels["black_sites"], levels["white_sites"]
+        own[...] = mosaic_own_site(mosaic, pattern=pattern, black=black, white=white)
+        mosaic_signal(mosaic, pattern=pattern, black=black, white=white, out=signal, saturated=self.saturated,
+                      saturation_level=np.inf)
 
     def sums(self):
         return self.site_sum, self.n_site_sum, self.other_sum, self.saturated, self.levels
@@ -193,6 +206,27 @@ def _interval_owned(paths, owned, centre_frame, threshold, half_window, block_fr
     return tracker.partial()
 
 
+def _site_owned(paths, owned, window_start, k, block_frames):
+    """The :class:`~shadowcam.lab.site_signal.SiteSums` of one owned chunk of RAW files, read again.
+
+    Each frame's own-site values come straight from its mosaic (no demosaic) and its
+    signal as the tracker's (:func:`shadowcam.lab.mosaic_signal.mosaic_signal`).
+    """
+    start, stop = owned
+    frames = _MosaicFrames(paths, start, (0, 0), np.inf)
+    own = np.empty((block_frames,) + frames.shape, np.float32)
+    signal = np.empty_like(own)
+
+    def samples():
+        for first in range(start, stop, block_frames):
+            n = min(block_frames, stop - first)
+            for i in range(n):
+                frames.read_site(paths[first + i], own[i], signal[i])
+            yield own[:n], signal[:n]
+
+    return site_window_sums(samples(), window_start, k, first=start)
+
+
 def _mosaic_colour(summary, chunk_sums):
     """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place).
 
@@ -250,6 +284,11 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
                                   block_frames=16, method_params=None, classify_params=None):
     """Shadow times of one sweep from its image files (RAW, TIFF, PNG, EXR ...).
 
+    The same timing as the workflow's frame stores
+    (:func:`shadowcam.lab.shadow_time.measured_shadow_times`, the one path of both):
+    dip interval, connected dips, and for RAW with ``edge_fit`` each pixel's own
+    mosaic site.
+
     Parameters
     ----------
     paths : sequence of str or Path
@@ -267,18 +306,28 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
 
     Notes
     -----
-    The dip interval (a dip wider than the tracker's window, as the workflow's
-    shadow-time step measures it) comes from each pixel's stored window where
-    its crossings lie inside it; only if some pixel's do not are the files
-    read a second time for those pixels (in time chunks, as the tracking)
-    (:func:`shadowcam.lab.dip_tracker.track_intervals`).
+    The files are read a second time only for what the tracked windows do not hold,
+    in time chunks as the tracking (one per worker): the dip interval of pixels whose
+    crossings lie beyond their window (:func:`shadowcam.lab.dip_tracker.track_intervals`);
+    for RAW with ``edge_fit`` every frame once more, each site's own value straight from
+    its mosaic (:func:`shadowcam.lab.site_signal.mosaic_own_site`, no demosaic; the
+    site's lit statistics take every frame outside its window); and, in this process,
+    the support of ``several_minima`` / ``wide_dip`` pixels
+    (:func:`shadowcam.lab.connected_dips.support_intervals`) when there are any.
     """
     paths = [os.fspath(p) for p in paths]
     summary = track_files(paths, half_window=half_window, workers=workers,
                           block_frames=block_frames)
-    interval = track_intervals(None, summary, measure=lambda centre, threshold: _in_chunks(
-        _interval_owned, paths, workers, centre, threshold, summary.half_window, int(block_frames)))
-    summary, interval = without_interval(summary, interval)
+    block_frames = int(block_frames)
+
+    def measure(centre, threshold):
+        return _in_chunks(_interval_owned, paths, workers, centre, threshold, summary.half_window, block_frames)
+
+    def site_window(tracked, site_colour):
+        parts = _in_chunks(_site_owned, paths, workers, tracked.window_start, tracked.window.shape[0], block_frames)
+        return site_window_of_sums(parts, tracked, site_colour=site_colour)
+
     cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern, interval=interval,
-                                method_params=method_params, classify_params=classify_params)
+    return measured_shadow_times(summary, read=partial(_signal_blocks, paths, block_frames), method=method,
+                                 cfa_pattern=cfa_pattern, measure=measure, site_window=site_window,
+                                 method_params=method_params, classify_params=classify_params)

@@ -17,11 +17,15 @@ import pytest
 
 from shadowcam._shared.flux_centroid import flux_centroid_shift
 from shadowcam.io.cfa import demosaic_bilinear
+from shadowcam.io.decode import mosaic_image
 from shadowcam.lab.mosaic_signal import mosaic_signal
 from shadowcam.lab.dip_classification import OK
 from shadowcam.lab.shadow_time import summary_shadow_times, sweep_shadow_times, track_sweep
 from shadowcam.lab.shadow_time_methods import _site_times
-from shadowcam.lab.site_signal import blend_variance, cfa_site_colours, track_site_window
+from shadowcam.lab.site_signal import (
+    blend_variance, cfa_site_colours, mosaic_own_site, own_site_samples, site_window_of_sums, site_window_sums,
+    track_site_window,
+)
 
 SHAPE = (24, 32)
 WHITE, BLACK = 4095, 256
@@ -153,6 +157,40 @@ def test_site_window_holds_each_sites_own_samples_and_lit_statistics(wire_sweep)
     np.testing.assert_allclose(site.neighbour_noise, std, rtol=1e-3)
     with pytest.raises(ValueError, match="site_colour"):
         track_site_window(_blocks(frames), summary, site_colour=colour[:-1])
+
+
+def test_time_chunks_of_site_sums_give_the_single_passs_window(wire_sweep):
+    frames, _, _ = _raw_sweep(wire_sweep, electrons=400.0, seed=2)
+    summary, _, _ = track_sweep(_blocks(frames), SHAPE)
+    colour = cfa_site_colours(SHAPE, "RGGB")
+    whole = track_site_window(_blocks(frames), summary, site_colour=colour)
+    own = own_site_samples(frames, colour.astype(np.intp))
+    signal = frames.sum(axis=3, dtype=np.float32)
+    k = summary.window.shape[0]
+    parts = [site_window_sums([(own[a:b], signal[a:b])], summary.window_start, k, first=a)
+             for a, b in ((0, 13), (13, 30), (30, len(frames)))]
+    chunked = site_window_of_sums(parts, summary, site_colour=colour)
+    np.testing.assert_array_equal(chunked.window, whole.window)
+    np.testing.assert_array_equal(chunked.count, whole.count)
+    for name in ("level", "noise", "neighbour_level", "neighbour_noise"):
+        # float64 sums added in another order
+        np.testing.assert_allclose(getattr(chunked, name), getattr(whole, name), rtol=1e-12, err_msg=name)
+    with pytest.raises(ValueError, match="frames"):
+        site_window_of_sums(parts[:2], summary, site_colour=colour)
+
+
+@pytest.mark.parametrize("black, white", [(256, 4095), (512, 16383), (64, 1023)])
+def test_own_sites_from_the_mosaic_are_the_demosaics_bit_for_bit(black, white):
+    rng = np.random.default_rng(4)
+    mosaic = rng.integers(0, white + 1, size=(10, 12)).astype(np.uint16)
+    levels = dict(black_sites=np.full((2, 2), black), white_sites=np.full((2, 2), white))
+    for pattern in ("RGGB", "GBRG"):
+        image = mosaic_image(mosaic, cfa_pattern=pattern, **levels)
+        colour = cfa_site_colours(mosaic.shape, pattern).astype(np.intp)
+        expected = own_site_samples(image[None], colour)[0]
+        got = mosaic_own_site(mosaic, pattern=pattern, black=levels["black_sites"], white=levels["white_sites"])
+        assert got.dtype == np.float32
+        np.testing.assert_array_equal(got, expected)
 
 
 @pytest.mark.parametrize("row, col", [(4, 6), (4, 7), (5, 6), (5, 7)])  # R, G, G, B sites of RGGB
