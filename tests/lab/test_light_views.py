@@ -284,7 +284,8 @@ def test_lights_in_another_order_in_each_sweep_are_paired_by_their_contrast_maps
 
 
 def test_lights_at_nearly_one_place_are_flagged_not_paired_by_chance():
-    """Two lights 3.5 mm apart in the plane of the sweeps, 12-bit noise: their contrast maps
+    """Two lights 0.007 scene units apart (offsets +-0.0025 along e_u and e_v; the crossed pair
+    above is 0.034 apart), 12-bit noise: their contrast maps
     differ by less than the noise, so the pairing is flagged (attrs and a warning naming the
     reason) and the sweeps keep their shadow order."""
     lights = [{"kind": "point", "offset": [0.0025, -0.0025, 0.0]}, {"kind": "point", "offset": [-0.0025, 0.0025, 0.0]}]
