@@ -4,7 +4,9 @@ Each sweep's minima are found (:func:`shadowcam.lab.minima.find_minima`) and ass
 the lights (:func:`shadowcam.lab.light_assignment.assign_minima`) in the order the lights
 sit along the wire's motion (the capture's ``light_along_*``: a light further along the
 motion needs the wire further along to shadow a point, so later), checked against the
-lights' positions measured from the median gaps between their shadows; light k's shadow
+lights' positions measured from the median gaps between their shadows; which u light is
+which v light is measured from the lights' contrast maps (:func:`match_sweep_lights`; the
+description, when given, is checked against it); light k's shadow
 times of the u and v sweeps are its dual coordinates (uniform wire motion: the frame is
 the dual coordinate), and the reference image resampled there is the dual view from
 light k.
@@ -443,7 +445,8 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         ``light`` coordinate and optionally ``light_along_u``, ``light_along_v`` (light,):
         each light's position along the sweep's wire motion, which orders its shadows
         (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`);
-        without them light k is the k-th shadow to pass in both sweeps; attr ``cfa_pattern``
+        without them light k is the k-th shadow to pass in the u sweep, and the v sweep's
+        lights are paired with them by their contrast maps (:func:`pair_sweep_lights`); attr ``cfa_pattern``
         for demosaiced camera RAW frames (timed as :func:`sweep_light_times` times them). A
         capture's files: :func:`shadowcam.lab.light_files.light_set_views_of_plan`, or
         :func:`~shadowcam.lab.light_files.light_set_capture_of_plan` for this dataset.
@@ -458,8 +461,9 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
     check_order : bool
         Check the measured positions against ``light_along_<sweep>``
-        (:func:`check_light_order`, which assumes the lights at one height); False: only
-        measure them.
+        (:func:`check_light_order`, which assumes the lights at one height) and the
+        measured pairing of the sweeps' lights against theirs (:func:`pair_sweep_lights`);
+        False: only measure them (a contradicting pairing is a warning).
 
     Returns
     -------
@@ -469,13 +473,15 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         ``shown`` (sweep, light) int8 (1: the sweep shows the light's dip; 0: its dips are
         no more than noise alone places, every time ``unresolved_dip``), ``dual_view`` (light, v, u, channel), ``coverage`` (light, v, u) and ``position``
         (sweep, light): each light's position along the sweep measured from its shadows
-        (frames from the first light's, :func:`light_positions`).
+        (frames from the first light's, :func:`light_positions`); attrs ``pairing``,
+        ``pairing_z``, ``pairing_decided`` (:func:`pair_sweep_lights`).
 
     Raises
     ------
     ValueError
         When the measured positions disagree with ``light_along_<sweep>``
-        (:func:`check_light_order`).
+        (:func:`check_light_order`), or a decided pairing of the sweeps' lights with the
+        description (:func:`pair_sweep_lights`; with `check_order`).
     """
     missing = {"frames_u", "frames_v", "reference"} - set(capture)
     if missing or "light" not in capture.coords:
