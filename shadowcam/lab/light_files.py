@@ -24,7 +24,7 @@ import xarray as xr
 
 from shadowcam.cameras.array_files import read_stack
 from shadowcam.io.decode import frame_info, iter_frames
-from shadowcam.lab.light_views import SWEEPS, light_views_dataset, sweep_light_times, view_attrs
+from shadowcam.lab.light_views import SWEEPS, light_views_dataset, pair_sweep_lights, sweep_light_times, view_attrs
 
 
 #: the most decoded frames (float32 RGB) held at once while a sweep streams, in bytes
@@ -94,14 +94,17 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
         ``light_along_u``, ``light_along_v``), sweeps ``u``, ``v`` and a reference.
     half_window, method, radius, tolerance, check_order
         See :func:`shadowcam.lab.light_views.light_set_views`; without described positions
-        light k is the k-th shadow to pass in both sweeps and nothing is checked.
+        light k is the k-th shadow to pass in the u sweep, paired with the v sweep's by
+        their contrast maps (:func:`shadowcam.lab.light_views.pair_sweep_lights`).
 
     Returns
     -------
     xarray.Dataset
         :func:`shadowcam.lab.light_views.light_set_views`'s dataset over the dual grid
         (frames of v, frames of u); attrs also ``kinds`` (per light) and ``light_order``:
-        ``described`` (by ``light_along_*``) or ``shadows`` (in the order they pass).
+        ``described`` (by ``light_along_*``) or ``shadows`` (in the order they pass), and
+        the sweeps' pairing (``pairing``, ``pairing_z``, ``pairing_decided``,
+        :func:`shadowcam.lab.light_views.pair_sweep_lights`).
 
     Raises
     ------
@@ -119,9 +122,10 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
             _frame_blocks(plan.sweep(name).files, plan.frame_shape), block["count"], sweep=name,
             light_along=block[f"light_along_{name}"], half_window=half_window, method=method, radius=radius,
             tolerance=tolerance, check_order=check_order, cfa_pattern=pattern, shape=plan.frame_shape)
+    per_sweep, positions, pairing = pair_sweep_lights(per_sweep, positions, described=described, check=check_order)
     attrs = view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
                        check_order=check_order and described)
-    attrs.update(kinds=list(block["kinds"]), light_order="described" if described else "shadows")
+    attrs.update(kinds=list(block["kinds"]), light_order="described" if described else "shadows", **pairing)
     return light_views_dataset(per_sweep, positions, _reference(plan),
                                shape=(plan.n_frames("v"), plan.n_frames("u")), lights=np.arange(block["count"]),
                                channels=["R", "G", "B"], attrs=attrs)

@@ -4,7 +4,9 @@ Each sweep's minima are found (:func:`shadowcam.lab.minima.find_minima`) and ass
 the lights (:func:`shadowcam.lab.light_assignment.assign_minima`) in the order the lights
 sit along the wire's motion (the capture's ``light_along_*``: a light further along the
 motion needs the wire further along to shadow a point, so later), checked against the
-lights' positions measured from the median gaps between their shadows; light k's shadow
+lights' positions measured from the median gaps between their shadows; which u light is
+which v light is measured from the lights' contrast maps (:func:`match_sweep_lights`; the
+description, when given, is checked against it); light k's shadow
 times of the u and v sweeps are its dual coordinates (uniform wire motion: the frame is
 the dual coordinate), and the reference image resampled there is the dual view from
 light k.
@@ -12,6 +14,8 @@ light k.
 Offers
 ------
 light_positions : the lights' positions along a sweep from the gaps between their shadows.
+match_sweep_lights : which u-sweep light is which v-sweep light, from their contrast maps.
+pair_sweep_lights : the v sweep's lights put in the u sweep's order (measured, or checked).
 check_light_order : those positions against the capture's ``light_along_<sweep>``.
 sweep_light_times : one sweep's frames -> its minima assigned to the lights, their positions.
 light_views_dataset : per-light shadow times of both sweeps -> the dataset with the dual views.
@@ -22,10 +26,13 @@ light_set_errors : per-light, per-sweep absolute time errors on the scored pixel
 light_set_accuracy : per-light, per-sweep error and coverage against the renderer.
 """
 
+import itertools
+import warnings
 from dataclasses import fields, replace
 
 import numpy as np
 import xarray as xr
+from scipy.special import ndtri
 
 from shadowcam._shared.validation import check_array, check_positive
 from shadowcam.cameras.dual_view import resample_dual_view
@@ -130,6 +137,149 @@ def check_light_order(position, spread, light_along, *, sweep, tolerance=2.0, se
             "in the manifest) against the capture; lights at different heights break the "
             "proportion this check assumes (light-views --skip-order-check)")
     return np.concatenate([[0.0], np.cumsum(scale * described)])
+
+
+def match_sweep_lights(contrast_u, time_u, shown_u, contrast_v, time_v, shown_v, *, false_alarm=1e-3,
+                       min_pixels=20):
+    """Which u-sweep light is which v-sweep light, from their contrast maps.
+
+    The same light lights the same scene in both sweeps, so a light's contrast (its dip's
+    depth over the pixel's lit level: its share of the pixel's irradiance, shading and
+    attached shadows included) is the same map in u and in v, while different lights'
+    maps differ by their n.l / r^2 from different places. A sweep's dips are shallower than
+    the share by the wire's blur, a factor of the pixel and sweep common to nearby lights,
+    so the maps are compared normalised per pixel: the log contrasts centred over the
+    lights compared there. A pairing (a permutation) compares the lights both sweeps show
+    under it; its cost per pixel (where all of them are timed in both sweeps) is the sum of
+    squared differences of the centred log contrasts, and the pairing is the one of least
+    mean cost among those comparing the most lights. Its decisiveness is a sign test
+    against the runner-up: each pixel timed for both favours the pairing of smaller cost
+    there; with no preference either wins with probability 1/2, so ``z = (2 wins - n) /
+    sqrt(n)`` (the best's wins among n pixels), and the pairing is decided when ``z``
+    exceeds the one-sided ``false_alarm`` quantile (neighbouring pixels are treated as
+    independent).
+
+    Parameters
+    ----------
+    contrast_u, time_u : (L, H, W) array_like
+        The u sweep's per-light contrast and time (NaN = untimed), light k at index k.
+    shown_u : (L,) array_like of bool
+        Whether the u sweep shows each light's dip.
+    contrast_v, time_v, shown_v
+        The same for the v sweep.
+    false_alarm : float
+        The test's false-alarm rate.
+    min_pixels : int
+        Pixels below which a pairing, or the test, has no evidence.
+
+    Returns
+    -------
+    dict
+        ``order`` (L,) int ndarray: v light ``order[k]`` is u light k; ``z`` (float; inf
+        with one light or one pairing the evidence allows, 0 without evidence);
+        ``decided`` (bool); ``reason`` (str, why it is not decided; empty when it is);
+        ``cost`` (float, the pairing's mean cost; NaN without evidence).
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        log_u, log_v = (np.where(np.isfinite(np.asarray(t, np.float64)) & (np.asarray(c, np.float64) > 0),
+                                 np.log(np.asarray(c, np.float64)), np.nan)
+                        for c, t in ((contrast_u, time_u), (contrast_v, time_v)))
+    n_lights = log_u.shape[0]
+    shown_u, shown_v = np.asarray(shown_u, bool), np.asarray(shown_v, bool)
+    critical = float(-ndtri(false_alarm))
+    ranked = []
+    for order in itertools.permutations(range(n_lights)):
+        compared = [k for k in range(n_lights) if shown_u[k] and shown_v[order[k]]]
+        if len(compared) < 2:
+            continue
+        u, v = log_u[compared], log_v[[order[k] for k in compared]]
+        with np.errstate(invalid="ignore"):
+            cost = np.sum(((u - u.mean(0)) - (v - v.mean(0))) ** 2, axis=0)  # (H, W), NaN where one is untimed
+        valid = np.isfinite(cost)
+        if valid.sum() >= min_pixels:
+            ranked.append((-len(compared), float(cost[valid].mean()), order, cost))
+    ranked.sort(key=lambda r: (r[0], r[1]))
+    if n_lights == 1:
+        return {"order": np.zeros(1, int), "cost": np.nan, "z": float("inf"), "decided": True, "reason": ""}
+    if not ranked:
+        return {"order": np.arange(n_lights), "cost": np.nan, "z": 0.0, "decided": False,
+                "reason": "fewer than two lights are timed in both sweeps: no contrast maps to compare"}
+    best = ranked[0]
+    out = {"order": np.array(best[2]), "cost": best[1]}
+    rivals = [r for r in ranked[1:] if r[0] == best[0]]
+    if not rivals:
+        return dict(out, z=float("inf"), decided=True, reason="")
+    difference = rivals[0][3] - best[3]
+    difference = difference[np.isfinite(difference)]
+    wins, n = int(np.sum(difference > 0)), int(np.sum(difference != 0))
+    z = (2.0 * wins - n) / np.sqrt(n) if n >= min_pixels else 0.0
+    decided = bool(z > critical)
+    reason = "" if decided else (
+        f"the lights' contrast maps do not tell them apart (the runner-up pairing fits worse in "
+        f"{wins} of {n} pixels, z = {z:.2f} <= {critical:.2f}): lights at nearly one place or of equal shading")
+    return dict(out, z=float(z), decided=decided, reason=reason)
+
+
+def pair_sweep_lights(per_sweep, positions, *, described, check=True, false_alarm=1e-3):
+    """The v sweep's lights put in the u sweep's order, by their contrast maps.
+
+    Without a description the lights are numbered in the order their shadows pass in the
+    u sweep, and the v sweep's lights are matched to them by :func:`match_sweep_lights`;
+    an undecided match keeps the v sweep's shadow order, with a warning. With a
+    description (``light_along_*``, both sweeps already in its order) the measured
+    pairing is checked against it.
+
+    Parameters
+    ----------
+    per_sweep : mapping of str to dict
+        ``u`` and ``v`` -> :func:`sweep_light_times`'s times.
+    positions : mapping of str to (L,) ndarray
+        ``u`` and ``v`` -> its positions.
+    described : bool
+        Both sweeps are in the order of the capture's ``light_along_*``.
+    check : bool
+        With a description: a decided measured pairing other than the described one is an
+        error; False: only a warning.
+    false_alarm : float
+        Of :func:`match_sweep_lights`.
+
+    Returns
+    -------
+    per_sweep, positions : dict
+        As given, the v sweep's entries in the u sweep's light order.
+    attrs : dict
+        ``pairing`` (``described``, ``measured`` or ``shadow_order``: undecided, the k-th
+        shadow of each sweep), ``pairing_z`` and ``pairing_decided`` (int).
+
+    Raises
+    ------
+    ValueError
+        Naming ``light_along_*`` when a decided measured pairing contradicts it (`check`).
+    """
+    u, v = per_sweep["u"], per_sweep["v"]
+    match = match_sweep_lights(u["contrast"], u["time"], u["shown"], v["contrast"], v["time"], v["shown"],
+                               false_alarm=false_alarm)
+    attrs = {"pairing_z": float(match["z"]), "pairing_decided": int(match["decided"])}
+    identity = np.arange(match["order"].size)
+    if not match["decided"]:
+        warnings.warn(f"pairing the u and v sweeps' lights: {match['reason']}; "
+                      + ("the description's (light_along_*) pairing is kept unchecked" if described else
+                         "light k is the k-th shadow to pass in each sweep, which may pair the wrong times "
+                         "(give lights.light_along_*)"), stacklevel=2)
+        return dict(per_sweep), dict(positions), dict(attrs, pairing="described" if described else "shadow_order")
+    if described:
+        if np.any(match["order"] != identity):
+            message = (f"light_along_u / light_along_v: the described lights pair u light k with v light k, "
+                       f"the contrast maps pair it with v light {match['order'].tolist()} (z = {match['z']:.1f}): "
+                       "check the lights' offsets against the capture")
+            if check:
+                raise ValueError(message)
+            warnings.warn(message, stacklevel=2)
+        return dict(per_sweep), dict(positions), dict(attrs, pairing="described")
+    order = match["order"]
+    paired = {key: value[order] for key, value in v.items()}
+    return ({"u": u, "v": paired}, {"u": positions["u"], "v": np.asarray(positions["v"])[order]},
+            dict(attrs, pairing="measured"))
 
 
 def _gather_light(record, index, ok):
@@ -295,7 +445,8 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         ``light`` coordinate and optionally ``light_along_u``, ``light_along_v`` (light,):
         each light's position along the sweep's wire motion, which orders its shadows
         (:func:`shadowcam.synthetic.lab.light_set_capture.render_light_set_capture`);
-        without them light k is the k-th shadow to pass in both sweeps; attr ``cfa_pattern``
+        without them light k is the k-th shadow to pass in the u sweep, and the v sweep's
+        lights are paired with them by their contrast maps (:func:`pair_sweep_lights`); attr ``cfa_pattern``
         for demosaiced camera RAW frames (timed as :func:`sweep_light_times` times them). A
         capture's files: :func:`shadowcam.lab.light_files.light_set_views_of_plan`, or
         :func:`~shadowcam.lab.light_files.light_set_capture_of_plan` for this dataset.
@@ -310,8 +461,9 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         Of :func:`~shadowcam.lab.light_assignment.assign_minima`.
     check_order : bool
         Check the measured positions against ``light_along_<sweep>``
-        (:func:`check_light_order`, which assumes the lights at one height); False: only
-        measure them.
+        (:func:`check_light_order`, which assumes the lights at one height) and the
+        measured pairing of the sweeps' lights against theirs (:func:`pair_sweep_lights`);
+        False: only measure them (a contradicting pairing is a warning).
 
     Returns
     -------
@@ -321,13 +473,15 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
         ``shown`` (sweep, light) int8 (1: the sweep shows the light's dip; 0: its dips are
         no more than noise alone places, every time ``unresolved_dip``), ``dual_view`` (light, v, u, channel), ``coverage`` (light, v, u) and ``position``
         (sweep, light): each light's position along the sweep measured from its shadows
-        (frames from the first light's, :func:`light_positions`).
+        (frames from the first light's, :func:`light_positions`); attrs ``pairing``,
+        ``pairing_z``, ``pairing_decided`` (:func:`pair_sweep_lights`).
 
     Raises
     ------
     ValueError
         When the measured positions disagree with ``light_along_<sweep>``
-        (:func:`check_light_order`).
+        (:func:`check_light_order`), or a decided pairing of the sweeps' lights with the
+        description (:func:`pair_sweep_lights`; with `check_order`).
     """
     missing = {"frames_u", "frames_v", "reference"} - set(capture)
     if missing or "light" not in capture.coords:
@@ -341,11 +495,13 @@ def light_set_views(capture, *, half_window=4, method="edge_fit", radius=2, tole
             capture[f"frames_{name}"].values, n_lights, sweep=name, light_along=along, half_window=half_window,
             method=method, radius=radius, tolerance=tolerance, check_order=check_order,
             cfa_pattern=capture.attrs.get("cfa_pattern"))
+    per_sweep, positions, pairing = pair_sweep_lights(per_sweep, positions, described="light_along_u" in capture,
+                                                      check=check_order)
     return light_views_dataset(
         per_sweep, positions, capture["reference"].values, shape=(capture.sizes["t_v"], capture.sizes["t_u"]),
         lights=capture["light"].values, channels=capture["channel"].values,
-        attrs=view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
-                         check_order=check_order and "light_along_u" in capture))
+        attrs={**view_attrs(half_window=half_window, method=method, radius=radius, tolerance=tolerance,
+                            check_order=check_order and "light_along_u" in capture), **pairing})
 
 
 def view_attrs(*, half_window, method, radius, tolerance, check_order):

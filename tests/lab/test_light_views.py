@@ -8,7 +8,7 @@ import pytest
 from shadowcam.io.cfa import demosaic_bilinear
 from shadowcam.lab.light_views import (
     _gather_light, check_light_order, light_positions, light_set_accuracy, light_set_errors, light_set_views,
-    sweep_light_times,
+    match_sweep_lights, sweep_light_times,
 )
 from shadowcam.lab.minima import OK, find_minima
 from shadowcam.lab.shadow_time_methods import _site_times
@@ -243,3 +243,94 @@ def test_the_own_site_window_is_the_sites_channel_over_the_channel_sums_level():
         np.testing.assert_array_equal(getattr(plain, name), getattr(minima, name))
     with pytest.raises(ValueError, match="site_colour"):
         find_minima(frames, (6, 8), count=1, site_colour=colour[:5])
+
+
+# ------------------------------------------------- which u light is which v light (no description)
+
+#: two point lights whose shadows pass in one order in the u sweep and in the other in the v sweep
+CROSSED = [{"kind": "point", "offset": [0.012, -0.012, 0.0]}, {"kind": "point", "offset": [-0.012, 0.012, 0.0]}]
+
+
+def _undescribed(capture):
+    """The capture without ``light_along_*``, and its truth relabelled as the stage numbers the
+    lights then: light k is the k-th shadow to pass in the u sweep."""
+    order = np.argsort(capture["light_along_u"].values, kind="stable")
+    truth = capture.isel(light=order).assign_coords(light=np.arange(capture.sizes["light"]))
+    return capture.drop_vars(["light_along_u", "light_along_v"]), truth
+
+
+@pytest.mark.parametrize("noise, p95_target", [(False, 0.35), (True, 1.0)])
+def test_lights_in_another_order_in_each_sweep_are_paired_by_their_contrast_maps(noise, p95_target):
+    """Light A's shadow passes first in u and second in v: without ``light_along_*`` the
+    contrast maps pair the sweeps' lights, exactly as the description does. Targets: the
+    dip-centroid target of the noise-free render (0.35 frame); with 12-bit noise (no mosaic,
+    32 x 32) below the false-time distance, 1 frame (the wrong pairing is 23-24 frames off)."""
+    extra = {"noise": True, "bit_depth": 12} if noise else {}
+    capture = render_light_set_capture({**BASE, "lights": CROSSED, "shutter": 1, **extra})
+    assert np.argmax(capture["light_along_u"].values) != np.argmax(capture["light_along_v"].values)
+    plain, truth = _undescribed(capture)
+    measured = light_set_views(plain)
+    assert measured.attrs["pairing"] == "measured" and measured.attrs["pairing_decided"] == 1
+    assert measured.attrs["pairing_z"] > 3.09
+    described = light_set_views(capture)
+    assert described.attrs["pairing"] == "described"
+    # the same times as the description's, the lights numbered in the u sweep's order
+    order = np.argsort(capture["light_along_u"].values, kind="stable")
+    np.testing.assert_array_equal(measured["time"].values, described["time"].values[:, order])
+    for entry in light_set_accuracy(measured, truth)["lights"]:
+        for sweep in ("u", "v"):
+            assert entry[sweep]["n_scored"] > 300 and entry[sweep]["coverage"] > 0.95
+            assert entry[sweep]["p95_error"] < p95_target
+
+
+def test_lights_at_nearly_one_place_are_flagged_not_paired_by_chance():
+    """Two lights 0.007 scene units apart (offsets +-0.0025 along e_u and e_v; the crossed pair
+    above is 0.034 apart), 12-bit noise: their contrast maps
+    differ by less than the noise, so the pairing is flagged (attrs and a warning naming the
+    reason) and the sweeps keep their shadow order."""
+    lights = [{"kind": "point", "offset": [0.0025, -0.0025, 0.0]}, {"kind": "point", "offset": [-0.0025, 0.0025, 0.0]}]
+    capture = render_light_set_capture({**BASE, "lights": lights, "shutter": 1, "noise": True, "bit_depth": 12})
+    plain, _ = _undescribed(capture)
+    with pytest.warns(UserWarning, match="do not tell them apart"):
+        views = light_set_views(plain)
+    assert views.attrs["pairing"] == "shadow_order" and views.attrs["pairing_decided"] == 0
+    assert views.attrs["pairing_z"] <= 3.09
+
+
+def test_a_description_the_contrast_maps_contradict_is_an_error_naming_the_key():
+    """Two lights: one gap fits any spacing (``check_light_order`` cannot see a swap), but the
+    contrast maps pair the sweeps' lights and see the v description swapped."""
+    capture = render_light_set_capture({**BASE, "lights": CROSSED, "shutter": 1})
+    swapped = capture.copy()
+    swapped["light_along_v"] = ("light", capture["light_along_v"].values[::-1].copy())
+    with pytest.raises(ValueError, match="light_along_u / light_along_v"):
+        light_set_views(swapped, method="dip_centroid")
+    with pytest.warns(UserWarning, match="light_along_u / light_along_v"):
+        light_set_views(swapped, method="dip_centroid", check_order=False)
+
+
+def test_the_match_of_equal_maps_is_undecided_and_of_distinct_maps_decided():
+    """Unit case: contrast maps that differ in their spatial pattern pair whatever the order,
+    equal maps (up to noise) cannot be told apart."""
+    rng = np.random.default_rng(5)
+    y, x = np.indices((30, 40))
+    maps = np.stack([0.3 + 0.2 * x / 40, 0.5 - 0.2 * y / 30])
+    times = np.ones_like(maps)
+    noisy = maps + rng.normal(0, 0.01, maps.shape)
+    match = match_sweep_lights(maps, times, [True, True], noisy[::-1], times, [True, True])
+    np.testing.assert_array_equal(match["order"], [1, 0])
+    assert match["decided"] and match["z"] > 20
+    equal = np.stack([maps[0], maps[0]])
+    match = match_sweep_lights(equal, times, [True, True], equal + rng.normal(0, 0.01, equal.shape), times,
+                               [True, True])
+    assert not match["decided"] and "do not tell them apart" in match["reason"]
+    # a light one sweep does not show gives no evidence: with two lights nothing is left to
+    # compare the per-pixel ratio with; with three the two others decide
+    match = match_sweep_lights(maps, times, [True, True], noisy[::-1], times, [True, False])
+    assert not match["decided"] and "fewer than two lights" in match["reason"]
+    three = np.concatenate([maps, [0.2 + 0.3 * (x + y) / 70]])
+    times3 = np.ones_like(three)
+    v_maps = three[[1, 0, 2]] + rng.normal(0, 0.01, three.shape)
+    match = match_sweep_lights(three, times3, [True] * 3, v_maps, times3, [True, True, False])
+    np.testing.assert_array_equal(match["order"], [1, 0, 2])
+    assert match["decided"]
