@@ -4,8 +4,11 @@ Reads a several-lights manifest (a user's ``data_manifest/<ds>.yaml`` with a top
 ``lights`` block, or the ``capture.json`` that render-lights writes), decodes the u and v
 sweeps one after the other; each sweep's minima are assigned to the lights by their order
 along the sweep, checked by spatial continuity, and timed by ``edge_fit`` over each
-light's own map (:func:`shadowcam.lab.light_files.light_set_views_of_plan`); the lights'
-positions along the sweep measured from the data must agree with the manifest's
+light's own map (:func:`shadowcam.lab.light_files.light_set_views_of_plan`). The v sweep's
+lights are paired with the u sweep's by their contrast maps (each light's share of a pixel's
+light is the same in both sweeps); a pairing the maps do not decide is flagged
+(``pairing_decided`` 0, a warning) and the shadows' order kept. The lights' positions along
+the sweep measured from the data, and a decided pairing, must agree with the manifest's
 ``lights.light_along_*`` when it gives them. A light whose dip a sweep cannot show (its
 minima no more than noise alone places) keeps no time there: reason ``unresolved_dip``,
 ``shown`` 0. Writes the per-light shadow times, reasons, contrast, confidence, ``shown``,
@@ -35,8 +38,8 @@ def add_parser(subparsers, name):
     parser.add_argument("--half-window", type=int, default=4,
                         help="frames: at least half the widest dip (a tube across the wire is wide); default 4")
     parser.add_argument("--skip-order-check", action="store_true",
-                        help="do not check the lights' measured positions against the manifest's "
-                             "lights.light_along_* (lights at different heights)")
+                        help="do not check the lights' measured positions and pairing against the "
+                             "manifest's lights.light_along_* (lights at different heights): warn instead")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/lights/light_views.nc")
     return parser
 
