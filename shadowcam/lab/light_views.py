@@ -571,7 +571,8 @@ def light_set_accuracy(views, capture, *, min_level=0.2, false_error=1.0):
         ``confidence_false`` (median confidence on the timed pixels within and beyond
         `false_error`; None where none), ``reasons`` (name -> count) and, from the views'
         ``shown``, ``dip_shown`` (bool) with a ``note`` where the sweep cannot show the
-        light's dip.
+        light's dip; ``pairing`` (``how``, ``z``, ``decided``: how the v sweep's lights were
+        paired with the u sweep's, :func:`pair_sweep_lights`) where the views record it.
     """
     errors = light_set_errors(views, capture, min_level=min_level)
     out = []
@@ -604,4 +605,8 @@ def light_set_accuracy(views, capture, *, min_level=0.2, false_error=1.0):
                     entry[name]["note"] = (f"the {name} sweep cannot show this light's dip: its minima are no "
                                            "more than noise alone places (reason unresolved_dip)")
         out.append(entry)
-    return {"lights": out}
+    if "pairing" not in views.attrs:
+        return {"lights": out}
+    pairing = {"how": str(views.attrs["pairing"]), "z": float(views.attrs["pairing_z"]),
+               "decided": bool(views.attrs["pairing_decided"])}
+    return {"lights": out, "pairing": pairing}

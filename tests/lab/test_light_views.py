@@ -277,7 +277,9 @@ def test_lights_in_another_order_in_each_sweep_are_paired_by_their_contrast_maps
     # the same times as the description's, the lights numbered in the u sweep's order
     order = np.argsort(capture["light_along_u"].values, kind="stable")
     np.testing.assert_array_equal(measured["time"].values, described["time"].values[:, order])
-    for entry in light_set_accuracy(measured, truth)["lights"]:
+    accuracy = light_set_accuracy(measured, truth)
+    assert accuracy["pairing"] == {"how": "measured", "z": measured.attrs["pairing_z"], "decided": True}
+    for entry in accuracy["lights"]:
         for sweep in ("u", "v"):
             assert entry[sweep]["n_scored"] > 300 and entry[sweep]["coverage"] > 0.95
             assert entry[sweep]["p95_error"] < p95_target
