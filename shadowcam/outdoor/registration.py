@@ -285,14 +285,14 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     # band-passed once and its band-pass resampled at every step (resampling log luminance)
     moving = bandpass_log(luma)
     for _ in range(max_iter):
-        error = translate(moving, shift, method="opencv_cubic").ravel() - target
+        error = translate(moving, shift, method="cubic_Keys1981").ravel() - target
         step = np.linalg.solve(normal, -np.array([_dot(weighted[0], error), _dot(weighted[1], error)]))
         shift += step
         if np.max(np.abs(shift - start)) > max_shift:
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = translate(moving, shift, method="opencv_cubic").ravel() - target
+    error = translate(moving, shift, method="cubic_Keys1981").ravel() - target
     residual = float(np.sqrt(_dot(flat * error, error) / max(float(flat.sum(dtype=np.float64)), 1.0)))
     return shift, residual
 

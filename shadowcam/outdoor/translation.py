@@ -85,7 +85,7 @@ def _translate_cubic_Keys1981(image, shift):
         rounding); bit-identical for any column window of `image` at columns
         ``ceil(|shift_col|) + 2`` or more from the window's cut edges.
     """
-    return translate_with_block_means(image, shift, factor=1)[0]
+    return translate_with_block_means(image, shift, factor=None)[0]
 
 
 def translate_with_block_means(image, shift, *, factor, out=None):
@@ -97,8 +97,8 @@ def translate_with_block_means(image, shift, *, factor, out=None):
         float32 (other dtypes are converted to float32).
     shift : (2,) array_like
         ``(shift_row, shift_col)`` in pixels.
-    factor : int, keyword-only
-        Block side (>= 1).
+    factor : int or None, keyword-only
+        Block side (>= 1); ``None``: no block means.
     out : (H, W) float32 ndarray, optional
         Written with the translated image (a buffer reused from frame to frame); must not
         be `image`.
@@ -109,18 +109,17 @@ def translate_with_block_means(image, shift, *, factor, out=None):
         Row pass then column pass, each the four cubic taps
         (:func:`cubic_weights`) added in order in float32, edges replicated; an axis
         with zero shift is copied.
-    block_means : (H // factor, W // factor) float32 ndarray
+    block_means : (H // factor, W // factor) float32 ndarray or None
         :func:`shadowcam.outdoor.registration.block_mean` of `translated` (to float32
-        rounding: the sums are float64).
+        rounding: the sums are float64); ``None`` without `factor`.
     """
     image = np.ascontiguousarray(image, dtype=np.float32)
     check_array(image, "image", ndim=2)
     shift = np.asarray(shift, dtype=np.float64)
     if shift.shape != (2,) or not np.all(np.isfinite(shift)):
         raise ValueError(f"shift must be two finite numbers (row, col); got {shift}")
-    factor = int(factor)
-    if factor < 1:
-        raise ValueError(f"factor must be >= 1; got {factor}")
+    if factor is not None and int(factor) < 1:
+        raise ValueError(f"factor must be >= 1 or None; got {factor}")
     if out is None:
         out = np.empty_like(image)
     elif out.shape != image.shape or out.dtype != np.float32 or not out.flags.c_contiguous or out is image:
@@ -129,9 +128,10 @@ def translate_with_block_means(image, shift, *, factor, out=None):
     for offset in shift:
         whole = math.floor(offset)
         taps += [None, 0] if offset == 0 else [cubic_weights(offset - whole), whole - 1]
-    sums = np.zeros((image.shape[0] // factor, image.shape[1] // factor), dtype=np.float64)
-    cubic_translate_rows(image, taps[0], taps[1], taps[2], taps[3], out, factor, sums)
-    return out, (sums / float(factor * factor)).astype(np.float32)
+    side = 1 if factor is None else int(factor)
+    sums = np.zeros((0, 0) if factor is None else (image.shape[0] // side, image.shape[1] // side), dtype=np.float64)
+    cubic_translate_rows(image, taps[0], taps[1], taps[2], taps[3], out, side, sums)
+    return out, None if factor is None else (sums / float(side * side)).astype(np.float32)
 
 
 def _translate_spline(image, shift):
