@@ -47,7 +47,7 @@ from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_level
 from shadowcam.outdoor.shade_field import block_grid, block_levels, shade_field, unclouded_blocks
 from shadowcam.outdoor.sky_mask import auto_sky_mask
 from shadowcam.outdoor.translation import translate, translate_with_block_means
-from shadowcam.outdoor.translation_kernels import normalise_smooth_minimum
+from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3

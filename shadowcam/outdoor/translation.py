@@ -36,7 +36,7 @@ import cv2
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in
-from shadowcam.outdoor.translation_kernels import cubic_translate_rows
+from shadowcam.outdoor.frame_kernels import cubic_translate_rows
 
 #: Keys' free parameter, as OpenCV's INTER_CUBIC
 KEYS_A = -0.75

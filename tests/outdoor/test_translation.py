@@ -5,7 +5,7 @@ import pytest
 
 from shadowcam.outdoor.registration import block_mean
 from shadowcam.outdoor.translation import cubic_weights, translate, translate_with_block_means
-from shadowcam.outdoor.translation_kernels import normalise_smooth_minimum
+from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 
 
 @pytest.mark.parametrize("fraction", [0.0, 0.25, 0.5, 0.9])

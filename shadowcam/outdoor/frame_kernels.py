@@ -1,4 +1,4 @@
-"""Compiled kernels of the full-resolution work on a registered frame (numba).
+"""Compiled per-frame kernels of the outdoor passes (numba).
 
 :func:`cubic_translate_rows` is the separable cubic translation of
 :func:`shadowcam.outdoor.translation.translate` ``"cubic_Keys1981"`` one output row at a time:
@@ -14,13 +14,20 @@ same pass, takes the running minimum of the 3-frame smoothing ``0.25 a + 0.5 b +
 (float32, in that order) of the first pass's per-pixel shadow level
 (:class:`shadowcam.outdoor.normalise.SequenceNormaliser`).
 
-Both validate nothing: :mod:`shadowcam.outdoor.translation` and
-:mod:`shadowcam.outdoor.normalise` do.
+:func:`block_upper_quartiles` is the per-block loop of
+:func:`shadowcam.outdoor.shade_field.block_levels`: each block's used ratios at or above the
+reach threshold gathered, sorted, and their upper quartile interpolated as ``np.percentile``
+(linear; ``a + d g`` below ``g = 0.5``, ``b - d (1 - g)`` from it, in the ratios' dtype), so
+the levels are numpy's bit for bit.
+
+None validates its inputs: :mod:`shadowcam.outdoor.translation`,
+:mod:`shadowcam.outdoor.normalise` and :mod:`shadowcam.outdoor.shade_field` do.
 
 Offers
 ------
 cubic_translate_rows : separable cubic translation with the translated frame's block sums.
 normalise_smooth_minimum : divide by the gain, then the running minimum of the 3-frame smoothing.
+block_upper_quartiles : each block's upper quartile of its lit ratios, with the block's usability tests.
 """
 
 import numba as nb
@@ -120,3 +127,53 @@ def normalise_smooth_minimum(current, gain, earlier, previous, minimum):
             smooth += now[c] * quarter
             if smooth < low[c] or smooth != smooth:  # NaN propagates, as np.minimum
                 low[c] = smooth
+
+
+@nb.njit(cache=True)
+def block_upper_quartiles(ratio, use, above, row_edges, col_edges, levels):
+    """Each block's upper quartile of its ratios ``above`` the reach threshold, where the block is usable.
+
+    Parameters
+    ----------
+    ratio : (h, w) float ndarray
+        ``luma / reference_luma`` where `use`.
+    use, above : (h, w) bool ndarray
+        Pixels used (lit in the reference, not near the ridge's shadow, positive reference) and,
+        of those, the ones at or above the reach threshold.
+    row_edges, col_edges : (By + 1,), (Bx + 1,) int ndarray
+        Block boundaries.
+    levels : (By, Bx) float64 ndarray
+        Written where the block has 10 or more ratios above, those are more than three quarters
+        of its used ones, and its used pixels are a quarter or more of the block; left as given
+        elsewhere.
+    """
+    n_rows, n_cols = levels.shape
+    gamma_cast = np.empty(1, dtype=ratio.dtype)
+    for i in range(n_rows):
+        r0, r1 = row_edges[i], row_edges[i + 1]
+        for j in range(n_cols):
+            c0, c1 = col_edges[j], col_edges[j + 1]
+            size = (r1 - r0) * (c1 - c0)
+            lit = np.empty(size, dtype=ratio.dtype)
+            n_used, n_lit = 0, 0
+            for r in range(r0, r1):
+                for c in range(c0, c1):
+                    if use[r, c]:
+                        n_used += 1
+                        if above[r, c]:
+                            lit[n_lit] = ratio[r, c]
+                            n_lit += 1
+            if n_lit < 10 or 4 * (n_used - n_lit) >= n_used or 4 * n_used < size:
+                continue
+            values = np.sort(lit[:n_lit])
+            virtual = (n_lit - 1) * 0.75
+            below = int(np.floor(virtual))
+            gamma = virtual - below
+            low, high = values[below], values[min(below + 1, n_lit - 1)]
+            diff = high - low
+            if gamma >= 0.5:
+                gamma_cast[0] = 1.0 - gamma
+                levels[i, j] = high - diff * gamma_cast[0]
+            else:
+                gamma_cast[0] = gamma
+                levels[i, j] = low + diff * gamma_cast[0]
