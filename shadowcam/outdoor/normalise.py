@@ -41,13 +41,13 @@ the merge turns them into the cloud's shade field over the frame (``shade_field`
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
-from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
-                                    shift_coarse_to_fine, soft_shadow, static_weight)
+from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, reference_levels,
+                                    registration_factor, shift_coarse_to_fine, soft_shadow, static_weight)
 from shadowcam.outdoor.shade_field import block_grid, block_levels, shade_field, unclouded_blocks
 from shadowcam.outdoor.sky_mask import auto_sky_mask
 from shadowcam.outdoor.translation import translate, translate_with_block_means
-from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
@@ -157,6 +157,9 @@ class SequenceNormaliser:
         # working size of registration and gains: masks hold where the whole block does
         self.factor = registration_factor((height, width), max_size=self._registration_size)
         self._small_reference = block_mean(self.reference_luma, self.factor)
+        # the reference's band-pass and gradients at every registration level: once, not per frame
+        self._reference_levels = reference_levels(
+            self._small_reference, levels=pyramid_levels(self._small_reference.shape, levels=self._registration_levels))
         self._small_lit = block_all(self.lit_at_start, self.factor)
         self._small_valid = block_all(~self._sky, self.factor)
         self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
@@ -240,7 +243,7 @@ class SequenceNormaliser:
             weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
                                    margin=self._registration_margin)
             shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
-                                            levels=self._registration_levels)
+                                            levels=self._registration_levels, prepared=self._reference_levels)
             shift = shift * factor
             # the oldest of the three frames kept is released by this frame's window: its buffer is reused
             spare = self._recent.pop(0) if len(self._recent) == 3 else None
