@@ -41,12 +41,13 @@ the merge turns them into the cloud's shade field over the frame (``shade_field`
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
-from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, registration_factor,
-                                    shift_coarse_to_fine, soft_shadow, static_weight)
+from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, reference_levels,
+                                    registration_factor, shift_coarse_to_fine, soft_shadow, static_weight)
 from shadowcam.outdoor.shade_field import block_grid, block_levels, shade_field, unclouded_blocks
 from shadowcam.outdoor.sky_mask import auto_sky_mask
-from shadowcam.outdoor.translation import translate
+from shadowcam.outdoor.translation import translate, translate_with_block_means
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
@@ -156,6 +157,9 @@ class SequenceNormaliser:
         # working size of registration and gains: masks hold where the whole block does
         self.factor = registration_factor((height, width), max_size=self._registration_size)
         self._small_reference = block_mean(self.reference_luma, self.factor)
+        # the reference's band-pass and gradients at every registration level: once, not per frame
+        self._reference_levels = reference_levels(
+            self._small_reference, levels=pyramid_levels(self._small_reference.shape, levels=self._registration_levels))
         self._small_lit = block_all(self.lit_at_start, self.factor)
         self._small_valid = block_all(~self._sky, self.factor)
         self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
@@ -239,11 +243,12 @@ class SequenceNormaliser:
             weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
                                    margin=self._registration_margin)
             shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
-                                            levels=self._registration_levels)
+                                            levels=self._registration_levels, prepared=self._reference_levels)
             shift = shift * factor
-            luma = translate(raw, shift, method="opencv_cubic")
-            del raw, small
-            small = block_mean(luma, factor)
+            # the oldest of the three frames kept is released by this frame's window: its buffer is reused
+            spare = self._recent.pop(0) if len(self._recent) == 3 else None
+            luma, small = translate_with_block_means(raw, shift, factor=factor, out=spare)
+            del raw
             levels = block_levels(small, ref, pixels=self._small_lit, row_edges=self._row_edges,
                                   col_edges=self._col_edges, reached_below=SHADOWED_CONTRAST * rough,
                                   dark=self._small_valid & ~self._small_lit, reach=self._penumbra_reach(small, rough))
@@ -257,19 +262,12 @@ class SequenceNormaliser:
             self.gain_source.append(int(source))
             self.gain_median.append(float(rough))
             self.shade_levels.append(levels.astype(np.float32))
-        if luma is not self.reference_luma:
-            luma /= np.float32(gain_sky)  # a fresh array (translate); in place saves a frame-sized copy
-        else:
-            luma = luma / np.float32(gain_sky)
+        if luma is self.reference_luma:
+            luma = luma.copy()
+        window = self._recent[-2:] if len(self._recent) >= 2 and k >= self.record_from else (None, None)
+        # luma /= gain_sky in place, then the minimum of 0.25 a + 0.5 b + 0.25 c (float32, in that order)
+        normalise_smooth_minimum(luma, np.float32(gain_sky), window[0], window[1], self._shadow_min)
         self._recent = (self._recent + [luma])[-3:]
-        if len(self._recent) == 3 and k >= self.record_from:
-            # 0.25 a + 0.5 b + 0.25 c with the same float32 operations in the same order, in two buffers
-            smooth = np.multiply(self._recent[0], np.float32(0.25))
-            term = np.multiply(self._recent[1], np.float32(0.5))
-            smooth += term
-            np.multiply(self._recent[2], np.float32(0.25), out=term)
-            smooth += term
-            np.minimum(self._shadow_min, smooth, out=self._shadow_min)
         self._k += 1
 
     def partial(self):
@@ -511,4 +509,4 @@ def part_frames(start, stop, *, overlap=2):
 
 def aligned_luminance(frame, shift):
     """Registered luminance ``(H, W)`` float32 of `frame` ``(H, W, C)`` given its shift (row, col)."""
-    return translate(luminance(frame), shift, method="opencv_cubic")
+    return translate(luminance(frame), shift, method="cubic_Keys1981")

@@ -28,6 +28,7 @@ static_weight : weight mask of pixels whose illumination state did not change.
 shift_lucas_kanade_LucasKanade1981 : translation by iterative least squares.
 shift_coarse_to_fine : the same on a pyramid of block means, coarse levels first (large shifts).
 pyramid_levels : number of coarser levels an image of a given shape supports.
+reference_levels : the reference's band-pass and gradients at every level (once per sequence).
 registration_factor : integer downsampling factor that brings a frame to a working size.
 block_mean : mean over factor x factor blocks (area downsampling; a shift scales by 1/factor).
 block_all : True where all pixels of a factor x factor block are (masks at the working size).
@@ -231,7 +232,7 @@ def block_all(mask, factor):
 
 
 def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, initial=(0.0, 0.0),
-                                       max_iter=10, tol=1e-3, min_weight=200.0, max_shift=5.0):
+                                       max_iter=10, tol=1e-3, min_weight=200.0, max_shift=5.0, prepared=None):
     """Estimate the translation of a frame relative to the reference.
 
     Lucas & Kanade (1981), "An iterative image registration technique",
@@ -255,6 +256,9 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     max_shift : float, optional
         A solution further than this from `initial` (pixels) is rejected
         (divergence) and `initial` is returned.
+    prepared : dict, optional
+        `reference_luma`'s band-pass and its gradients (a level of :func:`reference_levels`),
+        computed once for every frame registered to it; default: computed here.
 
     Returns
     -------
@@ -271,8 +275,11 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
         weight[4:-4, 4:-4] = 1.0
     weight = np.asarray(weight, dtype=np.float32)
     check_same_shape({"luma": luma, "reference_luma": ref, "weight": weight})
-    target = bandpass_log(ref).ravel()
-    grad_row, grad_col = (np.ascontiguousarray(g).ravel() for g in np.gradient(target.reshape(ref.shape)))
+    if prepared is None:
+        prepared = reference_levels(ref, levels=0)[0]
+    elif prepared["luma"].shape != ref.shape:
+        raise ValueError(f"prepared reference {prepared['luma'].shape} does not match reference_luma {ref.shape}")
+    target, grad_row, grad_col = prepared["target"], prepared["grad_row"], prepared["grad_col"]
     flat = weight.ravel()
     weighted = (flat * grad_row, flat * grad_col)
     normal = np.array([[_dot(weighted[0], grad_row), _dot(weighted[0], grad_col)],
@@ -285,16 +292,44 @@ def shift_lucas_kanade_LucasKanade1981(luma, reference_luma, *, weight=None, ini
     # band-passed once and its band-pass resampled at every step (resampling log luminance)
     moving = bandpass_log(luma)
     for _ in range(max_iter):
-        error = translate(moving, shift, method="opencv_cubic").ravel() - target
+        error = translate(moving, shift, method="cubic_Keys1981").ravel() - target
         step = np.linalg.solve(normal, -np.array([_dot(weighted[0], error), _dot(weighted[1], error)]))
         shift += step
         if np.max(np.abs(shift - start)) > max_shift:
             return start, float("nan")
         if np.max(np.abs(step)) < tol:
             break
-    error = translate(moving, shift, method="opencv_cubic").ravel() - target
+    error = translate(moving, shift, method="cubic_Keys1981").ravel() - target
     residual = float(np.sqrt(_dot(flat * error, error) / max(float(flat.sum(dtype=np.float64)), 1.0)))
     return shift, residual
+
+
+def reference_levels(reference_luma, *, levels):
+    """The reference prepared for Lucas-Kanade at every level of :func:`shift_coarse_to_fine`.
+
+    Parameters
+    ----------
+    reference_luma : (H, W) ndarray
+    levels : int
+        Coarser levels (each :func:`block_mean` by 2 of the one before).
+
+    Returns
+    -------
+    list of dict
+        Full size first, then each coarser level: ``luma (h, w)`` float32, ``target (h w,)`` its
+        :func:`bandpass_log` flattened, ``grad_row``, ``grad_col (h w,)`` the band-pass's
+        ``np.gradient``.
+    """
+    reference = np.asarray(reference_luma, dtype=np.float32)
+    check_array(reference, "reference_luma", ndim=2)
+    prepared = []
+    for level in range(int(levels) + 1):
+        if level:
+            reference = block_mean(reference, 2)
+        target = bandpass_log(reference)
+        grad_row, grad_col = (np.ascontiguousarray(g).ravel() for g in np.gradient(target))
+        prepared.append({"luma": reference, "target": target.ravel(), "grad_row": grad_row, "grad_col": grad_col})
+    return prepared
 
 
 def _dot(a, b):
@@ -343,7 +378,7 @@ def _border_weight(weight, border):
 
 
 def shift_coarse_to_fine(luma, reference_luma, *, weight=None, initial=(0.0, 0.0), levels=2, min_size=64,
-                         agree=0.5, **options):
+                         agree=0.5, prepared=None, **options):
     """Estimate a translation that may be large, coarse levels first.
 
     Each coarser level halves the images (:func:`block_mean`; the weight is kept
@@ -376,6 +411,9 @@ def shift_coarse_to_fine(luma, reference_luma, *, weight=None, initial=(0.0, 0.0
         Pixels (full images): a coarse estimate this close to `initial` is
         within reach of the search from `initial`, which is then the only one;
         solutions this close are the same.
+    prepared : list of dict, optional
+        :func:`reference_levels` of `reference_luma` with at least the levels used (computed once
+        for a sequence registered to one reference); default: computed here.
     **options
         Keyword options of :func:`shift_lucas_kanade_LucasKanade1981` (``max_iter``,
         ``tol``, ``min_weight``, ``max_shift``), used at every level.
@@ -397,25 +435,31 @@ def shift_coarse_to_fine(luma, reference_luma, *, weight=None, initial=(0.0, 0.0
     weight = np.asarray(weight, dtype=np.float32)
     check_same_shape({"weight": weight, "luma": luma})
     n_levels = pyramid_levels(luma.shape, levels=levels, min_size=min_size)
+    if prepared is None:
+        prepared = reference_levels(ref, levels=n_levels)
+    elif len(prepared) <= n_levels:
+        raise ValueError(f"prepared reference has {len(prepared)} levels; {n_levels + 1} are used")
     start = np.asarray(initial, dtype=np.float64).copy()
     coarse = start
     if n_levels:
-        frame, reference, mask = luma, ref, weight
+        frame, mask = luma, weight
         pyramid = []
-        for _ in range(n_levels):
-            frame, reference = block_mean(frame, 2), block_mean(reference, 2)
+        for level in range(1, n_levels + 1):
+            frame = block_mean(frame, 2)
             mask = block_all(mask > 0, 2).astype(np.float32)
-            pyramid.append((frame, reference, mask))
+            pyramid.append((frame, prepared[level], mask))
         coarse = start / 2 ** n_levels
         for frame, reference, mask in pyramid[::-1]:
-            coarse, _ = shift_lucas_kanade_LucasKanade1981(frame, reference, weight=_border_weight(mask, _border(coarse)),
+            coarse, _ = shift_lucas_kanade_LucasKanade1981(frame, reference["luma"], prepared=reference,
+                                                           weight=_border_weight(mask, _border(coarse)),
                                                            initial=coarse, **options)
             coarse = coarse * 2
     shift, residual = shift_lucas_kanade_LucasKanade1981(luma, ref, weight=_border_weight(weight, _border(start)),
-                                                         initial=start, **options)
+                                                         initial=start, prepared=prepared[0], **options)
     if np.max(np.abs(coarse - start)) > agree:
         guided, guided_residual = shift_lucas_kanade_LucasKanade1981(
-            luma, ref, weight=_border_weight(weight, _border(coarse)), initial=coarse, **options)
+            luma, ref, weight=_border_weight(weight, _border(coarse)), initial=coarse, prepared=prepared[0],
+            **options)
         # the guided search counts only if it found another solution, and a better one
         other = not np.isfinite(residual) or np.max(np.abs(guided - shift)) > agree
         if np.isfinite(guided_residual) and other and not guided_residual >= residual:

@@ -28,6 +28,7 @@ interpolate_field : ``T`` at every pixel ``(H, W)`` from a frame's block field.
 import cv2
 import numpy as np
 
+from shadowcam.outdoor.frame_kernels import block_upper_quartiles
 from shadowcam.outdoor.shade import FULLY_LIT
 
 
@@ -102,14 +103,11 @@ def block_levels(luma, reference_luma, *, pixels, row_edges, col_edges, reached_
         near = near.astype(np.uint8)
         near = cv2.dilate(near, np.ones((2 * reach + 1, 2 * reach + 1), np.uint8)).astype(bool)
         pixels = pixels & ~near
-    for i, (r0, r1) in enumerate(zip(row_edges[:-1], row_edges[1:])):
-        for j, (c0, c1) in enumerate(zip(col_edges[:-1], col_edges[1:])):
-            use = pixels[r0:r1, c0:c1] & (reference_luma[r0:r1, c0:c1] > 0)
-            ratio = luma[r0:r1, c0:c1][use] / reference_luma[r0:r1, c0:c1][use]
-            lit = ratio[ratio >= reached_below]
-            if lit.size < 10 or 4 * (ratio.size - lit.size) >= ratio.size or 4 * ratio.size < use.size:
-                continue
-            levels[i, j] = np.percentile(lit, 75)
+    use = pixels & (reference_luma > 0)
+    ratio = np.divide(luma, reference_luma, out=np.zeros(use.shape, np.result_type(luma, reference_luma)), where=use)
+    above = use & (ratio >= reached_below)
+    block_upper_quartiles(ratio, use, above, np.asarray(row_edges, dtype=np.int64),
+                          np.asarray(col_edges, dtype=np.int64), levels)  # np.percentile(ratios, 75) per block
     return levels
 
 

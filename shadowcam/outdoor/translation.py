@@ -27,6 +27,7 @@ Offers
 TRANSLATION_METHODS : method name -> translation function ``(image, shift) -> image``.
 translate : translate an image by a sub-pixel shift with a named method.
 cubic_weights : the four cubic-convolution weights of a fractional offset.
+translate_with_block_means : ``"cubic_Keys1981"`` and the block means of the result in one pass.
 """
 
 import math
@@ -35,6 +36,7 @@ import cv2
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in
+from shadowcam.outdoor.frame_kernels import cubic_translate_rows
 
 #: Keys' free parameter, as OpenCV's INTER_CUBIC
 KEYS_A = -0.75
@@ -83,33 +85,53 @@ def _translate_cubic_Keys1981(image, shift):
         rounding); bit-identical for any column window of `image` at columns
         ``ceil(|shift_col|) + 2`` or more from the window's cut edges.
     """
-    out = np.asarray(image, dtype=np.float32)
-    check_array(out, "image", ndim=2)
+    return translate_with_block_means(image, shift, factor=None)[0]
+
+
+def translate_with_block_means(image, shift, *, factor, out=None):
+    """``"cubic_Keys1981"`` translation and the block means of its result, in one pass (compiled).
+
+    Parameters
+    ----------
+    image : (H, W) ndarray
+        float32 (other dtypes are converted to float32).
+    shift : (2,) array_like
+        ``(shift_row, shift_col)`` in pixels.
+    factor : int or None, keyword-only
+        Block side (>= 1); ``None``: no block means.
+    out : (H, W) float32 ndarray, optional
+        Written with the translated image (a buffer reused from frame to frame); must not
+        be `image`.
+
+    Returns
+    -------
+    translated : (H, W) float32 ndarray
+        Row pass then column pass, each the four cubic taps
+        (:func:`cubic_weights`) added in order in float32, edges replicated; an axis
+        with zero shift is copied.
+    block_means : (H // factor, W // factor) float32 ndarray or None
+        :func:`shadowcam.outdoor.registration.block_mean` of `translated` (to float32
+        rounding: the sums are float64); ``None`` without `factor`.
+    """
+    image = np.ascontiguousarray(image, dtype=np.float32)
+    check_array(image, "image", ndim=2)
     shift = np.asarray(shift, dtype=np.float64)
     if shift.shape != (2,) or not np.all(np.isfinite(shift)):
         raise ValueError(f"shift must be two finite numbers (row, col); got {shift}")
-    for axis, offset in enumerate(shift):
-        if offset == 0:
-            continue
+    if factor is not None and int(factor) < 1:
+        raise ValueError(f"factor must be >= 1 or None; got {factor}")
+    if out is None:
+        out = np.empty_like(image)
+    elif out.shape != image.shape or out.dtype != np.float32 or not out.flags.c_contiguous or out is image:
+        raise ValueError(f"out must be a C-contiguous float32 array of shape {image.shape}, other than image")
+    taps = []
+    for offset in shift:
         whole = math.floor(offset)
-        weights = cubic_weights(offset - whole)
-        before, after = max(0, 1 - whole), max(0, whole + 2)
-        pad = [(0, 0), (0, 0)]
-        pad[axis] = (before, after)
-        padded = np.pad(out, pad, mode="edge")
-        size = out.shape[axis]
-        total, term = np.empty_like(out), np.empty_like(out)
-        for tap, weight in enumerate(weights):
-            start = whole - 1 + tap + before
-            window = [slice(None), slice(None)]
-            window[axis] = slice(start, start + size)
-            if tap == 0:
-                np.multiply(padded[tuple(window)], weight, out=total)
-            else:
-                np.multiply(padded[tuple(window)], weight, out=term)
-                total += term
-        out = total
-    return out if out is not image else out.copy()
+        taps += [None, 0] if offset == 0 else [cubic_weights(offset - whole), whole - 1]
+    side = 1 if factor is None else int(factor)
+    sums = np.zeros((0, 0) if factor is None else (image.shape[0] // side, image.shape[1] // side), dtype=np.float64)
+    cubic_translate_rows(image, taps[0], taps[1], taps[2], taps[3], out, side, sums)
+    return out, None if factor is None else (sums / float(side * side)).astype(np.float32)
 
 
 def _translate_spline(image, shift):

@@ -172,3 +172,20 @@ def test_recovers_an_area_sampled_shift(moved):
 
     estimate, _ = shift_coarse_to_fine(frame(*moved) * 1.2, frame(0, 0), levels=1)
     np.testing.assert_allclose(estimate, np.divide(moved, fine), atol=0.02)
+
+
+def test_a_prepared_reference_gives_the_same_shift_bit_for_bit():
+    from shadowcam.outdoor.registration import reference_levels, shift_coarse_to_fine
+
+    rng = np.random.default_rng(4)
+    ref = (rng.random((300, 400)) * 0.5 + 0.3).astype(np.float32)
+    ref = translate(ref, (0.3, 0.3), method="spline")  # some spatial correlation
+    frame = translate(ref, (-1.4, 2.2), method="opencv_cubic")  # content moves by (1.4, -2.2)
+    prepared = reference_levels(ref, levels=2)
+    assert [level["luma"].shape for level in prepared] == [(300, 400), (150, 200), (75, 100)]
+    alone = shift_coarse_to_fine(frame, ref, levels=2)
+    shared = shift_coarse_to_fine(frame, ref, levels=2, prepared=prepared)
+    assert np.array_equal(alone[0], shared[0]) and alone[1] == shared[1]
+    np.testing.assert_allclose(shared[0], (1.4, -2.2), atol=0.05)
+    with pytest.raises(ValueError, match="levels"):
+        shift_coarse_to_fine(frame, ref, levels=2, prepared=prepared[:2])

@@ -2,7 +2,9 @@
 
 import numpy as np
 
-from shadowcam.outdoor.shade_field import block_grid, interpolate_field, shade_field
+import pytest
+
+from shadowcam.outdoor.shade_field import block_grid, block_levels, interpolate_field, shade_field
 
 
 def test_shade_field_is_the_transmittance_of_the_blocks_levels():
@@ -36,3 +38,28 @@ def test_interpolated_field_is_bilinear_in_the_block_centres_and_the_same_in_col
     np.testing.assert_allclose(value, plane, atol=1e-6)
     strip = interpolate_field(field, row_centres=row_centres, col_centres=col_centres - 20, shape=(80, 25))
     np.testing.assert_array_equal(strip, value[:, 20:45])
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_block_levels_are_each_blocks_upper_quartile_of_its_lit_ratios(dtype):
+    rng = np.random.default_rng(5)
+    ref = (rng.random((120, 150)) * 0.8 + 0.1).astype(dtype)
+    ref[:3, :3] = 0  # no ratio where the reference is 0
+    state = rng.choice([0.2, 0.9, 1.1], p=[0.05, 0.5, 0.45], size=ref.shape)
+    state[48:72, 0:24] = 0.2  # a block the ridge reached: no level
+    luma = (ref * state * (1 + 0.05 * rng.standard_normal(ref.shape))).astype(dtype)
+    pixels = rng.random(ref.shape) > 0.1
+    pixels[96:, 120:] = False  # blocks without lit pixels (the last one 6 columns wide): no level
+    rows, cols, _, _ = block_grid(ref.shape, block=24, factor=1)
+    levels = block_levels(luma, ref, pixels=pixels, row_edges=rows, col_edges=cols, reached_below=0.3)
+    expected = np.full(levels.shape, np.nan)
+    for i in range(rows.size - 1):
+        for j in range(cols.size - 1):
+            block = np.s_[rows[i]:rows[i + 1], cols[j]:cols[j + 1]]
+            used = pixels[block] & (ref[block] > 0)
+            ratio = luma[block][used] / ref[block][used]
+            lit = ratio[ratio >= 0.3]
+            if lit.size >= 10 and 4 * (ratio.size - lit.size) < ratio.size and 4 * ratio.size >= used.size:
+                expected[i, j] = np.percentile(lit, 75)
+    assert np.isnan(levels[[2, 4, 4], [0, 5, 6]]).all() and np.isfinite(levels).sum() == levels.size - 3
+    assert np.array_equal(levels, expected, equal_nan=True)  # numpy's percentile, bit for bit

@@ -3,7 +3,9 @@
 import numpy as np
 import pytest
 
-from shadowcam.outdoor.translation import cubic_weights, translate
+from shadowcam.outdoor.registration import block_mean
+from shadowcam.outdoor.translation import cubic_weights, translate, translate_with_block_means
+from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 
 
 @pytest.mark.parametrize("fraction", [0.0, 0.25, 0.5, 0.9])
@@ -57,3 +59,44 @@ def test_every_method_moves_content_back_by_the_shift():
         translate(image, (0.5, 0.5), method="lanczos")
     with pytest.raises(ValueError, match="shift"):
         translate(image, (0.5,), method="spline")
+
+
+def _separable_cubic(image, shift):
+    """Independent reference: each axis's four taps from an edge-padded copy, in float64."""
+    out = image.astype(np.float64)
+    for axis, offset in enumerate(shift):
+        whole = int(np.floor(offset))
+        weights = cubic_weights(offset - whole).astype(np.float64)
+        index = np.clip(np.arange(out.shape[axis])[:, None] + whole - 1 + np.arange(4)[None, :], 0, out.shape[axis] - 1)
+        taken = np.take(out, index, axis=axis)  # (..., n, 4, ...) along `axis`
+        out = np.tensordot(taken, weights, axes=([axis + 1], [0]))
+    return out
+
+
+@pytest.mark.parametrize("shift", [(0.3, -1.7), (0.0, 2.25), (-3.4, 0.0), (5.5, -0.1)])
+def test_translation_with_block_means_is_the_cubic_kernel_and_its_block_means(shift):
+    image = np.random.default_rng(2).random((45, 62), dtype=np.float32)
+    buffer = np.full(image.shape, np.nan, np.float32)
+    moved, means = translate_with_block_means(image, shift, factor=4, out=buffer)
+    assert moved is buffer and means.shape == (11, 15)
+    np.testing.assert_allclose(moved, _separable_cubic(image, shift), rtol=0, atol=1e-6)
+    np.testing.assert_allclose(means, block_mean(moved, 4), rtol=0, atol=1e-6)  # float64 sums, float32 mean
+    assert np.array_equal(moved, translate(image, shift, method="cubic_Keys1981"))
+    assert translate_with_block_means(image, shift, factor=None)[1] is None
+    with pytest.raises(ValueError, match="out"):
+        translate_with_block_means(image, shift, factor=4, out=image)
+
+
+def test_the_running_minimum_of_the_smoothing_is_the_float32_formula():
+    rng = np.random.default_rng(3)
+    earlier, previous, current = (rng.random((9, 13), dtype=np.float32) for _ in range(3))
+    minimum = rng.random((9, 13), dtype=np.float32)
+    minimum[0, 0] = np.inf
+    gain = np.float32(1.37)
+    now = current / gain
+    expected = np.minimum(minimum, earlier * np.float32(0.25) + previous * np.float32(0.5) + now * np.float32(0.25))
+    normalise_smooth_minimum(current, gain, earlier, previous, minimum)
+    assert np.array_equal(current, now) and np.array_equal(minimum, expected)
+    before = minimum.copy()
+    normalise_smooth_minimum(current, gain, None, None, minimum)  # no window yet: only the division
+    assert np.array_equal(current, now / gain) and np.array_equal(minimum, before)
