@@ -200,11 +200,11 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     # sweep shadows), measured as the uncut neighbours' mean width, their spread the width's
     # uncertainty
     uncut = (reason == OK) & ~opened & np.isfinite(interval_entry) & np.isfinite(interval_exit)
-    width, width_std = _local_width(interval_exit - interval_entry, uncut)
+    one_edge = at_end & (interval.entry_open != interval.exit_open) & (interval.invalid == 0)
+    width, width_std = _local_width(interval_exit - interval_entry, uncut, one_edge)
     with np.errstate(invalid="ignore"):
         cut_centre = np.where(interval.exit_open, interval_entry + 0.5 * width, interval_exit - 0.5 * width)
-        cut = (at_end & (interval.entry_open != interval.exit_open) & (interval.invalid == 0)
-               & np.isfinite(cut_centre) & (cut_centre >= 0) & (cut_centre <= summary.n_frames - 1))
+        cut = one_edge & np.isfinite(cut_centre) & (cut_centre >= 0) & (cut_centre <= summary.n_frames - 1)
     edge_std = np.where(interval.exit_open, entry_std, exit_std)
     reason[cut] = DIP_AT_SWEEP_END_TIMED
     time = np.where(cut, cut_centre, time)
@@ -218,7 +218,7 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     # a thin dip cut by the sweep, from the removed light of its uncut neighbours' dips
     removed = _removed_light(summary)
     whole = (reason == OK) & ~cut_thin & ~(cut_start | cut_end) & np.isfinite(removed[0])
-    total, total_std = _local_width(removed[0], whole)
+    total, total_std = _local_width(removed[0], whole, cut_thin)
     cut_time, cut_std = _time_cut_thin_dips(summary, removed, cut_thin, cut_start, total, total_std)
     with np.errstate(invalid="ignore"):
         inside = cut_thin & np.isfinite(cut_time) & (cut_time >= 0) & (cut_time <= summary.n_frames - 1)
@@ -347,17 +347,18 @@ def _time_cut_thin_dips(summary, removed, pixels, cut_start, total, total_std):
     return time_map, std_map
 
 
-def _local_width(width, known, *, min_count=8):
+def _local_width(width, known, wanted, *, min_count=8):
     """Mean and standard deviation of `width` over the nearest `known` pixels, ``(H, W)`` each.
 
     Over the smallest square of side ``2 r + 1`` (``r`` = 1, 2, 4, ...) holding at
-    least `min_count` known pixels; NaN where the whole image holds fewer.
+    least `min_count` known pixels; NaN where the whole image holds fewer and outside
+    the `wanted` pixels (``(H, W)`` bool: the squares grow until these have theirs).
     """
     from scipy import ndimage
 
     values = np.where(known, width, 0.0)
     mean, spread = np.full(width.shape, np.nan), np.full(width.shape, np.nan)
-    left = np.ones(width.shape, bool)
+    left = np.array(wanted, bool)
     radius = 1
     while left.any():
         size = 2 * radius + 1
