@@ -88,32 +88,49 @@ def _crossings(summary, threshold):
     The crossings nearest to the minimum on each side are used; NaN where the
     dip does not come back above `threshold` inside the window.
     """
-    win = summary.window
-    k = win.shape[0]
-    h = summary.half_window
-    above = win >= threshold[None]
-    idx = np.arange(k)[:, None, None]
-    # entry: last slot before the centre that is above the threshold
-    left = np.where(above & (idx < h), idx, -1).max(axis=0)
-    # exit: first slot after the centre that is above the threshold
-    right = np.where(above & (idx > h), idx, k).min(axis=0)
-    rows, cols = np.indices(threshold.shape)
+    return _crossings_kernel(summary.window, np.asarray(threshold, np.float64), summary.window_start,
+                             summary.half_window)
 
-    def interpolate(a, b):
-        ok = (a >= 0) & (a < k) & (b >= 0) & (b < k)
-        a_c, b_c = np.clip(a, 0, k - 1), np.clip(b, 0, k - 1)
-        va, vb = win[a_c, rows, cols], win[b_c, rows, cols]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            frac = (va - threshold) / (va - vb)
-            crossing = summary.window_start + a_c + frac * (b_c - a_c)
-        return np.where(ok & np.isfinite(frac), crossing, np.nan)
 
-    entry = interpolate(left, left + 1)
-    exit_ = interpolate(right, right - 1)
-    centre_below = win[h] < threshold
-    entry = np.where(centre_below, entry, np.nan)
-    exit_ = np.where(centre_below, exit_, np.nan)
+@nb.njit(cache=True, parallel=True, error_model="numpy")
+def _crossings_kernel(window, threshold, window_start, half_window):
+    """:func:`_crossings` per pixel: the last slot before the centre (``half_window``) at or
+    above the threshold and the next one, the first after it and the one before, each pair
+    interpolated as ``start + a + (w[a] - t) / (w[a] - w[b]) * (b - a)``."""
+    k, rows, cols = window.shape
+    h = half_window
+    entry = np.full((rows, cols), np.nan)
+    exit_ = np.full((rows, cols), np.nan)
+    for r in nb.prange(rows):
+        for c in range(cols):
+            t = threshold[r, c]
+            if not window[h, r, c] < t:  # the centre must be below the threshold
+                continue
+            start = window_start[r, c]
+            left = -1
+            for j in range(h):
+                if window[j, r, c] >= t:
+                    left = j
+            right = k
+            for j in range(k - 1, h, -1):
+                if window[j, r, c] >= t:
+                    right = j
+            entry[r, c] = _interpolated(window, r, c, left, left + 1, t, start)
+            exit_[r, c] = _interpolated(window, r, c, right, right - 1, t, start)
     return entry, exit_
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _interpolated(window, r, c, a, b, t, start):
+    """Crossing of `t` between slots `a` and `b` of pixel ``(r, c)``; NaN outside the window
+    or where the quotient is not finite."""
+    k = window.shape[0]
+    if a >= 0 and a < k and b >= 0 and b < k:
+        va, vb = window[a, r, c], window[b, r, c]
+        frac = (va - t) / (va - vb)
+        if np.isfinite(frac):
+            return np.float64(start + a) + frac * np.float64(b - a)
+    return np.nan
 
 
 def _noise_time_std(summary, depth):
