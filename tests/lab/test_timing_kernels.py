@@ -66,3 +66,54 @@ def test_neighbour_median_equals_numpys_nanmedian(seed):
     got = neighbour_median(values)
     np.testing.assert_array_equal(got, expected)
     assert np.isnan(got[6, 6]) and np.isnan(got[1, 16])
+
+
+def _crossings_numpy(window, threshold, window_start, h):
+    k = window.shape[0]
+    above = window >= threshold[None]
+    idx = np.arange(k)[:, None, None]
+    left = np.where(above & (idx < h), idx, -1).max(axis=0)
+    right = np.where(above & (idx > h), idx, k).min(axis=0)
+    rows, cols = np.indices(threshold.shape)
+
+    def interpolate(a, b):
+        ok = (a >= 0) & (a < k) & (b >= 0) & (b < k)
+        a_c, b_c = np.clip(a, 0, k - 1), np.clip(b, 0, k - 1)
+        va, vb = window[a_c, rows, cols], window[b_c, rows, cols]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            frac = (va - threshold) / (va - vb)
+            crossing = window_start + a_c + frac * (b_c - a_c)
+        return np.where(ok & np.isfinite(frac), crossing, np.nan)
+
+    below = window[h] < threshold
+    return (np.where(below, interpolate(left, left + 1), np.nan),
+            np.where(below, interpolate(right, right - 1), np.nan))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_window_crossings_and_centroid_equal_the_numpy_formulation(seed):
+    from types import SimpleNamespace
+
+    from shadowcam.lab.shadow_time_methods import _centroid, _crossings, _removed_fraction
+
+    rng = np.random.default_rng(seed)
+    k, h, w, half = 9, 21, 27, 4
+    window = np.round(rng.uniform(0.0, 1.0, (k, h, w)), 2).astype(np.float32)  # ties and equal samples
+    window[half] *= 0.3
+    window[rng.random(window.shape) < 0.1] = np.nan
+    threshold = rng.uniform(0.2, 0.8, (h, w))
+    threshold[0, :3] = np.nan
+    start = rng.integers(-4, 300, (h, w))
+    summary = SimpleNamespace(window=window, window_start=start, half_window=half)
+    for got, expected in zip(_crossings(summary, threshold), _crossings_numpy(window, threshold, start, half)):
+        np.testing.assert_array_equal(got, expected)
+        assert np.isfinite(got).mean() > 0.3
+    # the centroid's coverage is computed in its kernel; numpy's clipped fraction gives the same sums
+    lit, noise = rng.uniform(0.5, 1.5, (h, w)), rng.uniform(0.01, 0.02, (h, w))
+    coverage = _removed_fraction(window, lit)
+    frames = start[None] + np.arange(k)[:, None, None]
+    held = np.isfinite(coverage)
+    total = np.where(held, coverage, 0.0).sum(axis=0)
+    mean = np.where(held, coverage * frames, 0.0).sum(axis=0) / total
+    time, _ = _centroid(window, lit, start, noise)
+    np.testing.assert_allclose(time, mean, rtol=1e-12)
