@@ -80,16 +80,23 @@ def supported_by_neighbours(candidate, strong, minimum_frame, *, radius=2, frame
     at least half of the strong neighbours, have their minimum within
     ``1 + frames_per_pixel * distance`` frames of the candidate's.
     """
-    agree = np.zeros(candidate.shape, np.int32)
-    total = np.zeros(candidate.shape, np.int32)
+    h, w = candidate.shape
+    rows, cols = np.nonzero(candidate)  # only the candidates are tested
+    agree = np.zeros(rows.shape, np.int32)
+    total = np.zeros(rows.shape, np.int32)
     frame = minimum_frame.astype(np.float64)
+    own = frame[rows, cols]
     for dr, dc in neighbour_offsets(radius):
-        n_strong = shifted(strong, dr, dc, False)
-        n_frame = shifted(frame, dr, dc, np.nan)
+        r, c = rows + dr, cols + dc
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        r, c = np.clip(r, 0, h - 1), np.clip(c, 0, w - 1)
+        n_strong = inside & strong[r, c]
         tolerance = 1.0 + frames_per_pixel * np.hypot(dr, dc)
         total += n_strong
-        agree += n_strong & (np.abs(n_frame - frame) <= tolerance)
-    return candidate & (agree >= min_support) & (2 * agree >= total)
+        agree += n_strong & (np.abs(frame[r, c] - own) <= tolerance)
+    supported = np.zeros(candidate.shape, bool)
+    supported[rows, cols] = (agree >= min_support) & (2 * agree >= total)
+    return supported
 
 
 def _partially_lit(detected, level, *, site_colour=None, site_image=None, resolution=0.0,

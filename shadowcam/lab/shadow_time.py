@@ -38,12 +38,12 @@ from shadowcam._shared.validation import check_in_interval
 from shadowcam.lab.connected_dips import support_intervals, time_connected_dips
 from shadowcam.lab.dip_classification import (
     _SMOOTHED_NOISE, DIP_AT_SWEEP_END, DIP_AT_SWEEP_END_TIMED, INVALID_INPUT, NEVER_SHADOWED, OK, REASONS, TIMED,
-    WIDE_DIP, classify_dips, detection_threshold, neighbour_offsets, supported_by_neighbours,
+    WIDE_DIP, classify_dips, detection_threshold, supported_by_neighbours,
 )
 from shadowcam.lab.dip_tracker import DipTracker, lit_colour, track_intervals, without_interval
-from shadowcam.lab.edge_refine import shifted
 from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
 from shadowcam.lab.site_signal import cfa_site_colours, track_site_window
+from shadowcam.lab.timing_kernels import neighbour_median, removed_light
 
 log = logging.getLogger(__name__)
 
@@ -146,10 +146,7 @@ def footprint_spread_std(interval, timed):
     """
     with np.errstate(invalid="ignore"):
         width = np.where(timed, interval.exit - interval.entry, np.nan)
-    neighbours = np.stack([shifted(width, dr, dc, np.nan) for dr, dc in neighbour_offsets(1)])
-    known = np.isfinite(neighbours).any(axis=0)
-    reference = np.full(width.shape, np.nan)
-    reference[known] = np.nanmedian(neighbours[:, known], axis=0)
+    reference = neighbour_median(np.ascontiguousarray(width, np.float64))
     with np.errstate(invalid="ignore"):
         excess = np.maximum(width - reference, 0.0)
     return 0.5 * np.nan_to_num(excess, nan=0.0, posinf=0.0)
@@ -203,11 +200,11 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     # sweep shadows), measured as the uncut neighbours' mean width, their spread the width's
     # uncertainty
     uncut = (reason == OK) & ~opened & np.isfinite(interval_entry) & np.isfinite(interval_exit)
-    width, width_std = _local_width(interval_exit - interval_entry, uncut)
+    one_edge = at_end & (interval.entry_open != interval.exit_open) & (interval.invalid == 0)
+    width, width_std = _local_width(interval_exit - interval_entry, uncut, one_edge)
     with np.errstate(invalid="ignore"):
         cut_centre = np.where(interval.exit_open, interval_entry + 0.5 * width, interval_exit - 0.5 * width)
-        cut = (at_end & (interval.entry_open != interval.exit_open) & (interval.invalid == 0)
-               & np.isfinite(cut_centre) & (cut_centre >= 0) & (cut_centre <= summary.n_frames - 1))
+        cut = one_edge & np.isfinite(cut_centre) & (cut_centre >= 0) & (cut_centre <= summary.n_frames - 1)
     edge_std = np.where(interval.exit_open, entry_std, exit_std)
     reason[cut] = DIP_AT_SWEEP_END_TIMED
     time = np.where(cut, cut_centre, time)
@@ -221,8 +218,8 @@ def _time_wide_dips(summary, interval, reason, time, entry, exit_, std):
     # a thin dip cut by the sweep, from the removed light of its uncut neighbours' dips
     removed = _removed_light(summary)
     whole = (reason == OK) & ~cut_thin & ~(cut_start | cut_end) & np.isfinite(removed[0])
-    total, total_std = _local_width(removed[0], whole)
-    cut_time, cut_std = _time_cut_thin_dips(summary, cut_start, total, total_std)
+    total, total_std = _local_width(removed[0], whole, cut_thin)
+    cut_time, cut_std = _time_cut_thin_dips(summary, removed, cut_thin, cut_start, total, total_std)
     with np.errstate(invalid="ignore"):
         inside = cut_thin & np.isfinite(cut_time) & (cut_time >= 0) & (cut_time <= summary.n_frames - 1)
     reason[cut_thin] = DIP_AT_SWEEP_END
@@ -282,18 +279,16 @@ def _removed_light(summary):
     ``(H, W)`` each: the sum over the window's frames inside the sweep, the sum of frame
     times the removed fraction, the largest removed fraction.
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
-        fraction = 1.0 - summary.window.astype(np.float64) / summary.lit_level[None]
-    frames = summary.window_start[None] + np.arange(summary.window.shape[0])[:, None, None]
-    held = np.isfinite(fraction)
-    total = np.where(held, fraction, 0.0).sum(axis=0)
-    moment = np.where(held, fraction * frames, 0.0).sum(axis=0)
-    floor = np.where(held, fraction, -np.inf).max(axis=0)
-    total = np.where(held.any(axis=0), total, np.nan)
-    return total, moment, floor
+    k = summary.window.shape[0]
+    shape = summary.lit_level.shape
+    total, moment, floor = removed_light(
+        np.ascontiguousarray(summary.window, np.float32).reshape(k, -1),
+        np.ascontiguousarray(summary.window_start, np.int64).ravel(),
+        np.ascontiguousarray(summary.lit_level, np.float64).ravel())
+    return total.reshape(shape), moment.reshape(shape), floor.reshape(shape)
 
 
-def _time_cut_thin_dips(summary, cut_start, total, total_std):
+def _time_cut_thin_dips(summary, removed, pixels, cut_start, total, total_std):
     """Centre of each thin dip cut by the sweep's first (`cut_start`) or last frame.
 
     A dip removes the same light summed over its frames (``1 - I / I_lit``: the wire's
@@ -307,6 +302,10 @@ def _time_cut_thin_dips(summary, cut_start, total, total_std):
     Parameters
     ----------
     summary : DipSummary
+    removed : tuple of (H, W) ndarray
+        :func:`_removed_light` of `summary`.
+    pixels : (H, W) bool ndarray
+        The cut dips to time (the others are NaN).
     cut_start : (H, W) bool ndarray
         The cut is at the sweep's first frame (else at its last).
     total, total_std : (H, W) ndarray
@@ -316,15 +315,19 @@ def _time_cut_thin_dips(summary, cut_start, total, total_std):
     -------
     time, time_std : (H, W) float64 ndarray
         Frames; outside ``[0, n_frames - 1]`` where the centre lies beyond the sweep,
-        NaN where `total` is unknown. ``time_std`` from the samples' noise and `total_std`.
+        NaN where `total` is unknown or outside `pixels`. ``time_std`` from the samples'
+        noise and `total_std`.
     """
-    seen, moment, floor = _removed_light(summary)
+    time_map, std_map = np.full(pixels.shape, np.nan), np.full(pixels.shape, np.nan)
+    seen, moment, floor = (part[pixels] for part in removed)
+    cut_start, total, total_std = cut_start[pixels], total[pixels], total_std[pixels]
+    window = summary.window[:, pixels]
     floor = np.clip(floor, 1e-3, 1.0)
     with np.errstate(invalid="ignore"):
         missing = np.maximum(total - seen, 0.0)
     beyond_first = np.where(cut_start, -1.0, float(summary.n_frames))
     step = np.where(cut_start, -1.0, 1.0)
-    k = summary.window.shape[0]
+    k = window.shape[0]
     placed, placed_moment = np.zeros(seen.shape), np.zeros(seen.shape)
     for j in range(k):
         mass = np.clip(missing - j * floor, 0.0, floor)
@@ -334,26 +337,28 @@ def _time_cut_thin_dips(summary, cut_start, total, total_std):
         time = (moment + placed_moment) / (seen + placed)
         # more missing than the window's length of floor: the centre is far beyond the sweep
         time = np.where(missing > k * floor, beyond_first + k * step, time)
-        frames = summary.window_start[None] + np.arange(k)[:, None, None]
-        held = np.isfinite(summary.window)
+        frames = summary.window_start[pixels][None] + np.arange(k)[:, None]
+        held = np.isfinite(window)
         lever = np.sqrt(np.where(held, (frames - beyond_first[None]) ** 2, 0.0).sum(axis=0))
-        sample_std = summary.noise / summary.lit_level * lever / total
+        sample_std = summary.noise[pixels] / summary.lit_level[pixels] * lever / total
         time_std = np.hypot(sample_std, np.abs(time - beyond_first) * total_std / total)
-    time = np.where(np.isfinite(total), time, np.nan)
-    return time, time_std
+    time_map[pixels] = np.where(np.isfinite(total), time, np.nan)
+    std_map[pixels] = time_std
+    return time_map, std_map
 
 
-def _local_width(width, known, *, min_count=8):
+def _local_width(width, known, wanted, *, min_count=8):
     """Mean and standard deviation of `width` over the nearest `known` pixels, ``(H, W)`` each.
 
     Over the smallest square of side ``2 r + 1`` (``r`` = 1, 2, 4, ...) holding at
-    least `min_count` known pixels; NaN where the whole image holds fewer.
+    least `min_count` known pixels; NaN where the whole image holds fewer and outside
+    the `wanted` pixels (``(H, W)`` bool: the squares grow until these have theirs).
     """
     from scipy import ndimage
 
     values = np.where(known, width, 0.0)
     mean, spread = np.full(width.shape, np.nan), np.full(width.shape, np.nan)
-    left = np.ones(width.shape, bool)
+    left = np.array(wanted, bool)
     radius = 1
     while left.any():
         size = 2 * radius + 1

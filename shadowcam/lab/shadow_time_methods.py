@@ -43,37 +43,43 @@ def _removed_fraction(window, lit_level):
 
 
 @nb.njit(cache=True, parallel=True, error_model="numpy")
-def _centroid_kernel(coverage, window_start, noise, lit_level):
-    """:func:`_centroid` per pixel (one pass over the window, both cores)."""
-    n_k, rows, cols = coverage.shape
+def _centroid_kernel(window, lit_level, window_start, noise):
+    """:func:`_centroid` per pixel of ``window (K, H, W)``: its coverage (as
+    :func:`_removed_fraction` of a float64 `lit_level`, the quotient in float64) and the
+    centroid in one pass over the window, both cores."""
+    n_k, rows, cols = window.shape
     centre = np.empty((rows, cols))
     std = np.empty((rows, cols))
     for r in nb.prange(rows):
+        coverage = np.empty(n_k)
         for c in range(cols):
             total = 0.0
             moment = 0.0
             for k in range(n_k):
-                v = coverage[k, r, c]
+                v = 1.0 - np.float64(window[k, r, c]) / lit_level[r, c]
+                v = 0.0 if v < 0.0 else (1.0 if v > 1.0 else v)  # np.clip: NaN stays NaN
+                coverage[k] = v
                 if np.isfinite(v):
                     total += v
                     moment += v * np.float64(window_start[r, c] + k)
             mean = moment / total
             spread = 0.0
             for k in range(n_k):
-                if np.isfinite(coverage[k, r, c]):
+                if np.isfinite(coverage[k]):
                     spread += (np.float64(window_start[r, c] + k) - mean) ** 2
             centre[r, c] = mean
             std[r, c] = noise[r, c] / lit_level[r, c] * np.sqrt(spread) / total
     return centre, std
 
 
-def _centroid(summary, coverage):
+def _centroid(window, lit_level, window_start, noise):
     """Coverage-weighted mean time and its noise standard deviation, ``(H, W)`` each.
 
-    Each coverage sample carries noise ``sigma / level``, propagated to the
+    The coverage is :func:`_removed_fraction` of ``window (K, H, W)`` and ``lit_level
+    (H, W)``; each coverage sample carries noise ``noise / lit_level``, propagated to the
     mean; non-finite samples take no part.
     """
-    return _centroid_kernel(coverage, summary.window_start, summary.noise, summary.lit_level)
+    return _centroid_kernel(window, np.asarray(lit_level, np.float64), window_start, noise)
 
 
 def _crossings(summary, threshold):
@@ -82,32 +88,49 @@ def _crossings(summary, threshold):
     The crossings nearest to the minimum on each side are used; NaN where the
     dip does not come back above `threshold` inside the window.
     """
-    win = summary.window
-    k = win.shape[0]
-    h = summary.half_window
-    above = win >= threshold[None]
-    idx = np.arange(k)[:, None, None]
-    # entry: last slot before the centre that is above the threshold
-    left = np.where(above & (idx < h), idx, -1).max(axis=0)
-    # exit: first slot after the centre that is above the threshold
-    right = np.where(above & (idx > h), idx, k).min(axis=0)
-    rows, cols = np.indices(threshold.shape)
+    return _crossings_kernel(summary.window, np.asarray(threshold, np.float64), summary.window_start,
+                             summary.half_window)
 
-    def interpolate(a, b):
-        ok = (a >= 0) & (a < k) & (b >= 0) & (b < k)
-        a_c, b_c = np.clip(a, 0, k - 1), np.clip(b, 0, k - 1)
-        va, vb = win[a_c, rows, cols], win[b_c, rows, cols]
-        with np.errstate(invalid="ignore", divide="ignore"):
-            frac = (va - threshold) / (va - vb)
-            crossing = summary.window_start + a_c + frac * (b_c - a_c)
-        return np.where(ok & np.isfinite(frac), crossing, np.nan)
 
-    entry = interpolate(left, left + 1)
-    exit_ = interpolate(right, right - 1)
-    centre_below = win[h] < threshold
-    entry = np.where(centre_below, entry, np.nan)
-    exit_ = np.where(centre_below, exit_, np.nan)
+@nb.njit(cache=True, parallel=True, error_model="numpy")
+def _crossings_kernel(window, threshold, window_start, half_window):
+    """:func:`_crossings` per pixel: the last slot before the centre (``half_window``) at or
+    above the threshold and the next one, the first after it and the one before, each pair
+    interpolated as ``start + a + (w[a] - t) / (w[a] - w[b]) * (b - a)``."""
+    k, rows, cols = window.shape
+    h = half_window
+    entry = np.full((rows, cols), np.nan)
+    exit_ = np.full((rows, cols), np.nan)
+    for r in nb.prange(rows):
+        for c in range(cols):
+            t = threshold[r, c]
+            if not window[h, r, c] < t:  # the centre must be below the threshold
+                continue
+            start = window_start[r, c]
+            left = -1
+            for j in range(h):
+                if window[j, r, c] >= t:
+                    left = j
+            right = k
+            for j in range(k - 1, h, -1):
+                if window[j, r, c] >= t:
+                    right = j
+            entry[r, c] = _interpolated(window, r, c, left, left + 1, t, start)
+            exit_[r, c] = _interpolated(window, r, c, right, right - 1, t, start)
     return entry, exit_
+
+
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _interpolated(window, r, c, a, b, t, start):
+    """Crossing of `t` between slots `a` and `b` of pixel ``(r, c)``; NaN outside the window
+    or where the quotient is not finite."""
+    k = window.shape[0]
+    if a >= 0 and a < k and b >= 0 and b < k:
+        va, vb = window[a, r, c], window[b, r, c]
+        frac = (va - t) / (va - vb)
+        if np.isfinite(frac):
+            return np.float64(start + a) + frac * np.float64(b - a)
+    return np.nan
 
 
 def _noise_time_std(summary, depth):
@@ -161,8 +184,7 @@ def time_dip_centroid(summary):
     is the time the shadow's centre line crosses the pixel, using the partial
     coverage of the frames at the dip's edges.
     """
-    coverage = _coverage(summary)
-    time, std = _centroid(summary, coverage)
+    time, std = _centroid(summary.window, summary.lit_level, summary.window_start, summary.noise)
     threshold = summary.lit_level * 0.5 + 0.5 * summary.minimum_value
     entry, exit_ = _crossings(summary, threshold)
     return time, entry, exit_, std
@@ -251,8 +273,7 @@ def _site_times(summary, site, *, noise_floor=1e-4):
     own = np.where(keep, site.window, np.nan)
     own_noise = np.maximum(np.nan_to_num(site.noise, nan=np.inf), noise_floor)
     rest_noise = np.maximum(np.nan_to_num(site.neighbour_noise, nan=np.inf), noise_floor)
-    own_time, own_std = _centroid_kernel(_removed_fraction(own, site.level), summary.window_start,
-                                         own_noise, site.level)
+    own_time, own_std = _centroid(own, site.level, summary.window_start, own_noise)
     smooth = 0.25 * own[:-2] + 0.5 * own[1:-1] + 0.25 * own[2:]
     with np.errstate(invalid="ignore", divide="ignore"):
         floor = np.nanmin(np.where(np.isfinite(smooth), smooth, np.inf), axis=0)
@@ -260,8 +281,7 @@ def _site_times(summary, site, *, noise_floor=1e-4):
     z = detection_threshold(summary.n_frames, false_alarm=_SITE_FALSE_ALARM)
     significant = (contrast > z) & np.isfinite(own_time) & (own_std > 0)
     rest = np.where(keep, summary.window - site.window, np.nan)
-    rest_time, rest_std = _centroid_kernel(_removed_fraction(rest, site.neighbour_level), summary.window_start,
-                                           rest_noise, site.neighbour_level)
+    rest_time, rest_std = _centroid(rest, site.neighbour_level, summary.window_start, rest_noise)
     with np.errstate(invalid="ignore", divide="ignore"):
         joined = significant & np.isfinite(rest_time) & (rest_std > 0) & (
             (rest_time - own_time) ** 2 <= own_std**2 + rest_std**2)
