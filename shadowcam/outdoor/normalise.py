@@ -33,6 +33,7 @@ PartMerger : the same, one part at a time (memory independent of the number of p
 aligned_luminance : one frame's registered luminance from the pass's results.
 GAIN_SOURCES : where a frame's lit gain comes from (the pass's ``gain_source`` codes).
 cloud_shade : the sun term's transmittance under a cloud over every lit pixel, per frame.
+clouded_reference_gains : the lit gains of the first frames when the reference's lit pixels were under a cloud.
 
 Each frame also gives its blocks' lit level (:func:`shadowcam.outdoor.shade_field.block_levels`);
 the merge turns them into the cloud's shade field over the frame (``shade_field``).
@@ -57,7 +58,8 @@ CLOUDED_REFERENCE = 0.8
 #: per-frame results of the pass, concatenated over time parts
 _CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source", "gain_median", "shade_levels")
 #: ``gain_source`` codes: where a frame's lit gain comes from
-GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before",
+GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before "
+                "(for a clouded reference: of the frames after)",
                 2: "median of the lit pixels (no sky-lit pixels)"}
 
 
