@@ -16,7 +16,8 @@ combined arrival error against the pixel-centre truth (class-3 pixels, median in
 median / p95 / beyond 5 (coverage), signed median), overall and, with the disc sun, by the
 pixel's penumbra in the truth (``penumbra_start_time_s``, ``penumbra_end_time_s``, NaN outside
 the record): whole penumbra inside the record, under way at the first frame, not ended by the
-last frame; for the pixels under way at the first frame the arrival reasons and the ramp states.
+last frame; for the pixels under way at the first frame the arrival reasons and the ramp states;
+the lit pixels under a cloud in the first frame (transmittance < 0.95), and the events by kind.
 Also the CPU time (``time.process_time``, every thread) of each pass and of the step that times
 descents under way at their start from the neighbours' lit-to-shadow ratio
 (``outdoor.descent._neighbours_lit``, where the installed package has it) with the number of
@@ -36,7 +37,7 @@ import shadowcam.outdoor.descent as descent
 from measure_outdoor_gain import add_render_arguments, load
 from shadowcam.outdoor.accuracy import arrival_errors, map_to_truth_camera
 from shadowcam.io.frame_store import open_frames
-from shadowcam.outdoor.arrival import ARRIVAL_REASONS, arrival_map
+from shadowcam.outdoor.arrival import ARRIVAL_REASONS, EVENT_KINDS, arrival_map
 from shadowcam.outdoor.edges import track_edges
 from shadowcam.outdoor.photometry import photometry_from_frames
 
@@ -149,6 +150,13 @@ def main():
               f"{1e6 * clock.seconds / (height * width):.2f} us per pixel of the frame)")
     print(f"  class 3 ({class3.sum()} px): "
           f"{_line(arrival_errors(estimate, true_arrival, evaluate=class3, interval_s=interval))}")
+    if "cloud_attenuation" in truth:
+        # the lit pixels a cloud shades in the first frame (the first pass's reference)
+        clouded = class3 & truth["lit_center"].values[0].astype(bool) & (truth["cloud_attenuation"].values[0] < 0.95)
+        print(f"  under a cloud in the first frame ({clouded.sum()} px): "
+              f"{_line(arrival_errors(estimate, true_arrival, evaluate=clouded, interval_s=interval))}")
+    if "event_kind" in arrival:
+        print(f"  events: {_counts(EVENT_KINDS, arrival['event_kind'].values)}")
     start = truth["penumbra_start_time_s"].values if "penumbra_start_time_s" in truth else None
     if start is not None and np.isfinite(start).any():
         end = truth["penumbra_end_time_s"].values

@@ -33,6 +33,7 @@ PartMerger : the same, one part at a time (memory independent of the number of p
 aligned_luminance : one frame's registered luminance from the pass's results.
 GAIN_SOURCES : where a frame's lit gain comes from (the pass's ``gain_source`` codes).
 cloud_shade : the sun term's transmittance under a cloud over every lit pixel, per frame.
+clouded_reference_gains : the lit gains of the first frames when the reference's lit pixels were under a cloud.
 
 Each frame also gives its blocks' lit level (:func:`shadowcam.outdoor.shade_field.block_levels`);
 the merge turns them into the cloud's shade field over the frame (``shade_field``).
@@ -51,10 +52,14 @@ from shadowcam.outdoor.translation import translate, translate_with_block_means
 
 #: contrast (shadow / lit level) below which a pixel counts as having been shadowed
 SHADOWED_CONTRAST = 0.3
+#: a first frame whose lit-to-sky gain ratio is below this fraction of a later frame's was under a
+#: cloud over the reference's lit pixels (:func:`clouded_reference_gains`)
+CLOUDED_REFERENCE = 0.8
 #: per-frame results of the pass, concatenated over time parts
 _CURVES = ("shift", "gain_lit", "gain_sky", "kept_lit", "gain_source", "gain_median", "shade_levels")
 #: ``gain_source`` codes: where a frame's lit gain comes from
-GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before",
+GAIN_SOURCES = {0: "unclouded lit pixels", 1: "sky gain x lit-to-sky ratio of the frame before "
+                "(for a clouded reference: of the frames after)",
                 2: "median of the lit pixels (no sky-lit pixels)"}
 
 
@@ -347,13 +352,17 @@ class PartMerger:
             raise ValueError("no part holds the reference frame (frame 0)")
         sky, lit, shadow_min = self._sky, self._lit, self._shadow_min
         ref = luminance(self._reference)
+        curves = {key: np.concatenate(values) for key, values in self._curves.items()}
+        curves["gain_lit"], curves["gain_source"] = clouded_reference_gains(
+            curves["gain_lit"], curves["gain_sky"], curves["gain_source"])
+        # sky-normalised levels -> the reference's lit scale (1 unless the reference was under a cloud)
+        to_lit = np.float32(curves["gain_sky"][0] / curves["gain_lit"][0])
         with np.errstate(divide="ignore", invalid="ignore"):
-            contrast = np.where(ref > 0, shadow_min / ref, np.inf)
+            contrast = np.where(ref > 0, shadow_min * to_lit / ref, np.inf)
         shadowed = lit & (contrast < SHADOWED_CONTRAST)
         ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
-        shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref)
-        lit_level = np.where(lit, ref, shadow_min / ratio)
-        curves = {key: np.concatenate(values) for key, values in self._curves.items()}
+        shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref / to_lit)
+        lit_level = np.where(lit, ref, shadow_min * to_lit / ratio)
         shade = cloud_shade(curves["gain_median"], curves["gain_lit"], curves["gain_source"], shadow_ratio=ratio)
         return {
             **curves,
@@ -406,6 +415,48 @@ def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
     with np.errstate(divide="ignore", invalid="ignore"):
         shade = (median / lit - rho) / (1.0 - rho)
     return np.where(covered & np.isfinite(shade), np.clip(shade, 0.05, 1.0), 1.0)
+
+
+def clouded_reference_gains(gain_lit, gain_sky, gain_source, *, settled=CLOUDED_REFERENCE):
+    """The lit gains of the first frames when the reference's lit pixels were under a cloud.
+
+    The lit gain is measured against the reference's lit pixels; under a cloud over all of them
+    in the reference, the frames that follow read the clouded level as the lit one until the
+    cloud has left, when the lit-to-sky gain ratio ``gain_lit / gain_sky`` jumps up. A cloud
+    only removes sunlight, so the unclouded ratio of a frame is at least that of any frame
+    measured under the cloud: the frames from the first on whose ratio lies below `settled`
+    times the highest ratio of the frames from them on (the sunset lowers the sun's share, it
+    does not raise it) took the cloud's level for the lit one. Their lit gain becomes the sky
+    gain times that highest ratio, and their source ``1`` (a cloud over every lit pixel: its
+    shade is :func:`cloud_shade`'s).
+
+    Parameters
+    ----------
+    gain_lit, gain_sky : (T,) ndarray
+    gain_source : (T,) int ndarray
+        :data:`GAIN_SOURCES` codes.
+    settled : float, optional
+        Fraction of the later ratio below which a first frame's ratio counts as clouded.
+
+    Returns
+    -------
+    gain_lit : (T,) float64 ndarray
+    gain_source : (T,) int8 ndarray
+    """
+    lit = np.asarray(gain_lit, dtype=np.float64)
+    sky = np.asarray(gain_sky, dtype=np.float64)
+    source = np.asarray(gain_source, dtype=np.int8)
+    check_same_shape({"gain_lit": lit, "gain_sky": sky, "gain_source": source})
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(sky > 0, lit / sky, np.nan)
+    later = np.fmax.accumulate(ratio[::-1])[::-1]
+    clouded = np.logical_and.accumulate(ratio < settled * later)  # a prefix from the first frame
+    if not clouded.any():
+        return lit, source
+    lit, source = lit.copy(), source.copy()
+    lit[clouded] = sky[clouded] * later[clouded]
+    source[clouded] = 1
+    return lit, source
 
 
 def merge_parts(parts):

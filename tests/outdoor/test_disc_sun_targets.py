@@ -53,6 +53,20 @@ def test_disc_sun_renders_meet_the_nuisance_targets(case):
     assert not failed, failed
 
 
+@pytest.mark.parametrize("cloud", ["first_frame", "first_frame_whole"])
+def test_a_cloud_over_the_lit_cliff_in_the_first_frame_gives_no_wrong_arrivals(cloud):
+    # the pass's reference (frame 0) under a cloud that leaves in a few frames: over a fifth of the
+    # lit cliff, or over all of it, where the lit gain took the cloud's level for the lit one until
+    # it left and the tracker's lit levels rose with the relit pixels: 4.3 % beyond 5 intervals,
+    # p95 3.0 before (docs/benchmarks.md, issue 15). Coverage is no target: pixels the cloud
+    # leaves while it shades them get no time rather than a wrong one (0.73 over the whole cliff)
+    report, _ = _disc_sun_accuracy(height=64, width=96, frames=40, cloud=cloud)
+    stats = report["errors"]["combined"][PRIMARY_DEFINITION]
+    assert stats["coverage"] > (0.9 if cloud == "first_frame" else 0.6)
+    failed = [t for t in report["targets"] if not t["pass"]]
+    assert not failed, failed
+
+
 def test_long_penumbrae_at_a_photographers_cadence():
     # the sun 8.0 -> 7.2 deg in 96 frames: each pixel's penumbra lasts ~55 intervals, most ramps
     # begin before the first frame or end after the last; the nuisance targets are not met

@@ -236,6 +236,22 @@ def test_cloud_shade_is_the_median_transmittance_where_a_cloud_covers_every_lit_
     assert np.all(cloud_shade(0.5 * gain, gain, np.zeros(5, int), shadow_ratio=rho) == 1.0)
 
 
+def test_first_frames_under_a_cloud_over_every_lit_pixel_take_the_later_lit_to_sky_ratio():
+    from shadowcam.outdoor.normalise import clouded_reference_gains
+
+    sky = np.array([1.0, 0.9, 0.8, 0.8, 0.7, 0.6])
+    ratio = np.array([1.0, 1.0, 1.05, 2.4, 2.3, 2.2])  # the reference's cloud leaves at frame 3
+    gain, source = clouded_reference_gains(ratio * sky, sky, np.zeros(6, np.int8))
+    np.testing.assert_allclose(gain / sky, [2.4, 2.4, 2.4, 2.4, 2.3, 2.2], rtol=1e-12)
+    np.testing.assert_array_equal(source, [1, 1, 1, 0, 0, 0])
+    # a cloud later in the sequence (its frames' lit gain already the sky's times the ratio before)
+    # and the sunset's slow drift of the ratio leave the gains as they are
+    later = np.array([1.0, 0.98, 0.97, 0.5, 0.96, 1.02])
+    gain, source = clouded_reference_gains(later * sky, sky, np.zeros(6, np.int8))
+    np.testing.assert_array_equal(gain, later * sky)
+    assert not source.any()
+
+
 def _window_gain_errors(cloud):
     """The first pass's lit gain against the renderer's on a 48x64 window of the ridge at a
     photographer's cadence (the strip's scale: a cloud covers much or all of it), per frame,

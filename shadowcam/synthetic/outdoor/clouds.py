@@ -5,7 +5,7 @@ past them, then they relight: a transient shadow, unlike the ridge's, which stay
 scenarios vary what a tracker could fit to one cloud model: size (a few pixels to a large
 part of the cliff), speed (a few to some twenty frames over a point), border (Gaussian,
 soft rim, hard rim), depth, number per sequence, and a cloud that crosses the ridge shadow's
-edge while the edge moves.
+edge while the edge moves, and a cloud over part or all of the lit cliff in the first frame.
 
 Every cloud but ``drifting`` is placed from the ground truth of the view: it passes over a
 point that the ridge shadow reaches well after the cloud has gone (so the cloud is seen on
@@ -35,6 +35,10 @@ _SCENARIOS = {
     "several": [(70.0, 3.0, 0.55, 7.0, "lit"), (150.0, 40.0, 0.75, 14.0, "lit"),
                 (100.0, None, 0.5, 10.0, "lit")],
     "edge_crossing": [(120.0, 8.0, 0.7, 12.0, "edge")],
+    # over part of the lit cliff in the first frame (the pass's reference), gone a few frames later
+    "first_frame": [(150.0, 8.0, 0.65, 8.0, "first")],
+    # over the whole lit cliff in the first frame (radius: the lit cliff's, with a margin)
+    "first_frame_whole": [(None, 8.0, 0.65, 8.0, "first_whole")],
 }
 CLOUD_SCENARIOS = tuple(_SCENARIOS)
 
@@ -85,13 +89,22 @@ def cloud_shadows(scenario, *, terrain, duration_s, points_xy, arrival_s, times_
     clouds = []
     for k, (radius, rim, depth, frames_over, where) in enumerate(_SCENARIOS[scenario]):
         passage = frames_over * interval
-        speed = 2.0 * radius / passage
         heading = rng.uniform(0.0, 2.0 * np.pi)
-        velocity = speed * np.array([np.cos(heading), np.sin(heading)])
         # when the cloud is over its point: spread the clouds of a scenario over the sequence
         lo, hi = (0.1 + 0.25 * k) * times[-1], (0.3 + 0.25 * k) * times[-1]
-        t0 = rng.uniform(lo, hi)
-        if where == "lit":
+        t0 = 0.0 if where.startswith("first") else rng.uniform(lo, hi)
+        if where == "first_whole":
+            # centred on the lit cliff, its core over every lit point at the first frame
+            lit = np.isfinite(arrival) & (arrival > 0.0) | (arrival == np.inf)
+            centre = points[lit].mean(axis=0)
+            radius = 1.2 * float(np.sqrt(((points[lit] - centre) ** 2).sum(axis=1).max())) + 4.0 * rim
+            velocity = 2.0 * radius / passage * np.array([np.cos(heading), np.sin(heading)])
+            clouds.append({"start_xy": centre, "velocity_xy": velocity, "sigma_m": radius, "depth": depth,
+                           "rim_m": rim})
+            continue
+        speed = 2.0 * radius / passage
+        velocity = speed * np.array([np.cos(heading), np.sin(heading)])
+        if where in ("lit", "first"):
             # lit at start, reached by the ridge shadow long after the cloud has passed
             ok = np.isfinite(arrival) & (arrival > t0 + passage + 10.0 * interval) | (arrival == np.inf)
         else:
