@@ -55,8 +55,8 @@ def test_disc_sun_renders_meet_the_nuisance_targets(case):
 
 @pytest.mark.parametrize("cloud", ["first_frame", "first_frame_whole"])
 def test_a_cloud_over_the_lit_cliff_in_the_first_frame_gives_no_wrong_arrivals(cloud):
-    # the pass's reference (frame 0) under a cloud that leaves in a few frames: over a fifth of the
-    # lit cliff, or over all of it, where the lit gain took the cloud's level for the lit one until
+    # the pass's reference (frame 0) under a cloud that leaves in a few frames: over part of the
+    # lit cliff (37 % of its class-3 pixels), or over all of it, where the lit gain took the cloud's level for the lit one until
     # it left and the tracker's lit levels rose with the relit pixels: 4.3 % beyond 5 intervals,
     # p95 3.0 before (docs/benchmarks.md, issue 15). Coverage is no target: pixels the cloud
     # leaves while it shades them get no time rather than a wrong one (0.73 over the whole cliff)

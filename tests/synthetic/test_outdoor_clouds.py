@@ -65,3 +65,15 @@ def test_unknown_scenarios_and_no_room_are_rejected(scene):
     assert "drifting" in CLOUD_SCENARIOS
     with pytest.raises(ValueError, match="cloud"):
         render_outdoor_capture(scene, frames=4, supersample=1, seed=2, cloud="stormy", **QUIET)
+
+
+@pytest.mark.parametrize("scenario, share", [("first_frame", (0.1, 0.6)), ("first_frame_whole", (0.95, 1.0))])
+def test_a_first_frame_cloud_covers_the_lit_cliff_at_the_start_and_leaves(scene, scenario, share):
+    """The reference frame is clouded (part of the lit cliff, or all of it) and the cloud is gone
+    within about its 8 frames over a point (a margin of 4 frames for its rim)."""
+    gt = _render(scene, scenario)
+    shaded = gt["cloud_attenuation"].values < 0.9  # (time, row, col)
+    lit = gt["lit_center"].values
+    covered = (shaded[0] & lit[0]).sum() / lit[0].sum()
+    assert share[0] <= covered <= share[1]
+    assert not (shaded[12:] & lit[12:]).any()

@@ -36,7 +36,8 @@ _SCENARIOS = {
                 (100.0, None, 0.5, 10.0, "lit")],
     "edge_crossing": [(120.0, 8.0, 0.7, 12.0, "edge")],
     # over part of the lit cliff in the first frame (the pass's reference), gone a few frames later
-    "first_frame": [(150.0, 8.0, 0.65, 8.0, "first")],
+    # (radius: a third of the lit cliff's extent)
+    "first_frame": [(None, 8.0, 0.65, 8.0, "first")],
     # over the whole lit cliff in the first frame (radius: the lit cliff's, with a margin)
     "first_frame_whole": [(None, 8.0, 0.65, 8.0, "first_whole")],
 }
@@ -102,9 +103,23 @@ def cloud_shadows(scenario, *, terrain, duration_s, points_xy, arrival_s, times_
             clouds.append({"start_xy": centre, "velocity_xy": velocity, "sigma_m": radius, "depth": depth,
                            "rim_m": rim})
             continue
+        if where == "first":
+            # over part of the lit cliff at the first frame: a third of its extent, centred on a
+            # lit point half way out from its middle, moving further out (off the cliff)
+            lit = np.isfinite(arrival) & (arrival > 0.0) | (arrival == np.inf)
+            centre = points[lit].mean(axis=0)
+            extent = float(np.sqrt(((points[lit] - centre) ** 2).sum(axis=1).max()))
+            out = points[lit] - centre
+            reach = np.sqrt((out ** 2).sum(axis=1))
+            target = points[lit][np.argmin(np.abs(reach - 0.5 * extent))]
+            radius = extent / 3.0
+            outward = (target - centre) / max(float(np.hypot(*(target - centre))), 1e-9)
+            clouds.append({"start_xy": target, "velocity_xy": 2.0 * radius / passage * outward, "sigma_m": radius,
+                           "depth": depth, "rim_m": rim})
+            continue
         speed = 2.0 * radius / passage
         velocity = speed * np.array([np.cos(heading), np.sin(heading)])
-        if where in ("lit", "first"):
+        if where == "lit":
             # lit at start, reached by the ridge shadow long after the cloud has passed
             ok = np.isfinite(arrival) & (arrival > t0 + passage + 10.0 * interval) | (arrival == np.inf)
         else:
