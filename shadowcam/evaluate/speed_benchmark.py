@@ -290,17 +290,20 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
     """CPU time of each stage of the DNG -> shadow-time path on one thread, ns per pixel-frame.
 
     Runs the path's own pieces in this process, one after the other, on
-    `paths` (frames of one sweep): the direct mosaic read, the mosaic ->
-    channel-sum signal, the tracker's update, its finish (partial, merge),
-    the dip interval from the stored windows (and the count of pixels that
-    would need a second read), and the classification and timing; plus the
-    least arithmetic a streaming tracker needs (:func:`_minimal_tracker`)
-    and one numpy pass over the signal.
+    `paths` (frames of one sweep), as :func:`~shadowcam.lab.sweep_files.sweep_shadow_times_from_files`
+    runs them for RAW with ``edge_fit``: the direct mosaic read, the mosaic ->
+    channel-sum signal, each site's own value, the tracker's update (with the own
+    site), its finish (partial, merge), the dip interval from the stored windows
+    (and the count of pixels that would need a second read), and the
+    classification and timing with the CFA pattern (each pixel from its own site,
+    the connected dips' support read again from the files where the pipeline
+    does); plus the least arithmetic a streaming tracker needs
+    (:func:`_minimal_tracker`) and one numpy pass over the signal.
 
     Returns
     -------
     dict
-        ``decode``, ``signal``, ``track``, ``minimal_track``, ``numpy_pass``:
+        ``decode``, ``signal``, ``own``, ``track``, ``minimal_track``, ``numpy_pass``:
         ns per pixel-frame (best of `repeats`); ``finish_s``, ``interval_s``,
         ``timing_s``: seconds once per sweep; ``interval_unresolved``: pixels
         the interval pass must read the frames again for.
@@ -312,6 +315,8 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
     from shadowcam.io.mosaic_reader import MosaicReader
     from shadowcam.lab.mosaic_signal import mosaic_signal
     from shadowcam.lab.shadow_time import summary_shadow_times
+    from shadowcam.lab.site_signal import mosaic_own_site, tracked_site_window
+    from shadowcam.lab.sweep_files import mosaic_colour, signal_blocks
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
@@ -321,13 +326,16 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
         shape = reader.shape
         n = len(paths)
         pixel_frames = n * shape[0] * shape[1]
-        best = dict.fromkeys(("decode", "signal", "track", "minimal_track", "numpy_pass", "finish_s",
+        pattern = reader.levels["cfa_pattern"]
+        best = dict.fromkeys(("decode", "signal", "own", "track", "minimal_track", "numpy_pass", "finish_s",
                               "interval_s", "timing_s"), np.inf)
         for _ in range(repeats):
             clock = dict.fromkeys(best, 0.0)
-            tracker = DipTracker(shape)
+            tracker = DipTracker(shape, own_site=True, saturation_level=np.inf)  # as sweep_files tracks RAW
             block = np.empty((block_frames,) + shape, np.float32)
+            own = np.empty_like(block)
             saturated = np.zeros(shape, bool)
+            site_sum = np.zeros(shape, np.int64)
             for start in range(0, n, block_frames):
                 stop = min(start + block_frames, n)
                 for i in range(start, stop):
@@ -335,11 +343,16 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
                     mosaic, levels = reader.read(paths[i])
                     t1 = time.process_time()
                     mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
-                                  white=levels["white_sites"], out=block[i - start], saturated=saturated)
+                                  white=levels["white_sites"], out=block[i - start], saturated=saturated,
+                                  site_sum=site_sum)
+                    t2 = time.process_time()
+                    mosaic_own_site(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
+                                    white=levels["white_sites"], out=own[i - start])
                     clock["decode"] += t1 - t0
-                    clock["signal"] += time.process_time() - t1
+                    clock["signal"] += t2 - t1
+                    clock["own"] += time.process_time() - t2
                 t0 = time.process_time()
-                tracker.update(block[:stop - start], first_index=start)
+                tracker.update(block[:stop - start], first_index=start, own=own[:stop - start])
                 t1 = time.process_time()
                 ring, worst = np.zeros((3, shape[0] * shape[1]), np.float32), np.zeros(shape[0] * shape[1], np.float32)
                 _minimal_tracker(block[:stop - start].reshape(stop - start, -1), ring, worst)
@@ -349,17 +362,19 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
                 clock["minimal_track"] += t2 - t1
                 clock["numpy_pass"] += time.process_time() - t2
             t0 = time.process_time()
-            summary = tracker.result()
+            summary = mosaic_colour(tracker.result(), [(site_sum, n, np.zeros(shape, np.int64), saturated,
+                                                        reader.levels)])
             t1 = time.process_time()
             _, resolved = window_intervals(summary, half_depth(summary))
             t2 = time.process_time()
             interval = None
             if resolved.all():  # else the frames would be read again (not timed here)
                 summary, interval = without_interval(summary, track_intervals(iter(()), summary))
-            summary_shadow_times(summary, interval=interval)
+            summary_shadow_times(summary, interval=interval, cfa_pattern=pattern, own_site=True,
+                                 read=lambda: signal_blocks(paths, block_frames), site_window=tracked_site_window)
             t3 = time.process_time()
             clock.update(finish_s=t1 - t0, interval_s=t2 - t1, timing_s=t3 - t2)
-            for key in ("decode", "signal", "track", "minimal_track", "numpy_pass"):
+            for key in ("decode", "signal", "own", "track", "minimal_track", "numpy_pass"):
                 clock[key] *= 1e9 / pixel_frames
             best = {key: min(best[key], clock[key]) for key in best}
         best["interval_unresolved"] = int((~resolved).sum())
@@ -545,13 +560,14 @@ def format_report(figures):
     lines += [
         f"CPU time per stage on one thread ({g['frames']} frames of the sweep, ns per pixel-frame):",
         f"  decode (direct mosaic read) {g['decode']:6.1f}   mosaic -> signal {g['signal']:6.1f}"
-        f"   tracker update {g['track']:6.1f}",
+        f"   own site {g['own']:6.1f}   tracker update (with the own site) {g['track']:6.1f}",
         f"  least tracker arithmetic (store, smooth, compare) {g['minimal_track']:6.1f};"
         f" one numpy pass over the signal {g['numpy_pass']:6.1f}",
         f"  once per sweep: finish {g['finish_s']:.2f} s, interval from the windows {g['interval_s']:.2f} s"
         f" ({g['interval_unresolved']} of {g['pixels']} pixels need a second read), classify + time"
         f" {g['timing_s']:.2f} s",
-        f"  budget: tracking the decoded frames costs {(g['signal'] + g['track']) / g['decode']:.2f} of the decode"
+        f"  budget: tracking the decoded frames costs {(g['signal'] + g['own'] + g['track']) / g['decode']:.2f}"
+        " of the decode"
         f" (0.25 would give 0.8 end to end on the same cores)",
         "",
         f"shadow-time stage alone ({f['stage_frames']} in-memory frames of the central quarter):",

@@ -17,6 +17,8 @@ Offers
 track_files : DipSummary of a sweep from its files (parallel time chunks).
 sweep_shadow_times_from_files : shadow times of a sweep from its files.
 chunk_bounds : split ``n`` frames into contiguous owned chunks.
+signal_blocks : a sweep's tracked signal read again from its files, in blocks.
+mosaic_colour : a mosaic-tracked summary's channel sums from its chunks' per-site sums.
 """
 
 import multiprocessing
@@ -183,7 +185,7 @@ def _track_owned(paths, owned, half_window, block_frames, saturation_level, own_
     return tracker.partial(), frames.sums()
 
 
-def _signal_blocks(paths, block_frames, first=0, last=None):
+def signal_blocks(paths, block_frames, first=0, last=None):
     """Frames ``first .. last - 1`` of the sweep's tracked signal read again, in blocks of `block_frames`.
 
     A generator: nothing is read unless it is iterated.
@@ -202,15 +204,17 @@ def _interval_owned(paths, owned, centre_frame, threshold, half_window, block_fr
     """The IntervalPartial of one owned chunk, its padded frames read again."""
     tracker = IntervalTracker(centre_frame, threshold, half_window=half_window, n_frames=len(paths), owned=owned)
     first = max(0, owned[0] - IntervalTracker.PAD)
-    for block in _signal_blocks(paths, block_frames, first, min(len(paths), owned[1] + IntervalTracker.PAD)):
+    for block in signal_blocks(paths, block_frames, first, min(len(paths), owned[1] + IntervalTracker.PAD)):
         tracker.update(block)
     return tracker.partial()
 
 
-def _mosaic_colour(summary, chunk_sums):
+def mosaic_colour(summary, chunk_sums):
     """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place).
 
-    `chunk_sums`: :meth:`_MosaicFrames.sums` of every chunk; integer sums
+    `chunk_sums`: :meth:`_MosaicFrames.sums` of every chunk (per-site integer DN sums
+    over the frames with the first levels, their count, fixed-point sums of the
+    normalised other frames, clipped pixels, the first levels); integer sums
     are added before anything is rounded, so the result does not depend on
     the chunking.
     """
@@ -262,7 +266,7 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
     summary = merge_partials([partial for partial, _ in results], n_frames=len(paths))
     if results[0][1] is None:
         return summary
-    return _mosaic_colour(summary, [sums for _, sums in results])
+    return mosaic_colour(summary, [sums for _, sums in results])
 
 
 def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, workers=2,
@@ -310,6 +314,6 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
         return _in_chunks(_interval_owned, paths, workers, centre, threshold, summary.half_window, block_frames)
 
     cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
-    return measured_shadow_times(summary, read=partial(_signal_blocks, paths, block_frames), method=method,
+    return measured_shadow_times(summary, read=partial(signal_blocks, paths, block_frames), method=method,
                                  cfa_pattern=cfa_pattern, measure=measure, site_window=tracked_site_window,
                                  method_params=method_params, classify_params=classify_params)

@@ -25,7 +25,7 @@ def test_stage_figures_of_a_small_sweep(tmp_path):
     paths = write_sweep_dngs(scene, tmp_path, workers=1)
     figures = stage_ns(paths, block_frames=8, repeats=1)
     assert figures["frames"] == 30 and figures["pixels"] == 48 * 64
-    for key in ("decode", "signal", "track", "minimal_track", "numpy_pass"):
+    for key in ("decode", "signal", "own", "track", "minimal_track", "numpy_pass"):
         assert 0 < figures[key] < 1e6, key
     # the pixels left to a second read are those the stored windows do not resolve
     reader = MosaicReader(paths[0])
