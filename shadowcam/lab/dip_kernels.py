@@ -884,14 +884,16 @@ def own_window_sums(own_window, signal_window, keep):
 
 
 @nb.njit(cache=True, parallel=True)
-def copy_own_windows(span, span_first, centre, changed, end, half_window, own_window):
+def copy_own_windows(tail, block, first_index, centre, changed, end, half_window, own_window):
     """Copy the own values of frames ``centre - half_window .. centre + half_window`` of the changed pixels.
 
     Parameters
     ----------
-    span : (S, P) float32 ndarray
-        Own values of frames ``span_first + s``.
-    span_first : int
+    tail : (K, P) float32 ndarray
+        Own values of the ``K`` frames before `first_index`.
+    block : (T, P) float32 ndarray
+        Own values of frames ``first_index + t``.
+    first_index : int
     centre : (P,) int64 ndarray
         Each pixel's deepest centre.
     changed : (P,) bool ndarray
@@ -903,11 +905,17 @@ def copy_own_windows(span, span_first, centre, changed, end, half_window, own_wi
     own_window : (K, P) float32 ndarray
         Written in place for the changed pixels.
     """
-    n_s, n_p = span.shape
+    n_k, n_p = tail.shape
+    n_t = block.shape[0]
     for p in nb.prange(n_p):
         if not changed[p]:
             continue
         for q in range(2 * half_window + 1):
             f = centre[p] - half_window + q
-            s = f - span_first
-            own_window[q, p] = span[s, p] if 0 <= f < end and 0 <= s < n_s else np.nan
+            s = f - first_index
+            value = np.float32(np.nan)
+            if 0 <= f < end and 0 <= s < n_t:
+                value = block[s, p]
+            elif 0 <= f < end and -n_k <= s < 0:
+                value = tail[n_k + s, p]
+            own_window[q, p] = value

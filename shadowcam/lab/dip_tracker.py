@@ -344,15 +344,21 @@ class DipTracker:
         self._next = first + block.shape[0]
         if own is not None:
             _k.own_site_block(flat, own, first, *self.owned, self._own_sums, self._own_rest_invalid)
-            span = np.concatenate([self._own_tail, own])
-            self._copy_own_windows(deepest, span, first - self._own_tail.shape[0])
-            self._own_tail = np.ascontiguousarray(span[-self._own_tail.shape[0]:])
+            self._copy_own_windows(deepest, own, first)
+            k = self._own_tail.shape[0]
+            if own.shape[0] >= k:
+                self._own_tail[...] = own[-k:]
+            else:
+                self._own_tail = np.concatenate([self._own_tail[own.shape[0]:], own])
 
-    def _copy_own_windows(self, deepest, span, span_first):
-        """Give the pixels whose deepest centre moved from `deepest` its own values from `span` ``(S, P)``."""
+    def _copy_own_windows(self, deepest, own, first):
+        """Give the pixels whose deepest centre moved from `deepest` the own values of its window.
+
+        `own` ``(T, P)`` holds frames ``first ..``, the tail the ``K`` frames before.
+        """
         changed = self._top_frame[0] != deepest
-        _k.copy_own_windows(span, span_first, self._top_frame[0], changed, self._next, self.half_window,
-                            self._own_window)
+        _k.copy_own_windows(self._own_tail, own, first, self._top_frame[0], changed, self._next,
+                            self.half_window, self._own_window)
 
     def partial(self):
         """Finish the owned chunk and return its :class:`DipPartial`.
@@ -369,7 +375,7 @@ class DipTracker:
                               self._top_value, self._top_frame, self._window)
             own = {}
             if self.own_site:
-                self._copy_own_windows(deepest, self._own_tail, end - self._own_tail.shape[0])
+                self._copy_own_windows(deepest, self._own_tail[:0], end)
                 h, w = self.shape
                 own = dict(own_window=np.ascontiguousarray(self._own_window.T).reshape(h, w, -1),
                            own_sums=np.ascontiguousarray(self._own_sums.T).reshape(h, w, -1),

@@ -248,8 +248,9 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
     saturation_level : float, optional
     own_site : bool, optional
         RAW: keep each site's own value beside the signal (the summary's
-        ``tracked_site``, :class:`~shadowcam.lab.dip_tracker.DipTracker` ``own_site``;
-        ~36 bytes per pixel more); ignored for other files.
+        ``tracked_site``, :class:`~shadowcam.lab.dip_tracker.DipTracker` ``own_site``:
+        ``2 K * 4 + 64`` bytes per pixel more in the tracker, 4 per pixel and block frame
+        for the block's own values); ignored for other files.
 
     Returns
     -------
