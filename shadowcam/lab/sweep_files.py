@@ -6,9 +6,9 @@ padding) and feed them to a :class:`~shadowcam.lab.dip_tracker.DipTracker` that
 owns the chunk; this process then merges the partials (bit for bit the
 single-pass result) and times the dips as the workflow times a frame store
 (:func:`shadowcam.lab.shadow_time.measured_shadow_times`: dip interval, connected
-dips, each RAW pixel's own mosaic site, whose window and lit sums the tracking
-pass keeps), reading the files again, in time chunks, only for what the tracked
-windows do not hold.
+dips, each RAW pixel's own mosaic site), reading the files again, in time chunks,
+only for what the tracked windows do not hold (optionally the tracking pass keeps
+the own site's window and lit sums: ``own_site_in_first_pass``).
 Decode and tracking of different chunks overlap, and no frame store is
 written.
 
@@ -19,6 +19,7 @@ sweep_shadow_times_from_files : shadow times of a sweep from its files.
 chunk_bounds : split ``n`` frames into contiguous owned chunks.
 signal_blocks : a sweep's tracked signal read again from its files, in blocks.
 mosaic_colour : a mosaic-tracked summary's channel sums from its chunks' per-site sums.
+site_sums_from_files : the own-site sums of a chunk of RAW files, read again.
 """
 
 import multiprocessing
@@ -36,7 +37,7 @@ from shadowcam.lab.dip_kernels import SUM_SCALE, quantise_sum
 from shadowcam.lab.dip_tracker import DipTracker, IntervalTracker, merge_partials
 from shadowcam.lab.mosaic_signal import bilinear_channels, mosaic_signal
 from shadowcam.lab.shadow_time import measured_shadow_times
-from shadowcam.lab.site_signal import mosaic_own_site, tracked_site_window
+from shadowcam.lab.site_signal import mosaic_own_site, site_window_of_sums, site_window_sums, tracked_site_window
 
 #: worker start method: rawpy (OpenMP) may deadlock in forked processes
 _CONTEXT = multiprocessing.get_context("forkserver")
@@ -102,6 +103,14 @@ class _MosaicFrames:
             self.n_site_sum += 1
         elif owned:
             self.other_sum += quantise_sum(_normalised(mosaic, levels))
+
+    def read_site(self, path, own, signal):
+        """Each site's own value and the tracked signal of one frame, into `own` and `signal` ``(M, N)``."""
+        mosaic, levels = self.reader.read(path)
+        pattern, black, white = levels["cfa_pattern"], levels["black_sites"], levels["white_sites"]
+        mosaic_own_site(mosaic, pattern=pattern, black=black, white=white, out=own)
+        mosaic_signal(mosaic, pattern=pattern, black=black, white=white, out=signal, saturated=self.saturated,
+                      saturation_level=np.inf)
 
     def sums(self):
         return self.site_sum, self.n_site_sum, self.other_sum, self.saturated, self.levels
@@ -209,6 +218,27 @@ def _interval_owned(paths, owned, centre_frame, threshold, half_window, block_fr
     return tracker.partial()
 
 
+def site_sums_from_files(paths, owned, window_start, k, block_frames):
+    """The :class:`~shadowcam.lab.site_signal.SiteSums` of one owned chunk of RAW files, read again.
+
+    Each frame's own-site values come straight from its mosaic (no demosaic) and its
+    signal as the tracker's (:func:`shadowcam.lab.mosaic_signal.mosaic_signal`).
+    """
+    start, stop = owned
+    frames = _MosaicFrames(paths, start, (0, 0), np.inf)
+    own = np.empty((block_frames,) + frames.shape, np.float32)
+    signal = np.empty_like(own)
+
+    def samples():
+        for first in range(start, stop, block_frames):
+            n = min(block_frames, stop - first)
+            for i in range(n):
+                frames.read_site(paths[first + i], own[i], signal[i])
+            yield own[:n], signal[:n]
+
+    return site_window_sums(samples(), window_start, k, first=start)
+
+
 def mosaic_colour(summary, chunk_sums):
     """Give a mosaic-tracked summary its per-channel sums and clipped pixels (in place).
 
@@ -271,7 +301,8 @@ def track_files(paths, *, half_window=4, workers=2, block_frames=16, saturation_
 
 
 def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, workers=2,
-                                  block_frames=16, method_params=None, classify_params=None):
+                                  block_frames=16, method_params=None, classify_params=None,
+                                  own_site_in_first_pass=False):
     """Shadow times of one sweep from its image files (RAW, TIFF, PNG, EXR ...).
 
     The same timing as the workflow's frame stores
@@ -287,6 +318,12 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
         As :func:`shadowcam.lab.shadow_time.sweep_shadow_times`.
     workers, block_frames
         As :func:`track_files`.
+    own_site_in_first_pass : bool, optional
+        RAW with ``edge_fit``: the tracking pass keeps each site's own value and its
+        exact lit sums (:func:`track_files` ``own_site``) and the files are not decoded
+        again for the own site. Off by default: its noise comes from exact sums, not
+        from float64 sums block by block, which moves a few float32 outputs by one unit
+        in the last place (``docs/benchmarks.md``).
 
     Returns
     -------
@@ -296,25 +333,31 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
 
     Notes
     -----
-    For RAW with ``edge_fit`` the tracking pass also keeps each site's own value
-    (straight from its mosaic, :func:`shadowcam.lab.site_signal.mosaic_own_site`) at the
-    window's frames and its lit statistics in exact running sums (:func:`track_files`
-    ``own_site``), so the own site needs no second read. The files are read a second
-    time only for what the tracked windows do not hold, in time chunks as the tracking
-    (one per worker): the dip interval of pixels whose crossings lie beyond their window
-    (:func:`shadowcam.lab.dip_tracker.track_intervals`); and, in this process,
+    The files are read a second time only for what the tracked windows do not hold,
+    in time chunks as the tracking (one per worker): the dip interval of pixels whose
+    crossings lie beyond their window (:func:`shadowcam.lab.dip_tracker.track_intervals`);
+    for RAW with ``edge_fit`` every frame once more, each site's own value straight from
+    its mosaic (:func:`shadowcam.lab.site_signal.mosaic_own_site`, no demosaic; the
+    site's lit statistics take every frame outside its window), unless
+    `own_site_in_first_pass`; and, in this process,
     the support of ``several_minima`` / ``wide_dip`` pixels
     (:func:`shadowcam.lab.connected_dips.support_intervals`) when there are any.
     """
     paths = [os.fspath(p) for p in paths]
+    first_pass = bool(own_site_in_first_pass) and method == "edge_fit"
     summary = track_files(paths, half_window=half_window, workers=workers,
-                          block_frames=block_frames, own_site=method == "edge_fit")
+                          block_frames=block_frames, own_site=first_pass)
     block_frames = int(block_frames)
 
     def measure(centre, threshold):
         return _in_chunks(_interval_owned, paths, workers, centre, threshold, summary.half_window, block_frames)
 
+    def site_window(tracked, site_colour):
+        parts = _in_chunks(site_sums_from_files, paths, workers, tracked.window_start, tracked.window.shape[0],
+                           block_frames)
+        return site_window_of_sums(parts, tracked, site_colour=site_colour)
+
     cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
     return measured_shadow_times(summary, read=partial(signal_blocks, paths, block_frames), method=method,
-                                 cfa_pattern=cfa_pattern, measure=measure, site_window=tracked_site_window,
+                                 cfa_pattern=cfa_pattern, measure=measure, site_window=tracked_site_window if first_pass else site_window,
                                  method_params=method_params, classify_params=classify_params)
