@@ -286,22 +286,29 @@ def _minimal_tracker(block, ring, worst):
     return hits
 
 
-def stage_ns(paths, *, block_frames=16, repeats=2):
+def stage_ns(paths, *, block_frames=16, repeats=2, own_site_in_first_pass=False):
     """CPU time of each stage of the DNG -> shadow-time path on one thread, ns per pixel-frame.
 
     Runs the path's own pieces in this process, one after the other, on
-    `paths` (frames of one sweep): the direct mosaic read, the mosaic ->
-    channel-sum signal, the tracker's update, its finish (partial, merge),
-    the dip interval from the stored windows (and the count of pixels that
-    would need a second read), and the classification and timing; plus the
-    least arithmetic a streaming tracker needs (:func:`_minimal_tracker`)
-    and one numpy pass over the signal.
+    `paths` (frames of one sweep), as :func:`~shadowcam.lab.sweep_files.sweep_shadow_times_from_files`
+    runs them for RAW with ``edge_fit``: the direct mosaic read, the mosaic ->
+    channel-sum signal, the tracker's update, its finish (partial, merge), the
+    dip interval from the stored windows (and the count of pixels that would
+    need a second read), the own site's second read of every file
+    (:func:`~shadowcam.lab.sweep_files.site_sums_from_files`), and the
+    classification and timing with the CFA pattern (each pixel from its own site,
+    the connected dips' support read again from the files where the pipeline
+    does); plus the least arithmetic a streaming tracker needs
+    (:func:`_minimal_tracker`) and one numpy pass over the signal. With
+    `own_site_in_first_pass` (the pipeline's option of that name) each site's own
+    value is computed in the first pass and tracked instead of read again.
 
     Returns
     -------
     dict
-        ``decode``, ``signal``, ``track``, ``minimal_track``, ``numpy_pass``:
-        ns per pixel-frame (best of `repeats`); ``finish_s``, ``interval_s``,
+        ``decode``, ``signal``, ``own``, ``track``, ``site_read``, ``minimal_track``,
+        ``numpy_pass``: ns per pixel-frame (best of `repeats`; ``own`` 0 without
+        `own_site_in_first_pass`, ``site_read`` 0 with it); ``finish_s``, ``interval_s``,
         ``timing_s``: seconds once per sweep; ``interval_unresolved``: pixels
         the interval pass must read the frames again for.
     """
@@ -312,6 +319,8 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
     from shadowcam.io.mosaic_reader import MosaicReader
     from shadowcam.lab.mosaic_signal import mosaic_signal
     from shadowcam.lab.shadow_time import summary_shadow_times
+    from shadowcam.lab.site_signal import mosaic_own_site, site_window_of_sums, tracked_site_window
+    from shadowcam.lab.sweep_files import mosaic_colour, signal_blocks, site_sums_from_files
 
     threads = numba.get_num_threads()
     numba.set_num_threads(1)
@@ -321,13 +330,17 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
         shape = reader.shape
         n = len(paths)
         pixel_frames = n * shape[0] * shape[1]
-        best = dict.fromkeys(("decode", "signal", "track", "minimal_track", "numpy_pass", "finish_s",
-                              "interval_s", "timing_s"), np.inf)
+        pattern = reader.levels["cfa_pattern"]
+        first_pass = bool(own_site_in_first_pass)
+        best = dict.fromkeys(("decode", "signal", "own", "track", "site_read", "minimal_track", "numpy_pass",
+                              "finish_s", "interval_s", "timing_s"), np.inf)
         for _ in range(repeats):
             clock = dict.fromkeys(best, 0.0)
-            tracker = DipTracker(shape)
+            tracker = DipTracker(shape, own_site=first_pass, saturation_level=np.inf)  # as sweep_files tracks RAW
             block = np.empty((block_frames,) + shape, np.float32)
+            own = np.empty_like(block)
             saturated = np.zeros(shape, bool)
+            site_sum = np.zeros(shape, np.int64)
             for start in range(0, n, block_frames):
                 stop = min(start + block_frames, n)
                 for i in range(start, stop):
@@ -335,11 +348,18 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
                     mosaic, levels = reader.read(paths[i])
                     t1 = time.process_time()
                     mosaic_signal(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
-                                  white=levels["white_sites"], out=block[i - start], saturated=saturated)
+                                  white=levels["white_sites"], out=block[i - start], saturated=saturated,
+                                  site_sum=site_sum)
+                    t2 = time.process_time()
+                    if first_pass:
+                        mosaic_own_site(mosaic, pattern=levels["cfa_pattern"], black=levels["black_sites"],
+                                        white=levels["white_sites"], out=own[i - start])
                     clock["decode"] += t1 - t0
-                    clock["signal"] += time.process_time() - t1
+                    clock["signal"] += t2 - t1
+                    if first_pass:
+                        clock["own"] += time.process_time() - t2
                 t0 = time.process_time()
-                tracker.update(block[:stop - start], first_index=start)
+                tracker.update(block[:stop - start], first_index=start, own=own[:stop - start] if first_pass else None)
                 t1 = time.process_time()
                 ring, worst = np.zeros((3, shape[0] * shape[1]), np.float32), np.zeros(shape[0] * shape[1], np.float32)
                 _minimal_tracker(block[:stop - start].reshape(stop - start, -1), ring, worst)
@@ -349,17 +369,29 @@ def stage_ns(paths, *, block_frames=16, repeats=2):
                 clock["minimal_track"] += t2 - t1
                 clock["numpy_pass"] += time.process_time() - t2
             t0 = time.process_time()
-            summary = tracker.result()
+            summary = mosaic_colour(tracker.result(), [(site_sum, n, np.zeros(shape, np.int64), saturated,
+                                                        reader.levels)])
             t1 = time.process_time()
             _, resolved = window_intervals(summary, half_depth(summary))
             t2 = time.process_time()
             interval = None
             if resolved.all():  # else the frames would be read again (not timed here)
                 summary, interval = without_interval(summary, track_intervals(iter(()), summary))
-            summary_shadow_times(summary, interval=interval)
+            site_window = tracked_site_window
+            t_site = time.process_time()
+            if not first_pass:  # the pipeline's second read of every file for the own site
+                parts = [site_sums_from_files(paths, (0, n), summary.window_start, summary.window.shape[0],
+                                              block_frames)]
+
+                def site_window(tracked, colour):
+                    return site_window_of_sums(parts, tracked, site_colour=colour)
             t3 = time.process_time()
-            clock.update(finish_s=t1 - t0, interval_s=t2 - t1, timing_s=t3 - t2)
-            for key in ("decode", "signal", "track", "minimal_track", "numpy_pass"):
+            summary_shadow_times(summary, interval=interval, cfa_pattern=pattern, own_site=True,
+                                 read=lambda: signal_blocks(paths, block_frames), site_window=site_window)
+            t4 = time.process_time()
+            clock.update(finish_s=t1 - t0, interval_s=t2 - t1, site_read=0.0 if first_pass else t3 - t_site,
+                         timing_s=t4 - t3 + t_site - t2)
+            for key in ("decode", "signal", "own", "track", "site_read", "minimal_track", "numpy_pass"):
                 clock[key] *= 1e9 / pixel_frames
             best = {key: min(best[key], clock[key]) for key in best}
         best["interval_unresolved"] = int((~resolved).sum())
@@ -545,13 +577,16 @@ def format_report(figures):
     lines += [
         f"CPU time per stage on one thread ({g['frames']} frames of the sweep, ns per pixel-frame):",
         f"  decode (direct mosaic read) {g['decode']:6.1f}   mosaic -> signal {g['signal']:6.1f}"
-        f"   tracker update {g['track']:6.1f}",
+        f"   own site in the first pass {g['own']:6.1f}   tracker update {g['track']:6.1f}",
+        f"  own site's second read of every file {g['site_read']:6.1f}",
         f"  least tracker arithmetic (store, smooth, compare) {g['minimal_track']:6.1f};"
         f" one numpy pass over the signal {g['numpy_pass']:6.1f}",
         f"  once per sweep: finish {g['finish_s']:.2f} s, interval from the windows {g['interval_s']:.2f} s"
         f" ({g['interval_unresolved']} of {g['pixels']} pixels need a second read), classify + time"
         f" {g['timing_s']:.2f} s",
-        f"  budget: tracking the decoded frames costs {(g['signal'] + g['track']) / g['decode']:.2f} of the decode"
+        f"  budget: tracking the decoded frames costs"
+        f" {(g['signal'] + g['own'] + g['track'] + g['site_read']) / g['decode']:.2f}"
+        " of the decode"
         f" (0.25 would give 0.8 end to end on the same cores)",
         "",
         f"shadow-time stage alone ({f['stage_frames']} in-memory frames of the central quarter):",

@@ -27,6 +27,7 @@ track_block : feed a block of frames to the state (in place).
 finish_centres : test the last centres of a sequence that ended.
 window_sums : the exact sums of stored windows (to take the dip out of the running sums).
 merge_dips : the deepest and second dip of each pixel among its chunks' candidates, with its window and sums.
+own_site_block, own_window_sums, copy_own_windows : RAW sites' own values beside the channel sum (window and sums).
 interval_block : compare smoothed frames with a threshold around each pixel's deepest minimum (the dip's interval).
 interval_from_window : the same for pixels whose crossings lie in their stored window (no pass over the frames).
 """
@@ -580,6 +581,8 @@ def merge_dips(values, frames, windows, half_window):
         The deepest dip's window (NaN where there is none).
     count, fixed_sum, square_hi, square_lo : (P,) ndarray
         Its finite samples' :func:`window_sums` (zeros where there is none).
+    chunk : (P,) int64 ndarray
+        The chunk whose window it is (-1 where there is none).
     """
     n_p, k = windows[0].shape
     minimum_value = np.empty(n_p, np.float32)
@@ -592,6 +595,7 @@ def merge_dips(values, frames, windows, half_window):
     fixed_sum = np.zeros(n_p, np.int64)
     square_hi = np.zeros(n_p)
     square_lo = np.zeros(n_p)
+    chunk = np.full(n_p, -1, np.int64)
     for p in nb.prange(n_p):
         best = -1
         best_value = np.float32(0.0)
@@ -611,6 +615,7 @@ def merge_dips(values, frames, windows, half_window):
         found[p] = True
         minimum_value[p] = best_value
         minimum_frame[p] = best_frame
+        chunk[p] = best // TOP
         samples = windows[best // TOP][p]
         window[:, p] = samples
         count[p], fixed_sum[p], square_hi[p], square_lo[p] = _window_sum(samples)
@@ -627,7 +632,7 @@ def merge_dips(values, frames, windows, half_window):
                     second_value[p] = value
                     second_frame[p] = frame
     return (minimum_value, minimum_frame, second_value, second_frame, found, window, count, fixed_sum,
-            square_hi, square_lo)
+            square_hi, square_lo, chunk)
 
 
 @nb.njit(cache=True, parallel=True)
@@ -793,3 +798,124 @@ def interval_from_window(window, centre_frame, threshold, end, before_frame, bef
             if j == end - 1:
                 done_after = True  # the sweep ends inside the dip
         resolved[p] = done_before and done_after
+
+
+@nb.njit(cache=True, parallel=True)
+def own_site_block(block, own, first_index, start, stop, sums, rest_invalid):
+    """Add the owned frames of a block to each RAW site's own-value and neighbours' running sums.
+
+    For the frames ``first_index + t`` in ``[start, stop)`` with a finite own value,
+    the own value and the neighbours' part (the tracked signal, channels added in
+    order in float32 as :func:`track_block`, less the own value, in float32) enter the
+    sums in the exact forms of the tracker's (fixed-point sums, squares split in two).
+
+    Parameters
+    ----------
+    block : (T, P, C) float32 ndarray
+        The frames fed to :func:`track_block`.
+    own : (T, P) float32 ndarray
+        Each site's own value in those frames.
+    first_index, start, stop : int
+    sums : (7, P) int64 ndarray
+        Count; own fixed-point sum, square parts (``2**-8`` and ``2**-40`` units);
+        the neighbours' part's three likewise (in place).
+    rest_invalid : (P,) int64 ndarray
+        Frames whose neighbours' part is not finite (in place).
+    """
+    n_t, n_p, n_c = block.shape
+    for p in nb.prange(n_p):
+        for t in range(n_t):
+            j = first_index + t
+            if j < start or j >= stop:
+                continue
+            value = own[t, p]
+            if not np.isfinite(value):
+                continue
+            x = block[t, p, 0]
+            for c in range(1, n_c):
+                x += block[t, p, c]
+            _add_own(value, np.float32(x - value), sums, rest_invalid, p)
+
+
+@nb.njit(cache=True, inline="always")
+def _add_own(value, rest, sums, rest_invalid, p):
+    """Count a finite own value and add it and its neighbours' part `rest` (if finite) to pixel `p`'s sums."""
+    sums[0, p] += 1
+    _add_sample(np.float64(value), sums, 1, p)
+    if np.isfinite(rest):
+        _add_sample(np.float64(rest), sums, 4, p)
+    else:
+        rest_invalid[p] += 1
+
+
+@nb.njit(cache=True, inline="always")
+def _add_sample(x, sums, row, p):
+    """Add `x` to the fixed-point sum ``sums[row, p]`` and its square's parts to the next two rows."""
+    sums[row, p] += _fixed(x)
+    sq = x * x
+    hi = (sq + _SQ_HI) - _SQ_HI
+    sums[row + 1, p] += np.int64(hi * 256.0)
+    sums[row + 2, p] += np.int64((((sq - hi) + _SQ_LO) - _SQ_LO) * 2.0**40)
+
+
+@nb.njit(cache=True, parallel=True)
+def own_window_sums(own_window, signal_window, keep):
+    """The :func:`own_site_block` sums of each kept pixel's own and signal windows ``(K, P)``.
+
+    Returns
+    -------
+    sums : (7, P) int64 ndarray
+        As :func:`own_site_block`'s, over the window's frames with a finite own value.
+    rest_invalid : (P,) int64 ndarray
+        Window frames with a finite own value and a non-finite neighbours' part.
+    """
+    n_k, n_p = own_window.shape
+    sums = np.zeros((7, n_p), np.int64)
+    rest_invalid = np.zeros(n_p, np.int64)
+    for p in nb.prange(n_p):
+        if not keep[p]:
+            continue
+        for k in range(n_k):
+            value = own_window[k, p]
+            if not np.isfinite(value):
+                continue
+            _add_own(value, np.float32(signal_window[k, p] - value), sums, rest_invalid, p)
+    return sums, rest_invalid
+
+
+@nb.njit(cache=True, parallel=True)
+def copy_own_windows(tail, block, first_index, centre, changed, end, half_window, own_window):
+    """Copy the own values of frames ``centre - half_window .. centre + half_window`` of the changed pixels.
+
+    Parameters
+    ----------
+    tail : (K, P) float32 ndarray
+        Own values of the ``K`` frames before `first_index`.
+    block : (T, P) float32 ndarray
+        Own values of frames ``first_index + t``.
+    first_index : int
+    centre : (P,) int64 ndarray
+        Each pixel's deepest centre.
+    changed : (P,) bool ndarray
+        Pixels whose channel-sum window was copied since the last call.
+    end : int
+        One past the last frame fed (frames outside ``[0, end)`` are NaN, as the
+        channel sum's window).
+    half_window : int
+    own_window : (K, P) float32 ndarray
+        Written in place for the changed pixels.
+    """
+    n_k, n_p = tail.shape
+    n_t = block.shape[0]
+    for p in nb.prange(n_p):
+        if not changed[p]:
+            continue
+        for q in range(2 * half_window + 1):
+            f = centre[p] - half_window + q
+            s = f - first_index
+            value = np.float32(np.nan)
+            if 0 <= f < end and 0 <= s < n_t:
+                value = block[s, p]
+            elif 0 <= f < end and -n_k <= s < 0:
+                value = tail[n_k + s, p]
+            own_window[q, p] = value

@@ -92,6 +92,11 @@ class DipSummary:
         Demosaiced RAW: each pixel's own mosaic site in the window
         (:func:`shadowcam.lab.site_signal.track_site_window`), from which ``edge_fit``
         times it where its noise allows; None: timed from the tracked signal.
+    tracked_site : SiteWindow or None
+        RAW tracked with ``own_site`` (:class:`DipTracker`): each site's own value at the
+        window's frames and its lit statistics (and its neighbours' part's) over the
+        frames outside the window, from exact running sums (``colour`` None: the
+        timing gives it, :func:`shadowcam.lab.site_signal.tracked_site_window`).
     """
 
     window: np.ndarray
@@ -109,6 +114,7 @@ class DipSummary:
     channel_sum: np.ndarray = None
     saturated: np.ndarray = None
     site: object = None
+    tracked_site: object = None
 
     @property
     def half_window(self):
@@ -146,6 +152,14 @@ class DipPartial:
     channel_sum : (H, W, C) int64 ndarray
         Fixed-point per-channel sums (C = 0 if fed scalar frames).
     saturated : (H, W) bool ndarray
+    own_window : (H, W, K) float32 ndarray or None
+        Tracked with ``own_site``: each RAW site's own value at the frames of `window`.
+    own_sums : (H, W, 7) int64 ndarray or None
+        Count of the finite own values of the owned frames; their fixed-point sum and
+        square parts (``2**-8`` and ``2**-40`` units); the same of the neighbours' part
+        (signal less own) (:func:`shadowcam.lab.dip_kernels.own_site_block`).
+    own_rest_invalid : (H, W) int64 ndarray or None
+        Owned frames with a finite own value and a non-finite neighbours' part.
     """
 
     start: int
@@ -162,25 +176,31 @@ class DipPartial:
     invalid: np.ndarray
     channel_sum: np.ndarray
     saturated: np.ndarray
+    own_window: np.ndarray = None
+    own_sums: np.ndarray = None
+    own_rest_invalid: np.ndarray = None
 
     def save(self, path):
         """Write to `path` (ending ``.npz``) atomically: a temporary file, then a rename."""
         from shadowcam._shared.atomic import atomic_path
 
         with atomic_path(path) as tmp:
-            np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self)})
+            np.savez(tmp, **{f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None})
 
     @classmethod
     def load(cls, path):
         """Read a partial written by :meth:`save`."""
         with np.load(path) as data:
-            missing = {f.name for f in fields(cls)} - set(data.files)
+            missing = {f.name for f in fields(cls) if f.name not in _OWN_SITE_FIELDS} - set(data.files)
             if missing:
                 raise ValueError(f"path {path} is not a DipPartial file: missing {sorted(missing)}")
-            values = {f.name: data[f.name] for f in fields(cls)}
+            values = {f.name: data[f.name] for f in fields(cls) if f.name in data.files}
         for name in ("start", "stop", "end", "half_window"):
             values[name] = int(values[name])
         return cls(**values)
+
+
+_OWN_SITE_FIELDS = ("own_window", "own_sums", "own_rest_invalid")
 
 
 class DipTracker:
@@ -200,6 +220,11 @@ class DipTracker:
         Default: the whole sequence.
     saturation_level : float, optional
         Channel value at or above which a pixel counts as saturated.
+    own_site : bool, optional
+        RAW: :meth:`update` also takes each site's own value of the frames, kept at
+        the window's frames beside the signal (the frames whose signal the window
+        holds) and in exact running sums with its neighbours' part, so that the
+        summary carries ``tracked_site`` (no second pass over the frames for it).
 
     Examples
     --------
@@ -210,7 +235,7 @@ class DipTracker:
     7
     """
 
-    def __init__(self, shape, *, half_window=4, owned=None, saturation_level=0.999):
+    def __init__(self, shape, *, half_window=4, owned=None, saturation_level=0.999, own_site=False):
         if len(shape) != 2 or min(shape) < 1:
             raise ValueError(f"shape must be (H, W) with positive sizes; got {shape!r}")
         if int(half_window) < 1:
@@ -240,6 +265,13 @@ class DipTracker:
         self._channel_sum = None
         self._saturated = np.zeros(p, bool)
         self._partial = None
+        self.own_site = bool(own_site)
+        if self.own_site:
+            self._own_window = np.full((k, p), np.nan, np.float32)
+            # own values of the last K frames fed: a window copied in the next block may start there
+            self._own_tail = np.full((k, p), np.nan, np.float32)
+            self._own_sums = np.zeros((7, p), np.int64)
+            self._own_rest_invalid = np.zeros(p, np.int64)
 
     @staticmethod
     def padding(half_window):
@@ -255,7 +287,7 @@ class DipTracker:
         """One past the last frame fed so far (the frames seen, for a whole sweep)."""
         return self._next
 
-    def update(self, block, *, first_index=None):
+    def update(self, block, *, first_index=None, own=None):
         """Feed the next frames.
 
         Parameters
@@ -267,6 +299,9 @@ class DipTracker:
         first_index : int, optional
             Frame index of ``block[0]``; blocks must follow each other without
             gaps. Default: the next frame.
+        own : (T, H, W) array_like, optional
+            Each RAW site's own value in these frames; required with ``own_site``
+            (and only then).
         """
         if self._partial is not None:
             raise ValueError("update() called after result()/partial(); start a new DipTracker")
@@ -292,12 +327,38 @@ class DipTracker:
             self._channel_sum = np.zeros((n_c, self._raw.shape[1]), np.int64)
         elif self._channel_sum.shape[0] != n_c:
             raise ValueError(f"block has {n_c} channels but earlier blocks had {self._channel_sum.shape[0]}")
+        if self.own_site != (own is not None):
+            raise ValueError("own (each site's own value of the frames) must be given if and only if the "
+                             f"tracker was built with own_site=True; own_site={self.own_site}")
         flat = np.ascontiguousarray(block).reshape(block.shape[0], -1, n_c)
+        if own is not None:
+            own = np.ascontiguousarray(own, np.float32)
+            if own.shape != block.shape[:3]:
+                raise ValueError(f"own must have shape {block.shape[:3]} (the block's frames), got {own.shape}")
+            own = own.reshape(block.shape[0], -1)
+            deepest = self._top_frame[0].copy()
         _k.track_block(flat, first, *self.owned, self.half_window, np.float32(self.saturation_level),
                        self._raw, self._smooth, self._top_value, self._top_frame, self._window, self._signal_sum,
                        self._square_hi, self._square_lo, self._count, self._invalid,
                        self._channel_sum, self._saturated)
         self._next = first + block.shape[0]
+        if own is not None:
+            _k.own_site_block(flat, own, first, *self.owned, self._own_sums, self._own_rest_invalid)
+            self._copy_own_windows(deepest, own, first)
+            k = self._own_tail.shape[0]
+            if own.shape[0] >= k:
+                self._own_tail[...] = own[-k:]
+            else:
+                self._own_tail = np.concatenate([self._own_tail[own.shape[0]:], own])
+
+    def _copy_own_windows(self, deepest, own, first):
+        """Give the pixels whose deepest centre moved from `deepest` the own values of its window.
+
+        `own` ``(T, P)`` holds frames ``first ..``, the tail the ``K`` frames before.
+        """
+        changed = self._top_frame[0] != deepest
+        _k.copy_own_windows(self._own_tail, own, first, self._top_frame[0], changed, self._next,
+                            self.half_window, self._own_window)
 
     def partial(self):
         """Finish the owned chunk and return its :class:`DipPartial`.
@@ -309,8 +370,16 @@ class DipTracker:
             start, stop = self.owned
             end = self._next
             first = max(end - self.half_window - 1, start)  # centres not yet tested
+            deepest = self._top_frame[0].copy() if self.own_site else None
             _k.finish_centres(first, min(stop, end), end, self.half_window, self._raw, self._smooth,
                               self._top_value, self._top_frame, self._window)
+            own = {}
+            if self.own_site:
+                self._copy_own_windows(deepest, self._own_tail[:0], end)
+                h, w = self.shape
+                own = dict(own_window=np.ascontiguousarray(self._own_window.T).reshape(h, w, -1),
+                           own_sums=np.ascontiguousarray(self._own_sums.T).reshape(h, w, -1),
+                           own_rest_invalid=self._own_rest_invalid.reshape(h, w))
             h, w = self.shape
             channels = self._channel_sum if self._channel_sum is not None else np.zeros((0, h * w), np.int64)
 
@@ -323,7 +392,7 @@ class DipTracker:
                 window=pixel_major(self._window), signal_sum=self._signal_sum.reshape(h, w),
                 square_hi=self._square_hi.reshape(h, w), square_lo=self._square_lo.reshape(h, w),
                 count=self._count.reshape(h, w), invalid=self._invalid.reshape(h, w),
-                channel_sum=pixel_major(channels), saturated=self._saturated.reshape(h, w),
+                channel_sum=pixel_major(channels), saturated=self._saturated.reshape(h, w), **own,
             )
             self._raw = self._smooth = None
         return self._partial
@@ -388,6 +457,10 @@ def merge_partials(partials, *, n_frames):
         return tuple(np.ascontiguousarray(getattr(p, name)).reshape(-1, width) for p in partials)
 
     merged = list(_k.merge_dips(flat("top_value", _k.TOP), flat("top_frame", _k.TOP), flat("window", k), h))
+    chunk = merged.pop()
+    tracked_site = None
+    if all(p.own_window is not None for p in partials):
+        tracked_site = _tracked_site(partials, merged[5], chunk, shape)
     window = merged.pop(5).reshape((k,) + shape)
     minimum_value, minimum_frame, second_value, second_frame, found, win_count, win_sum, win_hi, win_lo = (
         part.reshape(shape) for part in merged)
@@ -422,7 +495,47 @@ def merge_partials(partials, *, n_frames):
         n_frames=n_frames,
         channel_sum=channel_sum / _k.SUM_SCALE if channel_sum.shape[-1] else None,
         saturated=saturated,
+        tracked_site=tracked_site,
     )
+
+
+def _tracked_site(partials, window, chunk, shape):
+    """The own-site :class:`~shadowcam.lab.site_signal.SiteWindow` (``colour`` None) of merged partials.
+
+    Each pixel's own window is its deepest dip's chunk's (as the signal's `window`
+    ``(K, P)``); its lit statistics are the chunks' running sums less the window's
+    samples' (exact, so independent of the chunking).
+    """
+    from shadowcam.lab.site_signal import SiteWindow
+
+    k, n_p = window.shape
+    own_window = np.full((n_p, k), np.nan, np.float32)
+    for index, part in enumerate(partials):
+        take = chunk == index
+        own_window[take] = part.own_window.reshape(n_p, k)[take]
+    own_window = np.ascontiguousarray(own_window.T)
+    in_window, window_invalid = _k.own_window_sums(own_window, window, chunk >= 0)
+    sums = sum(np.ascontiguousarray(part.own_sums).reshape(n_p, 7).T for part in partials) - in_window
+    rest_invalid = sum(part.own_rest_invalid.reshape(n_p) for part in partials) - window_invalid
+    count = sums[0]
+    level, noise = _level_noise(sums[1], sums[2], sums[3], count)
+    rest_level, rest_noise = _level_noise(sums[4], sums[5], sums[6], count)
+    rest_level[rest_invalid > 0] = np.nan
+    rest_noise[rest_invalid > 0] = np.nan
+    own_window[~np.isfinite(own_window)] = np.nan
+    return SiteWindow(window=own_window.reshape((k,) + shape), level=level.reshape(shape),
+                      noise=noise.reshape(shape), count=count.reshape(shape),
+                      neighbour_level=rest_level.reshape(shape), neighbour_noise=rest_noise.reshape(shape),
+                      colour=None)
+
+
+def _level_noise(fixed_sum, square_hi, square_lo, count):
+    """Mean and sample standard deviation from exact sums (units as :func:`~shadowcam.lab.dip_kernels.own_site_block`'s)."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        level = np.where(count > 0, fixed_sum / _k.SUM_SCALE / count, np.nan)
+        variance = (square_hi / 256.0 + square_lo / 2.0**40) / count - level**2
+        variance = np.maximum(variance, 0) * count / np.maximum(count - 1, 1)
+    return level, np.sqrt(variance)
 
 
 @dataclass

@@ -20,12 +20,13 @@ own_site_samples : each site's own channel of a demosaiced block.
 track_site_window : one pass over a sweep's demosaiced frames -> the :class:`SiteWindow`.
 site_window_sums, SiteSums : one pass over a range of frames' own samples and signal (time chunks).
 site_window_of_sums : the :class:`SiteWindow` from the sums of consecutive frame ranges.
+tracked_site_window : the :class:`SiteWindow` the dip tracker kept in its pass (RAW tracked with ``own_site``).
 mosaic_own_site : each site's own value straight from a mosaic, bit for bit the demosaic's.
 blend_variance : per-axis second moment of the channel sum's (or its neighbours' part's) demosaic taps.
 cfa_site_colours : the CFA channel measured at each pixel of a Bayer mosaic.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numba as nb
 import numpy as np
@@ -227,6 +228,28 @@ def site_window_of_sums(parts, summary, *, site_colour):
                       neighbour_noise=rest_noise, colour=colour.astype(np.int8))
 
 
+def tracked_site_window(summary, site_colour):
+    """The :class:`SiteWindow` of a summary tracked with each site's own value (no pass over the frames).
+
+    Parameters
+    ----------
+    summary : DipSummary
+        From a :class:`~shadowcam.lab.dip_tracker.DipTracker` built with ``own_site``
+        (its ``tracked_site``: lit statistics from exact running sums).
+    site_colour : (H, W) int ndarray
+        CFA channel of each site.
+
+    Returns
+    -------
+    SiteWindow
+    """
+    if summary.tracked_site is None:
+        raise ValueError("summary has no tracked_site: track the sweep with DipTracker(..., own_site=True)")
+    shape = summary.lit_level.shape
+    colour = check_array(site_colour, "site_colour", shape=shape, dtype_kind="iu")
+    return replace(summary.tracked_site, colour=colour.astype(np.int8))
+
+
 def track_site_window(blocks, summary, *, site_colour):
     """Own-site samples of every pixel in its dip window, and its own lit statistics.
 
@@ -256,7 +279,7 @@ def track_site_window(blocks, summary, *, site_colour):
     return site_window_of_sums([sums], summary, site_colour=colour)
 
 
-def mosaic_own_site(mosaic, *, pattern, black, white):
+def mosaic_own_site(mosaic, *, pattern, black, white, out=None):
     """Each site's own value straight from a Bayer mosaic, as the RAW decode's demosaic gives it.
 
     :func:`shadowcam.io.decode.mosaic_image` keeps a site's own channel as
@@ -273,6 +296,8 @@ def mosaic_own_site(mosaic, *, pattern, black, white):
         CFA pattern of the top-left 2x2 block (unused by the arithmetic; checked).
     black, white : (2, 2) array_like
         Levels of the top-left 2x2 block's sites, DN.
+    out : (M, N) float32 ndarray, optional
+        Where to write the values (C-contiguous).
 
     Returns
     -------
@@ -286,7 +311,9 @@ def mosaic_own_site(mosaic, *, pattern, black, white):
     scale = np.float32(65535 // int(white.max()))
     black = np.asarray(black, np.float64).reshape(2, 2).astype(np.float32) * scale
     span = white.astype(np.float32) * scale - black
-    own = np.empty(mosaic.shape, np.float32)
+    own = np.empty(mosaic.shape, np.float32) if out is None else out
+    if own.shape != mosaic.shape or own.dtype != np.float32 or not own.flags.c_contiguous:
+        raise ValueError(f"out must be a C-contiguous float32 array of shape {mosaic.shape}")
     _own_site_kernel(np.ascontiguousarray(mosaic), scale, black, span, own)
     return own
 

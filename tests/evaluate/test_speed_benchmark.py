@@ -25,8 +25,11 @@ def test_stage_figures_of_a_small_sweep(tmp_path):
     paths = write_sweep_dngs(scene, tmp_path, workers=1)
     figures = stage_ns(paths, block_frames=8, repeats=1)
     assert figures["frames"] == 30 and figures["pixels"] == 48 * 64
-    for key in ("decode", "signal", "track", "minimal_track", "numpy_pass"):
+    for key in ("decode", "signal", "track", "site_read", "minimal_track", "numpy_pass"):
         assert 0 < figures[key] < 1e6, key
+    assert figures["own"] == 0
+    first_pass = stage_ns(paths, block_frames=8, repeats=1, own_site_in_first_pass=True)
+    assert 0 < first_pass["own"] < 1e6 and first_pass["site_read"] == 0
     # the pixels left to a second read are those the stored windows do not resolve
     reader = MosaicReader(paths[0])
     tracker = DipTracker((48, 64))
