@@ -359,5 +359,6 @@ def sweep_shadow_times_from_files(paths, *, method="edge_fit", half_window=4, wo
 
     cfa_pattern = read_mosaic(paths[0])[1]["cfa_pattern"] if is_raw(paths[0]) else None
     return measured_shadow_times(summary, read=partial(signal_blocks, paths, block_frames), method=method,
-                                 cfa_pattern=cfa_pattern, measure=measure, site_window=tracked_site_window if first_pass else site_window,
+                                 cfa_pattern=cfa_pattern, measure=measure,
+                                 site_window=tracked_site_window if first_pass else site_window,
                                  method_params=method_params, classify_params=classify_params)
