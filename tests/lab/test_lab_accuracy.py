@@ -302,10 +302,14 @@ def test_interval_errors_score_the_penumbras_outer_edges():
                      "penumbra_last": (("sweep", "row", "col"), (true_last + 0.3)[None])},
                     coords={"sweep": ["u"]}, attrs={"n_frames_u": 40})
     stats = interval_errors(st, gt)["u"]
-    assert stats["outer_coverage"] == pytest.approx(19 / 20)
+    assert stats["n_outer_truth"] == 20 and stats["outer_coverage"] == pytest.approx(19 / 20)
     assert stats["first"]["p95"] == pytest.approx(0.1) and stats["last"]["max"] == pytest.approx(0.3)
     table = {row["quantity"]: row for row in accuracy_table({"interval": {"u": stats}})}
     assert table["penumbra first |error| p95, sweep u"]["unit"] == "frame"
     assert table["penumbra outer edges coverage, sweep u"]["value"] == "95"
     # without the law's edges in the shadow times: no outer rows
     assert "first" not in interval_errors(st.drop_vars(["penumbra_first", "penumbra_last"]), gt)["u"]
+    # a source never half hidden (a wire narrower than it): no half-depth truth, the outer edges scored
+    never = gt.assign(interval_entry_u=gt["interval_entry_u"] * np.nan, interval_exit_u=gt["interval_exit_u"] * np.nan)
+    stats = interval_errors(st, never)["u"]
+    assert stats["n_truth"] == 0 and stats["n_outer_truth"] == 20 and stats["first"]["p95"] == pytest.approx(0.1)
