@@ -27,16 +27,20 @@ hidden_share : F(t) of the law, with the footprint's two-point spread.
 fit_penumbra_law : per pixel, the law's parameters from the samples of its dip.
 law_edges : first contact, last release and the half-hidden crossings of fitted laws.
 dips_are_wide : whether a sweep's dips are wider than the tracker's window (the law applies).
+choose_profile : the source profile (disc or box) whose law fits a sweep's dips best.
 penumbra_edges : a sweep's outer edges and half-hidden crossings from the law (one read of
     the frames for its wide dips).
 """
 
+import logging
 from dataclasses import dataclass
 
 import numpy as np
 
 from shadowcam._shared.validation import check_in
 from shadowcam.lab.dip_classification import OK
+
+log = logging.getLogger(__name__)
 
 
 def disc_share_below(z):
@@ -293,13 +297,38 @@ def _dip_samples(blocks, rows, cols, first, count):
     return np.where(np.isfinite(samples), frames, np.nan), samples
 
 
-def penumbra_edges(read, results, *, n_frames, half_window, footprint_variance=None, profile="disc"):
+def choose_profile(times, samples, *, centre, width, spread, max_pixels=256):
+    """The source profile whose law fits a sweep's dips best: the least median residual
+    over up to `max_pixels` of them, evenly spread (every point of a sweep sees the same
+    source, so one profile serves the sweep).
+
+    Parameters
+    ----------
+    times, samples : (N, K) ndarray
+    centre, width, spread : (N,) ndarray
+        As :func:`fit_penumbra_law`.
+    max_pixels : int, optional
+
+    Returns
+    -------
+    str
+        A key of :data:`PROFILES`.
+    """
+    pick = np.unique(np.linspace(0, len(times) - 1, min(len(times), max_pixels)).round().astype(np.intp))
+    scores = {name: np.nanmedian(fit_penumbra_law(times[pick], samples[pick], centre=centre[pick],
+                                                  width=width[pick], spread=spread[pick], profile=name).rms)
+              for name in PROFILES}
+    return min(scores, key=lambda name: (not np.isfinite(scores[name]), scores[name]))
+
+
+def penumbra_edges(read, results, *, n_frames, half_window, footprint_variance=None, profile=None):
     """Outer edges and half-hidden crossings of a sweep's wide dips from the law.
 
     Each timed pixel's samples from its half-depth entry less half the width (and 2
     frames) to its exit plus as much (within the sweep) are read once and fitted
     (:func:`fit_penumbra_law`, starting from the half-depth interval); the footprint
-    spread is ``sqrt(footprint_variance) |grad shadow_time|`` (0 when undeclared). Only
+    spread is ``sqrt(footprint_variance) |grad shadow_time|`` (0 when undeclared), the
+    profile the one that fits the sweep best unless given. Only
     where the sweep's dips are wide (:func:`dips_are_wide`), on the pixels timed ``ok``
     (a dip cut by the sweep has no law fit); a pixel whose fit fails (non-finite, full not
     below lit, centre outside its samples) keeps no edges and its crossings.
@@ -314,6 +343,7 @@ def penumbra_edges(read, results, *, n_frames, half_window, footprint_variance=N
     footprint_variance : float, optional
         Per-axis second moment of a pixel's footprint, px^2.
     profile : {"disc", "box"}, optional
+        Default: the one that fits the sweep best (:func:`choose_profile`).
 
     Returns
     -------
@@ -336,8 +366,11 @@ def penumbra_edges(read, results, *, n_frames, half_window, footprint_variance=N
     gradient = np.hypot(*np.gradient(results["shadow_time"].astype(np.float64)))
     gradient = np.where(np.isfinite(gradient), gradient, np.nanmedian(gradient) if np.isfinite(gradient).any() else 0.0)
     spread = np.sqrt(footprint_variance or 0.0) * gradient[rows, cols]
-    fit = fit_penumbra_law(times, samples, centre=0.5 * (entry + exit_)[rows, cols], width=width[rows, cols],
-                           spread=spread, profile=profile)
+    centre, width = 0.5 * (entry + exit_)[rows, cols], width[rows, cols]
+    if profile is None and len(rows):
+        profile = choose_profile(times, samples, centre=centre, width=width, spread=spread)
+    fit = fit_penumbra_law(times, samples, centre=centre, width=width, spread=spread, profile=profile or "disc")
+    log.info("penumbra law (%s profile) fitted to %d wide dips", fit.profile, len(rows))
     edges = law_edges(fit)
     good = (np.isfinite(edges["first"]) & np.isfinite(edges["last"]) & (fit.full < fit.lit)
             & (fit.centre > first_frame) & (fit.centre < last[rows, cols]))
