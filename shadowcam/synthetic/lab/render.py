@@ -285,10 +285,11 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0, light=No
     Frame k shows the wire at ``p(k) = p0 + k v``; a light path is dark in frame k when the
     wire blocks it, i.e. ``|k - t_c| < half_width`` (``raycast.wire_occlusion_interval``).
     Under a continuous area light (`light` a disc, sphere or tube,
-    ``area_occlusion.exact_occlusion``) with an instant exposure and planar motion, each
-    path instead loses the share of the whole source the wire blocks as seen from its
-    scene point (``area_occlusion.blocked_share``): the light samples still shade and cast
-    the scene's own shadows, but the wire's penumbra is that of the continuous source.
+    ``area_occlusion.exact_occlusion``) each path instead loses the share of the whole
+    source the wire blocks as seen from its scene point (``area_occlusion.blocked_share``;
+    an open shutter averages it over ``EXPOSURE_INSTANTS`` instants): the light samples
+    still shade and cast the scene's own shadows, but the wire's penumbra is that of the
+    continuous source.
     With an open `shutter` the frame integrates the moving wire over its exposure: the path
     is dimmed by the fraction of ``[k - shutter/2, k + shutter/2]`` the wire blocks it (a
     real camera's motion blur: the hard-edged dip gets ramps, so its sampled shape carries
@@ -329,17 +330,20 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0, light=No
     t_c, half = wire_occlusion_interval(paths.points, paths.light, sweep, mask,
                                         distant=paths.distant)
     reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
+    offsets = None
     if path_offsets is not None:
         offsets = np.asarray(path_offsets, dtype=np.float64)
         if offsets.shape != (n_frames,) or not np.all(np.isfinite(offsets)):
             raise ValueError(f"path_offsets: expected {n_frames} finite offsets (one per "
                              f"frame), got shape {offsets.shape}")
+    if exact_occlusion(light):
+        return _continuous_source_frames(paths, light, sweep, mask, reference, n_frames,
+                                         offsets=offsets, shutter=shutter)
+    if offsets is not None:
         return _frames_with_offsets(paths, t_c, half, _offset_rate(paths, sweep, mask),
                                     offsets, reference)
     if shutter > 0:
         return _exposed_frames(paths, t_c, half, reference, n_frames, shutter)
-    if exact_occlusion(light):
-        return _continuous_source_frames(paths, light, sweep, mask, reference, n_frames)
     with np.errstate(invalid="ignore"):
         first = np.floor(t_c - half) + 1  # strict inequality: open interval
         last = np.ceil(t_c + half) - 1
@@ -359,9 +363,15 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0, light=No
     return frames.reshape(n_frames, *paths.shape, 3)
 
 
-def _continuous_source_frames(paths, light, sweep, mask, reference, n_frames):
+#: sub-instants over an open shutter's exposure for a continuous area light (midpoint rule)
+EXPOSURE_INSTANTS = 16
+
+
+def _continuous_source_frames(paths, light, sweep, mask, reference, n_frames, *, offsets=None, shutter=0.0):
     """Frames under a continuous area light: each scene point's paths lose the share of the
-    source the wire blocks from that point (``area_occlusion.blocked_share``), per frame."""
+    source the wire blocks from that point (``area_occlusion.blocked_share``), per frame;
+    with `offsets` the wire of frame k is displaced along the mask normal, with an open
+    `shutter` the share is averaged over :data:`EXPOSURE_INSTANTS` instants of the exposure."""
     n_pix = reference.shape[0]
     points, inverse = np.unique(paths.points, axis=0, return_inverse=True)
     inverse = inverse.ravel()
@@ -369,9 +379,12 @@ def _continuous_source_frames(paths, light, sweep, mask, reference, n_frames):
                          for c in range(3)], axis=-1)
     pixel = np.zeros(len(points), dtype=np.int64)
     pixel[inverse] = paths.pixel
+    instants = ((np.arange(EXPOSURE_INSTANTS) + 0.5) / EXPOSURE_INSTANTS - 0.5) * shutter if shutter > 0 else [0.0]
     frames = np.empty((n_frames, n_pix, 3), dtype=np.float32)
     for k in range(n_frames):
-        share = blocked_share(points, light, sweep, mask, np.full(len(points), float(k)))
+        wire = sweep if offsets is None else replace(sweep, p0=sweep.p0 + offsets[k] * mask.normal)
+        share = np.mean([blocked_share(points, light, wire, mask, np.full(len(points), k + lag))
+                         for lag in instants], axis=0)
         for c in range(3):
             deficit = np.bincount(pixel, weights=share * radiance[:, c], minlength=n_pix)
             frames[k, :, c] = np.clip(reference[:, c] - deficit, 0.0, None)
