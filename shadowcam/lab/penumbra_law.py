@@ -14,7 +14,7 @@ points' times about the centre's by ``spread`` frames (standard deviation): the 
 F averaged over the two times ``t -+ spread`` (the symmetric two-point kernel of that
 variance; exact for two sub-samples along the sweep). The fit
 (:func:`fit_penumbra_law`) finds centre, extent and width by damped Gauss-Newton on the
-samples, with lit and full solved exactly (linear) at each step: first contact
+samples, with lit and full (>= 0) solved exactly (linear) at each step: first contact
 ``centre - width/2 - extent`` and last release ``centre + width/2 + extent`` (the
 source's extreme points seen through the wire's edges) and the half-hidden crossings
 follow from the shape, and a dip without umbra gets its full-occlusion level.

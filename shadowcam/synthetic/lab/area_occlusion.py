@@ -165,13 +165,12 @@ def occlusion_times(points, light, sweep, mask, *, share=0.0, iterations=45):
 
 
 def _time_extent(points, light, sweep, mask, centre):
-    """Frames the wire's axis takes to cross the source's projection (an upper bound)."""
-    size = np.full(len(points), light.size)
-    offsets = np.stack([light.position + sign * light.size * axis
-                        for sign in (-1.0, 1.0) for axis in (mask.e_u, mask.e_v)])
-    spans = [np.abs(wire_occlusion_interval(points, np.broadcast_to(o, points.shape), sweep, mask)[0] - centre)
-             for o in offsets]
-    return np.where(np.isfinite(centre), np.nanmax(np.stack(spans), axis=0), size)
+    """Frames the wire's axis takes to cross the source's projection (an upper bound: points
+    a whole size from its centre along the mask's axes; 0 where the finite wire misses them)."""
+    offsets = [light.position + sign * light.size * axis for sign in (-1.0, 1.0) for axis in (mask.e_u, mask.e_v)]
+    spans = np.stack([np.abs(wire_occlusion_interval(points, np.broadcast_to(o, points.shape), sweep, mask)[0]
+                             - centre) for o in offsets])
+    return np.where(np.isfinite(spans), spans, 0.0).max(axis=0)
 
 
 def extreme_offset(light, direction):
