@@ -612,6 +612,11 @@ INTERVAL_ROWS = {
     **{f"{part}.{stat}": (f"dip interval {part} |error| {label}", "frame", 1.0)
        for part in ("entry", "centre", "exit")
        for stat, label in (("median", "median"), ("p95", "p95"), ("rmse", "RMSE"), ("max", "max"))},
+    "n_outer_truth": ("penumbra outer edges: pixels whose whole penumbra lies in the sweep", "pixel", 1.0),
+    "outer_coverage": ("penumbra outer edges coverage", "%", 100.0),
+    **{f"{part}.{stat}": (f"penumbra {part} |error| {label}", "frame", 1.0)
+       for part in ("first", "last")
+       for stat, label in (("median", "median"), ("p95", "p95"), ("rmse", "RMSE"), ("max", "max"))},
 }
 #: target name -> the report key it checks (per sweep of ``shadow_time``; sweep None: a section)
 TARGET_KEYS = {"shadow_time_p95_frames": "p95", "shadow_time_coverage": "coverage",
@@ -717,7 +722,7 @@ def noise_condition(manifest, noise=None):
 
 
 def interval_errors(shadow_time, ground_truth, *, sweeps=("u", "v")):
-    """Errors of the dip interval's entry, centre and exit against their exact times.
+    """Errors of the dip interval's entry, centre and exit (and outer edges) against their exact times.
 
     Parameters
     ----------
@@ -738,7 +743,12 @@ def interval_errors(shadow_time, ground_truth, *, sweeps=("u", "v")):
         sweep's frames ``0 .. shadow_time.attrs["n_frames_<sweep>"] - 1``: only those have
         a measurable entry and exit),
         ``coverage`` (their share with an estimated interval), and ``entry``, ``centre``,
-        ``exit``: median, p95, RMSE, max of the absolute error in frames.
+        ``exit``: median, p95, RMSE, max of the absolute error in frames. Where both
+        `shadow_time` (the penumbra law of wide dips, ``penumbra_first``, ``penumbra_last``)
+        and the truth have the outer edges, also ``n_outer_truth`` (lit pixels whose whole
+        penumbra lies in the sweep, with or without a half-hidden truth), ``outer_coverage``
+        (their share with both edges) and ``first``, ``last``: the same statistics of
+        their errors.
     """
     missing = {"interval_entry", "interval_exit"} - set(shadow_time)
     if missing:
@@ -769,6 +779,17 @@ def interval_errors(shadow_time, ground_truth, *, sweeps=("u", "v")):
             "centre": _stats(np.abs(0.5 * (entry + exit_) - 0.5 * (true_entry + true_exit))[found]),
             "exit": _stats(np.abs(exit_ - true_exit)[found]),
         }
+        if first is not true_entry and {"penumbra_first", "penumbra_last"} <= set(shadow_time):
+            # every lit pixel whose whole penumbra lies in the sweep (also where the source is
+            # never half hidden, a wire narrower than it: no half-depth truth)
+            outer_truth = lit & np.isfinite(first) & np.isfinite(last) & inside
+            outer_first, outer_last = (shadow_time[k].sel(sweep=sweep).transpose("row", "col").values.astype(np.float64)
+                                       for k in ("penumbra_first", "penumbra_last"))
+            outer = outer_truth & np.isfinite(outer_first) & np.isfinite(outer_last)
+            out[sweep].update(
+                n_outer_truth=int(outer_truth.sum()),
+                outer_coverage=float(outer.sum() / outer_truth.sum()) if outer_truth.any() else float("nan"),
+                first=_stats(np.abs(outer_first - first)[outer]), last=_stats(np.abs(outer_last - last)[outer]))
     return out
 
 

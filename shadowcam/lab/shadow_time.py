@@ -41,6 +41,7 @@ from shadowcam.lab.dip_classification import (
     WIDE_DIP, classify_dips, detection_threshold, supported_by_neighbours,
 )
 from shadowcam.lab.dip_tracker import DipTracker, lit_colour, track_intervals, without_interval
+from shadowcam.lab.penumbra_law import penumbra_edges
 from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
 from shadowcam.lab.site_signal import cfa_site_colours, track_site_window
 from shadowcam.lab.timing_kernels import neighbour_median, removed_light
@@ -543,7 +544,10 @@ def measured_shadow_times(summary, *, read, method="edge_fit", cfa_pattern=None,
     interval (:func:`shadowcam.lab.dip_tracker.track_intervals`, from the windows where
     they hold it), the lit statistics without it, the connected dips' support, and for
     RAW (a `cfa_pattern`) with ``edge_fit`` each pixel's own mosaic site; then
-    :func:`summary_shadow_times`.
+    :func:`summary_shadow_times`; where the sweep's dips are wider than the window, their
+    outer edges and half-hidden crossings from the penumbra law
+    (:func:`shadowcam.lab.penumbra_law.penumbra_edges`, with ``method_params``'
+    ``footprint_variance``).
 
     Parameters
     ----------
@@ -562,14 +566,18 @@ def measured_shadow_times(summary, *, read, method="edge_fit", cfa_pattern=None,
     Returns
     -------
     dict
-        As :func:`summary_shadow_times`.
+        As :func:`summary_shadow_times`, with the keys of
+        :func:`~shadowcam.lab.penumbra_law.penumbra_edges` where it applies.
     """
     interval = track_intervals(read(), summary, measure=measure)
     summary, interval = without_interval(summary, interval)
     own_site = bool(cfa_pattern) and method == "edge_fit"
-    return summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern or None, interval=interval,
-                                read=read, own_site=own_site, site_window=site_window if own_site else None,
-                                method_params=method_params, classify_params=classify_params)
+    results = summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern or None, interval=interval,
+                                   read=read, own_site=own_site, site_window=site_window if own_site else None,
+                                   method_params=method_params, classify_params=classify_params)
+    results.update(penumbra_edges(read, results, n_frames=summary.n_frames, half_window=summary.half_window,
+                                  footprint_variance=(method_params or {}).get("footprint_variance")))
+    return results
 
 
 _VARIABLE_ATTRS = {
@@ -587,6 +595,12 @@ _VARIABLE_ATTRS = {
     "interval_exit": ("frame", "time the smoothed signal comes back above half the dip's depth (interval exit)"),
     "interval_entry_std": ("frame", "standard deviation of interval_entry (noise over the crossing's slope)"),
     "interval_exit_std": ("frame", "standard deviation of interval_exit (noise over the crossing's slope)"),
+    "penumbra_first": ("frame", "first contact: the wire's leading edge reaches the source's extreme point "
+                                "(penumbra law, wide dips only)"),
+    "penumbra_last": ("frame", "last release: the trailing edge frees the source's other extreme point "
+                               "(penumbra law, wide dips only)"),
+    "penumbra_first_std": ("frame", "standard deviation of penumbra_first (the law's fit)"),
+    "penumbra_last_std": ("frame", "standard deviation of penumbra_last (the law's fit)"),
 }
 
 
@@ -613,9 +627,12 @@ def shadow_time_dataset(per_sweep, *, channels=("R", "G", "B")):
     names = list(per_sweep)
     data = {}
     for key, (units, long_name) in _VARIABLE_ATTRS.items():
-        if not all(key in per_sweep[n] for n in names):
+        if not all(key in per_sweep[n] for n in names) and not (
+                key.startswith("penumbra_") and any(key in per_sweep[n] for n in names)):
             continue
-        stacked = np.stack([per_sweep[n][key] for n in names])
+        shape = per_sweep[names[0]]["reason"].shape
+        # the law's edges of a sweep whose dips were not wide: none
+        stacked = np.stack([per_sweep[n].get(key, np.full(shape, np.nan, np.float32)) for n in names])
         dims = ("sweep", "row", "col", "channel") if stacked.ndim == 4 else ("sweep", "row", "col")
         data[key] = (dims, stacked, {"units": units, "long_name": long_name})
     data["reason"] = (("sweep", "row", "col"), np.stack([per_sweep[n]["reason"] for n in names]), {

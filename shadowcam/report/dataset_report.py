@@ -169,7 +169,7 @@ def viewpoints_report_figure(viewpoints, *, truth=None):
         if truth is not None and all(k in truth for k in keys):
             own = truth.assign(reciprocal=truth[keys[0]], dual_cam_visible=truth[keys[1]])
             reciprocal, _ = reciprocal_on_dual_grid(own, dual.shape[:2], dual_coords=dual_coords)
-        rows.append((f"viewpoint {name}", dual, reciprocal))
+        rows.append((str(name), dual, reciprocal))
     return figures.viewpoints_figure(rows)
 
 

@@ -282,3 +282,34 @@ def test_uncertain_times_are_counted_and_stay_in_the_score():
     assert "n_uncertain" not in shadow_time_errors(estimate, truth, lit=lit)
     with pytest.raises(ValueError, match="time_std"):
         shadow_time_errors(estimate, truth, lit=lit, time_std=std[:2])
+
+
+def test_interval_errors_score_the_penumbras_outer_edges():
+    """First contact early by 0.1, last release late by 0.3 frame, one pixel without them."""
+    from shadowcam.lab.accuracy import accuracy_table, interval_errors
+
+    rows, cols = 4, 5
+    true_entry = np.tile(np.arange(cols, dtype=float) + 10.0, (rows, 1))
+    true_exit, true_first, true_last = true_entry + 8.0, true_entry - 4.0, true_entry + 12.0
+    gt = xr.Dataset({"lit": (("row", "col"), np.ones((rows, cols), bool)),
+                     "interval_entry_u": (("row", "col"), true_entry), "interval_exit_u": (("row", "col"), true_exit),
+                     "penumbra_first_u": (("row", "col"), true_first), "penumbra_last_u": (("row", "col"), true_last)})
+    first = true_first - 0.1
+    first[0, 0] = np.nan
+    st = xr.Dataset({"interval_entry": (("sweep", "row", "col"), true_entry[None]),
+                     "interval_exit": (("sweep", "row", "col"), true_exit[None]),
+                     "penumbra_first": (("sweep", "row", "col"), first[None]),
+                     "penumbra_last": (("sweep", "row", "col"), (true_last + 0.3)[None])},
+                    coords={"sweep": ["u"]}, attrs={"n_frames_u": 40})
+    stats = interval_errors(st, gt)["u"]
+    assert stats["n_outer_truth"] == 20 and stats["outer_coverage"] == pytest.approx(19 / 20)
+    assert stats["first"]["p95"] == pytest.approx(0.1) and stats["last"]["max"] == pytest.approx(0.3)
+    table = {row["quantity"]: row for row in accuracy_table({"interval": {"u": stats}})}
+    assert table["penumbra first |error| p95, sweep u"]["unit"] == "frame"
+    assert table["penumbra outer edges coverage, sweep u"]["value"] == "95"
+    # without the law's edges in the shadow times: no outer rows
+    assert "first" not in interval_errors(st.drop_vars(["penumbra_first", "penumbra_last"]), gt)["u"]
+    # a source never half hidden (a wire narrower than it): no half-depth truth, the outer edges scored
+    never = gt.assign(interval_entry_u=gt["interval_entry_u"] * np.nan, interval_exit_u=gt["interval_exit_u"] * np.nan)
+    stats = interval_errors(st, never)["u"]
+    assert stats["n_truth"] == 0 and stats["n_outer_truth"] == 20 and stats["first"]["p95"] == pytest.approx(0.1)

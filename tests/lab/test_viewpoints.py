@@ -47,3 +47,21 @@ def test_a_dataset_without_intervals_says_what_to_do():
     ds = _dataset([[1.0]], [[2.0]]).drop_vars(["interval_entry", "interval_exit"])
     with pytest.raises(ValueError, match="recompute it"):
         shadow_time_at(ds, "entry")
+
+
+@pytest.mark.parametrize("viewpoint, start", [("penumbra_first", 0.0), ("penumbra_last", 1.0)])
+def test_outer_viewpoints_take_the_penumbras_outer_edges(viewpoint, start):
+    entry, exit_ = np.array([[10.0, 20.5]]), np.array([[18.0, 28.5]])
+    ds = _dataset(entry, exit_)
+    outer = {"penumbra_first": entry - 3.0, "penumbra_last": exit_ + 3.0}
+    for name, value in outer.items():
+        ds[name] = (("sweep", "row", "col"), value[None].astype(np.float32))
+        ds[f"{name}_std"] = (("sweep", "row", "col"), np.full((1, 1, 2), 0.05 if name.endswith("first") else 0.07,
+                                                              np.float32))
+    out = shadow_time_at(ds, viewpoint)
+    np.testing.assert_allclose(out["shadow_time"].values[0], outer[viewpoint])
+    np.testing.assert_allclose(out["time_std"].values[0], 0.05 if start == 0.0 else 0.07, rtol=1e-6)
+    assert viewpoint_fraction(viewpoint) == start
+    # a capture whose dips were not wide has no outer edges
+    with pytest.raises(ValueError, match="penumbra law"):
+        shadow_time_at(_dataset(entry, exit_), viewpoint)

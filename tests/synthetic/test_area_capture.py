@@ -61,7 +61,8 @@ def test_sphere_samples_project_to_a_uniform_disc_along_any_direction(k, directi
 
 def test_a_tube_spans_the_u_sweep_and_is_a_point_to_the_v_sweep():
     # a tube along e_u: the u sweep's dip spreads over the tube's projection (penumbra as long
-    # as the tube seen through the mask), the v sweep's stays a point light's
+    # as the tube seen through the mask), the v sweep's stays a point light's (the wire
+    # parallel to the tube hides all of it at once)
     from shadowcam.synthetic.lab.area_truth import area_light_times
 
     scene = make_scene("tabletop", height=16, width=16, frames=48, light_kind="area", wire_radius_frames=3,
@@ -74,8 +75,8 @@ def test_a_tube_spans_the_u_sweep_and_is_a_point_to_the_v_sweep():
     spread = {}
     for name in ("u", "v"):
         first, _ = area_light_times(points, scene.sweeps[name], scene.mask, scene.light, fraction=0.0)
-        inner, _ = area_light_times(points, scene.sweeps[name], scene.mask, scene.light, fraction=1.0)
-        spread[name] = np.nanmedian(inner - first)
+        half, _ = area_light_times(points, scene.sweeps[name], scene.mask, scene.light, fraction=0.5)
+        spread[name] = np.nanmedian(half - first)
     assert spread["u"] > 1.0 and spread["v"] < 1e-6
 
 
@@ -158,9 +159,9 @@ def test_area_light_capture_carries_interval_truth_and_viewpoint_renders(shape):
 
 
 def test_extreme_point_views_give_the_penumbras_outer_edges():
-    # the corner of the disc samples' bounding box, through the leading edges, is the view
-    # whose times are the first sample's blocking in both sweeps (area_truth at fraction 0);
-    # the opposite corner through the trailing edges the last sample's freeing
+    # the corner of the continuous disc's bounding box, through the leading edges, is the
+    # view whose times are the disc's first contact in both sweeps (area_truth at fraction
+    # 0); the opposite corner through the trailing edges its last release
     from shadowcam.synthetic.lab.area_truth import area_light_times
     from shadowcam.synthetic.lab.render import _extreme_point_views
 
@@ -173,9 +174,11 @@ def test_extreme_point_views_give_the_penumbras_outer_edges():
         for column, sweep in enumerate(("u", "v")):
             truth = area_light_times(points, scene.sweeps[sweep], scene.mask, scene.light, fraction=0.0)[pick]
             np.testing.assert_allclose(xy[:, column] - 0.5, truth, atol=1e-9)
-    # sampled finely, the disc's corner lies off the disc, farther from the centre than any
-    # sample (with 4 x 4 samples, which lie on the diagonals, it is the sample at 225 deg)
-    fine = make_scene("tabletop", height=16, width=16, frames=48, light_kind="area", area_light={"samples": 12})
-    corner = _extreme_point_views(fine)["penumbra_first"][0]
-    radius = np.linalg.norm(light_samples(fine.light)[0] - fine.light.center, axis=1).max()
-    assert np.linalg.norm(corner - fine.light.center) == pytest.approx(np.sqrt(2) * radius * np.cos(np.radians(15)))
+    # the corner of the bounding square of the disc: sqrt(2) radii from its centre, off the disc
+    corner = views["penumbra_first"][0]
+    assert np.linalg.norm(corner - scene.light.center) == pytest.approx(np.sqrt(2) * 0.5 * scene.light.size)
+    # a square keeps its samples: the corner of their bounding box
+    square = make_scene("tabletop", height=16, width=16, frames=48, light_kind="area", wire_radius_frames=4,
+                        area_light={"shape": "square", "samples": 4})
+    offset = _extreme_point_views(square)["penumbra_first"][0] - square.light.center
+    assert np.linalg.norm(offset) == pytest.approx(np.sqrt(2) * 0.5 * 0.006 * (1 - 1 / 4))

@@ -51,25 +51,26 @@ def test_each_viewpoint_gets_its_shadow_times_and_dual_view(viewpoint_run):
 def test_area_capture_viewpoints_match_their_reciprocal_renders(viewpoint_run):
     workdir = viewpoint_run
     report = json.loads((workdir / f"results/{AREA}/accuracy.json").read_text())
-    # dip interval against the half-depth crossings of area_truth, over the pixels whose
-    # whole dip lies in the 64 frames; measured: coverage u 0.968, v 0.975; p95 entry
-    # 0.337 / 0.378, centre 0.154 / 0.238, exit 0.366 / 0.346 frame (entry / exit off by the
-    # lit level's residual bias, docs/benchmarks.md)
+    # dip interval against the continuous disc's exact times (area_truth), over the pixels
+    # whose whole dip lies in the 64 frames; the wide dips' half-hidden crossings and outer
+    # edges from the penumbra law. Measured: coverage u 0.972, v 0.978; p95 entry 0.083 /
+    # 0.071, centre 0.079 / 0.060, exit 0.084 / 0.069, first contact 0.088 / 0.080, last
+    # release 0.090 / 0.069 frame (target 0.2)
     for sweep in ("u", "v"):
         interval = report["interval"][sweep]
         assert interval["n_truth"] > 1500
-        assert interval["coverage"] >= 0.95
-        assert interval["centre"]["p95"] <= 0.3
-        assert interval["entry"]["p95"] <= 0.45 and interval["exit"]["p95"] <= 0.45
+        assert interval["coverage"] >= 0.95 and interval["outer_coverage"] >= 0.95
+        for part in ("entry", "centre", "exit", "first", "last"):
+            assert interval[part]["p95"] <= 0.2, (sweep, part, interval[part])
     # each viewpoint's dual view (mesh carrying the camera-pixel density) against its own
-    # reciprocal render after one gain: measured relative RMSE 0.164 / 0.169 / 0.170 (the
-    # main dual view's 0.198), coverage of what the camera sees 0.87 / 0.87 / 0.86 (dips cut by
-    # the sweep's ends timed from one crossing; 0.82 / 0.78 / 0.78 without them). Without
-    # the density the same views scored 0.236 / 0.235 / 0.235, and 0.51-0.61 against the
-    # other viewpoints' renders (which differ by the wire's width): the bound separates them.
+    # reciprocal render after one gain: measured relative RMSE 0.131 / 0.125 / 0.125 (the
+    # main dual view's 0.126), coverage of what the camera sees 0.87 / 0.86 / 0.85 (dips cut by
+    # the sweep's ends timed from one crossing). Against the other viewpoints' renders
+    # (which differ by the wire's width) the views scored 0.51-0.61 on the 4 x 4-sample render:
+    # the bound separates them.
     for name in VIEWPOINTS:
         scores = report["viewpoints"][name]
-        assert scores["rel_rmse_masked"] <= 0.25, (name, scores)
+        assert scores["rel_rmse_masked"] <= 0.2, (name, scores)
         assert scores["coverage_of_visible"] >= 0.7, (name, scores)
     assert (workdir / f"results/{AREA}/figures/viewpoints.png").is_file()
     # the table (accuracy.csv, shown as figures/accuracy.html) has the same two sections

@@ -1,6 +1,9 @@
 """Exact entry and exit times of a wire's shadow under an area light (the renderer's model).
 
-An area light is rendered as weighted point samples (:func:`shadowcam.synthetic.lab.scene.light_samples`);
+A disc, sphere or tube is rendered as the continuous source
+(:mod:`shadowcam.synthetic.lab.area_occlusion`): the time at which a `fraction` of it is
+blocked is solved on its exact blocked share (``fraction = 0``: first contact and last
+release, the source's extreme points). A square is rendered as weighted point samples (:func:`shadowcam.synthetic.lab.scene.light_samples`);
 the wire (a cylinder) blocks the segment from a scene point to each sample
 during an analytic interval of frames
 (:func:`shadowcam.synthetic.lab.raycast.wire_occlusion_interval`). When the
@@ -17,12 +20,14 @@ tracker measures.
 Offers
 ------
 sample_intervals : per point and light sample, the frames the wire blocks it.
-area_light_times : entry and exit at a blocked fraction of the source, per point.
+area_light_times : entry and exit at a blocked fraction of the source, per point (exact for
+    the continuous disc, sphere and tube; the samples' staircase for a square).
 """
 
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_in_interval
+from shadowcam.synthetic.lab.area_occlusion import exact_occlusion, occlusion_times
 from shadowcam.synthetic.lab.raycast import wire_occlusion_interval
 from shadowcam.synthetic.lab.scene import light_samples
 
@@ -97,6 +102,9 @@ def area_light_times(points, sweep, mask, light=None, *, fraction=0.5):
     light = sweep.light if light is None else light
     if light is None:
         raise ValueError("light: the sweep carries no light; pass one")
+    if exact_occlusion(light):
+        # a share just below the whole: the umbra's edges for fraction 1
+        return occlusion_times(points, light, sweep, mask, share=min(float(fraction), 1.0 - 1e-12))
     start, stop, weight = sample_intervals(points, sweep, mask, light)
     # blocked weight rising through `fraction` (interval starts), falling back (ends, reversed)
     entry = _blocked_time(start, weight, fraction)

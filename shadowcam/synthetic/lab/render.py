@@ -44,6 +44,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import xarray as xr
 
+from shadowcam.synthetic.lab.area_occlusion import blocked_share, exact_occlusion, extreme_offset
 from shadowcam.synthetic.lab.optics import (
     camera_light_through_optics, camera_pixels_of_points, intersect_through_optics,
 )
@@ -278,11 +279,17 @@ def _exposed_frames(paths, t_c, half, reference, n_frames, shutter):
     return frames.reshape(n_frames, *paths.shape, 3)
 
 
-def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0):
+def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0, light=None):
     """Frames of one wire sweep.
 
     Frame k shows the wire at ``p(k) = p0 + k v``; a light path is dark in frame k when the
     wire blocks it, i.e. ``|k - t_c| < half_width`` (``raycast.wire_occlusion_interval``).
+    Under a continuous area light (`light` a disc, sphere or tube,
+    ``area_occlusion.exact_occlusion``) each path instead loses the share of the whole
+    source the wire blocks as seen from its scene point (``area_occlusion.blocked_share``;
+    an open shutter averages it over ``EXPOSURE_INSTANTS`` instants): the light samples
+    still shade and cast the scene's own shadows, but the wire's penumbra is that of the
+    continuous source.
     With an open `shutter` the frame integrates the moving wire over its exposure: the path
     is dimmed by the fraction of ``[k - shutter/2, k + shutter/2]`` the wire blocks it (a
     real camera's motion blur: the hard-edged dip gets ramps, so its sampled shape carries
@@ -303,6 +310,9 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0):
     shutter : float
         Exposure of each frame as a fraction of the frame interval, in [0, 1]; 0 = an
         instant (the wire frozen at ``p(k)``). Not combined with `path_offsets`.
+    light : PointLight, AreaLight or DistantLight, optional
+        The light `paths` were traced under; needed only for the exact occlusion of a
+        continuous area light (None: every light as its samples).
 
     Returns
     -------
@@ -320,11 +330,16 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0):
     t_c, half = wire_occlusion_interval(paths.points, paths.light, sweep, mask,
                                         distant=paths.distant)
     reference = _pixel_sums(paths)  # float64: fully blocked pixels cancel to ~1e-18
+    offsets = None
     if path_offsets is not None:
         offsets = np.asarray(path_offsets, dtype=np.float64)
         if offsets.shape != (n_frames,) or not np.all(np.isfinite(offsets)):
             raise ValueError(f"path_offsets: expected {n_frames} finite offsets (one per "
                              f"frame), got shape {offsets.shape}")
+    if exact_occlusion(light):
+        return _continuous_source_frames(paths, light, sweep, mask, reference, n_frames,
+                                         offsets=offsets, shutter=shutter)
+    if offsets is not None:
         return _frames_with_offsets(paths, t_c, half, _offset_rate(paths, sweep, mask),
                                     offsets, reference)
     if shutter > 0:
@@ -345,6 +360,34 @@ def sweep_frames(paths, sweep, mask, *, path_offsets=None, shutter=0.0):
                            minlength=n_pix * (n_frames + 1))
         deficit = np.cumsum(diff.reshape(n_pix, n_frames + 1), axis=1)[:, :n_frames]
         frames[:, :, c] = np.clip(reference[:, c] - deficit.T, 0.0, None)
+    return frames.reshape(n_frames, *paths.shape, 3)
+
+
+#: sub-instants over an open shutter's exposure for a continuous area light (midpoint rule)
+EXPOSURE_INSTANTS = 16
+
+
+def _continuous_source_frames(paths, light, sweep, mask, reference, n_frames, *, offsets=None, shutter=0.0):
+    """Frames under a continuous area light: each scene point's paths lose the share of the
+    source the wire blocks from that point (``area_occlusion.blocked_share``), per frame;
+    with `offsets` the wire of frame k is displaced along the mask normal, with an open
+    `shutter` the share is averaged over :data:`EXPOSURE_INSTANTS` instants of the exposure."""
+    n_pix = reference.shape[0]
+    points, inverse = np.unique(paths.points, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    radiance = np.stack([np.bincount(inverse, weights=paths.radiance[:, c], minlength=len(points))
+                         for c in range(3)], axis=-1)
+    pixel = np.zeros(len(points), dtype=np.int64)
+    pixel[inverse] = paths.pixel
+    instants = ((np.arange(EXPOSURE_INSTANTS) + 0.5) / EXPOSURE_INSTANTS - 0.5) * shutter if shutter > 0 else [0.0]
+    frames = np.empty((n_frames, n_pix, 3), dtype=np.float32)
+    for k in range(n_frames):
+        wire = sweep if offsets is None else replace(sweep, p0=sweep.p0 + offsets[k] * mask.normal)
+        share = np.mean([blocked_share(points, light, wire, mask, np.full(len(points), k + lag))
+                         for lag in instants], axis=0)
+        for c in range(3):
+            deficit = np.bincount(pixel, weights=share * radiance[:, c], minlength=n_pix)
+            frames[k, :, c] = np.clip(reference[:, c] - deficit, 0.0, None)
     return frames.reshape(n_frames, *paths.shape, 3)
 
 
@@ -699,22 +742,28 @@ def _extreme_point_views(scene):
     The wire of sweep u moves along e_u, so it first blocks the source point of least e_u
     coordinate and last frees the one of greatest; likewise along e_v. With the light's
     plane parallel to the mask plane a point's u time depends on its e_u coordinate alone,
-    so the corner (least u, least v) of the samples' bounding box, seen through the wires'
+    so the corner (least u, least v) of the source's bounding box, seen through the wires'
     leading edges, has both sweeps' first times (``penumbra_first``; a corner of the
     bounding square for a disc, off the disc itself), the opposite corner through the
-    trailing edges their last times (``penumbra_last``). None when the planes are not
-    parallel.
+    trailing edges their last times (``penumbra_last``). The box is the continuous
+    source's (``area_occlusion.extreme_offset``) where the renderer occludes it exactly,
+    else its samples'. None when the planes are not parallel.
     """
     mask, light = scene.mask, scene.light
-    positions = light_samples(light)[0]
     if abs(abs(mask.normal @ light.normal) - 1.0) > 1e-9 or scene.sweeps["u"].velocity @ mask.e_u <= 0 \
             or scene.sweeps["v"].velocity @ mask.e_v <= 0:
         return {}
-    u, v = (positions - light.center) @ mask.e_u, (positions - light.center) @ mask.e_v
-    return {"penumbra_first": (light.center + u.min() * mask.e_u + v.min() * mask.e_v, 0.0,
-                               "the samples' bounding-box corner the wires reach first, through their leading edges"),
-            "penumbra_last": (light.center + u.max() * mask.e_u + v.max() * mask.e_v, 1.0,
-                              "the samples' bounding-box corner the wires leave last, through their trailing edges")}
+    if exact_occlusion(light):
+        reach = np.array([extreme_offset(light, mask.e_u), extreme_offset(light, mask.e_v)])
+        low, high, what = -reach, reach, "the continuous source's"
+    else:
+        positions = light_samples(light)[0]
+        u, v = (positions - light.center) @ mask.e_u, (positions - light.center) @ mask.e_v
+        low, high, what = np.array([u.min(), v.min()]), np.array([u.max(), v.max()]), "the samples'"
+    return {"penumbra_first": (light.center + low[0] * mask.e_u + low[1] * mask.e_v, 0.0,
+                               f"{what} bounding-box corner the wires reach first, through their leading edges"),
+            "penumbra_last": (light.center + high[0] * mask.e_u + high[1] * mask.e_v, 1.0,
+                              f"{what} bounding-box corner the wires leave last, through their trailing edges")}
 
 
 def _light_attrs(light):
@@ -796,9 +845,9 @@ class CaptureRenderer:
         `path_offsets`, the non-planar wire motion, and `shutter`, the exposure)."""
         if name not in self._paths:
             raise ValueError(f"name: no sweep {name!r}; available: {self.sweep_names}")
-        sweep = self.scene.sweeps[name.removeprefix("cal_")]
-        return sweep_frames(self._paths[name], sweep, self.scene.mask,
-                            path_offsets=path_offsets, shutter=shutter)
+        base = name.removeprefix("cal_")
+        return sweep_frames(self._paths[name], self.scene.sweeps[base], self.scene.mask,
+                            path_offsets=path_offsets, shutter=shutter, light=_sweep_light(self.scene, base))
 
 
 def _trace_per_light(objects, camera, scene, names, supersample, prefix=""):

@@ -11,7 +11,8 @@ Texture, Material : procedural albedo (checker, discs, bricks, coloured squares)
     Blinn-Phong specular term.
 Sphere, Box, GroundPlane, BackPlane : scene objects (box yawed about +y; ground infinite;
     the finite back plane carries 2-D plane coordinates (x, y) and is the calibration plane).
-PointLight, DistantLight, AreaLight : lights; ``light_samples`` gives their stratified samples.
+PointLight, DistantLight, AreaLight : lights; ``light_samples`` gives their stratified samples,
+    ``light_plane_axes`` an area light's in-plane axes.
 PinholeCamera, OrthographicCamera : cameras; ``look_at_camera`` builds a pinhole.
 camera_rays, project : pixel-edge coordinates <-> world rays / points.
 MaskPlane, WireSweep : the mask plane and the wire sweeps u, v (README 1.3); a sweep may
@@ -357,6 +358,11 @@ def _frame(normal, up=UP):
     return e_u, np.cross(normal, e_u)
 
 
+def light_plane_axes(light):
+    """Unit (e1, e2) of an area light's plane (e1: a tube's axis), as its samples use them."""
+    return _frame(light.normal, UP if abs(light.normal[1]) < 0.99 else (1, 0, 0))
+
+
 def _sphere_offsets(k, radius):
     """(k**3, 3) offsets inside a ball whose projection on any plane is a uniform disc.
 
@@ -417,7 +423,7 @@ def light_samples(light):
         k = light.samples_per_side
         a, b = np.meshgrid((np.arange(k) + 0.5) / k, (np.arange(k) + 0.5) / k, indexing="ij")
         a, b = a.ravel(), b.ravel()
-        e1, e2 = _frame(light.normal, UP if abs(light.normal[1]) < 0.99 else (1, 0, 0))
+        e1, e2 = light_plane_axes(light)
         if light.shape == "disc":  # equal-area stratified polar mapping
             r = 0.5 * light.size * np.sqrt(a)
             phi = 2 * np.pi * b
