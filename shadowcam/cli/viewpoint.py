@@ -25,8 +25,8 @@ from shadowcam.lab.viewpoints import shadow_time_at
 def add_parser(subparsers, name):
     """Register ``viewpoint`` on `subparsers`; return its parser."""
     parser = subparsers.add_parser(name, help="shadow times of one viewpoint across the dip interval")
-    parser.add_argument("--shadow-time", required=True, help="shadow_time.nc with interval_entry/exit")
-    parser.add_argument("--viewpoint", required=True, help="entry, centre, exit or a fraction in [0, 1]")
+    parser.add_argument("--shadow-time", required=True, help="shadow_time.nc with interval_entry/exit (penumbra_first/last for the outer viewpoints)")
+    parser.add_argument("--viewpoint", required=True, help="entry, centre, exit, a fraction in [0, 1], penumbra_first or penumbra_last")
     parser.add_argument("--out", required=True, help="output netCDF, e.g. results/<ds>/viewpoints/entry/shadow_time.nc")
     return parser
 

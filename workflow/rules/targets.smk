@@ -39,7 +39,7 @@ def dataset_targets(ds):
         if "dual_view" in plan.stages:
             targets += [
                 f"results/{ds}/viewpoints/{vp}/dual_view.nc"
-                for vp in config["dual_view"]["viewpoints"]
+                for vp in dataset_viewpoints(plan)
             ]
         accuracy = [f"results/{ds}/accuracy.json", f"results/{ds}/accuracy.csv"]
     return targets + (accuracy if plan.has_ground_truth else [])
@@ -85,15 +85,28 @@ def get_accuracy_flags(wildcards, input):
 
 
 VIEWPOINT_PRODUCTS = ("shadow_time", "dual_coords", "dual_view")
+OUTER_VIEWPOINTS = ("penumbra_first", "penumbra_last")
+
+
+def dataset_viewpoints(plan):
+    """The configured viewpoints a capture has: the source's extreme points
+    (penumbra_first, penumbra_last) only under an extended light (``light: area``)."""
+    extended = plan.camera.get("light") == "area"
+    return [
+        vp
+        for vp in config["dual_view"]["viewpoints"]
+        if extended or vp not in OUTER_VIEWPOINTS
+    ]
 
 
 def get_viewpoint_products(wildcards):
     """Shadow time, dual coordinates and dual view of each configured viewpoint."""
-    if "dual_view" not in capture(wildcards.ds).stages:
+    plan = capture(wildcards.ds)
+    if "dual_view" not in plan.stages:
         return []
     return [
         f"results/{wildcards.ds}/viewpoints/{vp}/{stem}.nc"
-        for vp in config["dual_view"]["viewpoints"]
+        for vp in dataset_viewpoints(plan)
         for stem in VIEWPOINT_PRODUCTS
     ]
 
