@@ -10,10 +10,7 @@ grid of blocks that level, divided by the frame's lit gain, gives ``T = (q - rho
 
 Blocks clearly dimmed against the frame's brightest block (their level below
 :data:`FULLY_LIT` of it) are under a cloud: the frame's lit gain is then the brightest block's
-level (:mod:`shadowcam.outdoor.normalise`). Every block's ``T`` is taken as measured (only
-clipped to ``[0.05, 1]``): a thin shade, or the edge of a cloud across a block, is divided out
-as much as a deep one, so the field has no step where a cloud's transmittance crosses a cut.
-A block with no level (sky, ground shadowed from
+level (:mod:`shadowcam.outdoor.normalise`). A block with no level (sky, ground shadowed from
 the start, or reached by the ridge) takes the value of the nearest block that has one. Each
 pixel's ``T`` is the bilinear interpolation of the blocks' ``T`` at their centres (held constant
 beyond the outer centres), computed column by column so that column strips of the frame get the
@@ -163,9 +160,9 @@ def shade_field(levels, gain_lit, *, shadow_ratio):
     Returns
     -------
     (T, By, Bx) float32 ndarray
-        ``(levels / gain_lit - rho) / (1 - rho)`` clipped to ``[0.05, 1]`` (a block at or
-        above the lit gain reads 1); blocks without a level take the nearest block's value in
-        the frame, 1 where no block of the frame has one.
+        ``(levels / gain_lit - rho) / (1 - rho)`` clipped to ``[0.05, 1]`` where below
+        :data:`FULLY_LIT` (a clear cloud), else 1; blocks without a level take the nearest
+        block's value in the frame, 1 where no block of the frame has one.
     """
     levels = np.asarray(levels, dtype=np.float64)
     gain = np.asarray(gain_lit, dtype=np.float64)
@@ -174,7 +171,7 @@ def shade_field(levels, gain_lit, *, shadow_ratio):
     rho = float(np.clip(shadow_ratio, 0.0, 0.99))
     with np.errstate(divide="ignore", invalid="ignore"):
         shade = (levels / gain[:, None, None] - rho) / (1.0 - rho)
-    shade = np.clip(shade, 0.05, 1.0)
+    shade = np.where(shade < FULLY_LIT, np.clip(shade, 0.05, 1.0), np.where(np.isfinite(shade), 1.0, np.nan))
     out = np.ones(levels.shape, dtype=np.float32)
     for k in range(levels.shape[0]):
         out[k] = np.nan_to_num(_fill_nearest(shade[k]), nan=1.0)
