@@ -3,7 +3,8 @@
 Usage::
 
     python scripts/measure_outdoor_under_way.py [render options of measure_outdoor_gain.py]
-        [--capture RESULTS_DIR] [--rows A B] [--gains-from-rows A B] [--truth-gain] [--save MAPS.npz]
+        [--capture RESULTS_DIR] [--rows A B] [--gains-from-rows A B] [--truth-gain] [--field-error]
+        [--save MAPS.npz]
 
 Renders (or reads from ``--cache``) the ridge sunset of ``scripts/measure_outdoor_gain.py``
 (seed 3, every nuisance, 14-bit Poisson-Gaussian noise on linear RGB), or with ``--capture`` reads
@@ -22,7 +23,10 @@ last frame; for the pixels under way at the first frame the arrival reasons and 
 the lit pixels under a cloud in the first frame (transmittance < 0.95), and the events by kind;
 and, for every class-3 pixel, the error by ramp state and by the cloud's transmittance of the
 pixel at its true arrival (the nearest frame; where the truth has the cloud), signed medians
-included: where a median error comes from.
+included: where a median error comes from. With ``--field-error``, the first pass's cloud shade
+field against the truth's transmittance (``cloud_attenuation``) averaged over each block: the
+frames where a block is off by more than :data:`FIELD_OFF` and their worst blocks (the field is
+relative to the reference: under a clouded reference it is not the truth's transmittance).
 Also the CPU time (``time.process_time``, every thread) of each pass and of the step that times
 descents under way at their start from the neighbours' lit-to-shadow ratio
 (``outdoor.descent._neighbours_lit``, where the installed package has it) with the number of
@@ -48,7 +52,9 @@ from shadowcam.outdoor.normalise import cloud_shades
 from shadowcam.outdoor.photometry import photometry_from_frames
 
 #: options of this script that are not the render's (left out of the cache key)
-OWN_OPTIONS = ("save", "capture", "rows", "gains_from_rows", "truth_gain")
+OWN_OPTIONS = ("save", "capture", "rows", "gains_from_rows", "truth_gain", "field_error")
+#: a block's field this far from the truth's mean transmittance over it is reported (``--field-error``)
+FIELD_OFF = 0.08
 #: bins of the cloud's transmittance at a pixel's true arrival
 TRANSMITTANCE_BINS = (0.0, 0.6, 0.8, 0.95, 1.01)
 #: the first pass's per-frame curves that ``--gains-from-rows`` takes from a band of rows
@@ -119,6 +125,27 @@ def _with_truth_gain(photometry, truth):
     return out
 
 
+def _field_error(photometry, truth):
+    """Print the frames whose shade field is off the truth's block-mean transmittance, worst blocks first."""
+    field = photometry["shade_field"].values
+    rows, cols = photometry["shade_rows"].values, photometry["shade_cols"].values
+    attenuation = truth["cloud_attenuation"].values
+    height, width = attenuation.shape[1:]
+    row_edges = np.r_[0, 0.5 * (rows[1:] + rows[:-1]), height].astype(int)
+    col_edges = np.r_[0, 0.5 * (cols[1:] + cols[:-1]), width].astype(int)
+    means = np.add.reduceat(np.add.reduceat(attenuation, row_edges[:-1], axis=1), col_edges[:-1], axis=2)
+    means /= np.outer(np.diff(row_edges), np.diff(col_edges))[None]
+    error = field - means
+    print(f"  shade field - truth's block mean ({field.shape[1]}x{field.shape[2]} blocks): "
+          f"{np.min(error):+.3f} .. {np.max(error):+.3f}; frames with a block off by more than {FIELD_OFF}:")
+    gain = photometry["gain"].values / truth["lit_gain"].values
+    for k in np.flatnonzero((np.abs(error) > FIELD_OFF).any(axis=(1, 2))):
+        worst = np.argsort(-np.abs(error[k]), axis=None)[:4]
+        blocks = ", ".join(f"({i}, {j}) {field[k, i, j]:.2f} vs {means[k, i, j]:.2f}"
+                           for i, j in zip(*np.unravel_index(worst, error[k].shape)))
+        print(f"    frame {k}: gain / truth's {gain[k]:.3f}, source {int(photometry['gain_source'].values[k])}; {blocks}")
+
+
 def main():
     parser = add_render_arguments(argparse.ArgumentParser(description=__doc__.splitlines()[0]))
     parser.add_argument("--save", default=None, help="write the maps (estimate, reason, state, truth) here")
@@ -129,6 +156,8 @@ def main():
                         help="per-frame gains and cloud shade from the first pass on rows A:B alone")
     parser.add_argument("--truth-gain", action="store_true",
                         help="the renderer's lit gain in place of the first pass's (the shade field recomputed)")
+    parser.add_argument("--field-error", action="store_true",
+                        help="the shade field against the truth's transmittance averaged over each block")
     args = parser.parse_args()
     render_args = argparse.Namespace(**{k: v for k, v in vars(args).items() if k not in OWN_OPTIONS})
     if args.capture:
@@ -218,6 +247,8 @@ def main():
             if chosen.any():
                 print(f"    timed in state {name} ({chosen.sum()} px): "
                       f"{_line(arrival_errors(estimate, true_arrival, evaluate=chosen, interval_s=interval))}")
+    if args.field_error and "cloud_attenuation" in truth and "shade_field" in photometry:
+        _field_error(photometry, truth)
     if args.save:
         np.savez_compressed(args.save, estimate=estimate, reason=reason, state=state, truth=true_arrival,
                             class3=class3, times=times)
