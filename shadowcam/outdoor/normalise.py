@@ -33,6 +33,7 @@ PartMerger : the same, one part at a time (memory independent of the number of p
 aligned_luminance : one frame's registered luminance from the pass's results.
 GAIN_SOURCES : where a frame's lit gain comes from (the pass's ``gain_source`` codes).
 cloud_shade : the sun term's transmittance under a cloud over every lit pixel, per frame.
+cloud_shades : that and the shade field over the frame, per frame (what the merge records).
 clouded_reference_gains : the lit gains of the first frames when the reference's lit pixels were under a cloud.
 
 Each frame also gives its blocks' lit level (:func:`shadowcam.outdoor.shade_field.block_levels`);
@@ -363,13 +364,12 @@ class PartMerger:
         ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref / to_lit)
         lit_level = np.where(lit, ref, shadow_min * to_lit / ratio)
-        shade = cloud_shade(curves["gain_median"], curves["gain_lit"], curves["gain_source"], shadow_ratio=ratio)
+        shade, field = cloud_shades(curves["gain_median"], curves["gain_lit"], curves["gain_source"],
+                                    curves["shade_levels"], shadow_ratio=ratio)
         return {
             **curves,
             "cloud_shade": shade,
-            "shade_field": np.where((curves["gain_source"] == 1)[:, None, None],
-                                    shade[:, None, None].astype(np.float32),
-                                    shade_field(curves["shade_levels"], curves["gain_lit"], shadow_ratio=ratio)),
+            "shade_field": field,
             "shade_rows": self._grid[0],
             "shade_cols": self._grid[1],
             "sky": sky,
@@ -415,6 +415,33 @@ def cloud_shade(gain_median, gain_lit, gain_source, *, shadow_ratio):
     with np.errstate(divide="ignore", invalid="ignore"):
         shade = (median / lit - rho) / (1.0 - rho)
     return np.where(covered & np.isfinite(shade), np.clip(shade, 0.05, 1.0), 1.0)
+
+
+def cloud_shades(gain_median, gain_lit, gain_source, shade_levels, *, shadow_ratio):
+    """The cloud's shade of every frame: :func:`cloud_shade` and the field the tracker divides out.
+
+    Parameters
+    ----------
+    gain_median, gain_lit : (T,) ndarray
+    gain_source : (T,) int ndarray
+        As :func:`cloud_shade`.
+    shade_levels : (T, By, Bx) ndarray
+        The blocks' lit levels (:func:`shadowcam.outdoor.shade_field.block_levels`).
+    shadow_ratio : float, keyword-only
+
+    Returns
+    -------
+    cloud_shade : (T,) float64 ndarray
+    shade_field : (T, By, Bx) float32 ndarray
+        Uniform (``cloud_shade``) in the frames whose lit gain comes from the sky gain (a cloud
+        over every lit pixel, ``gain_source`` 1), else the blocks' transmittance
+        (:func:`shadowcam.outdoor.shade_field.shade_field`).
+    """
+    shade = cloud_shade(gain_median, gain_lit, gain_source, shadow_ratio=shadow_ratio)
+    covered = (np.asarray(gain_source) == 1)[:, None, None]
+    field = np.where(covered, shade[:, None, None].astype(np.float32),
+                     shade_field(shade_levels, gain_lit, shadow_ratio=shadow_ratio))
+    return shade, field
 
 
 def clouded_reference_gains(gain_lit, gain_sky, gain_source, *, settled=CLOUDED_REFERENCE):
