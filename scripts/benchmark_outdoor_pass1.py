@@ -3,9 +3,10 @@
 
     .venv/bin/python scripts/benchmark_outdoor_pass1.py [--size 6000x4000] [--frames 8] [--dir /tmp/...] [--source results/synthetic_ridge/capture/frames]
 
-Makes ````frames`` 14-bit lossless-JPEG RGGB DNGs of the given size from the rendered
+Makes ``frames`` 14-bit lossless-JPEG RGGB DNGs of the given size from the rendered
 ``synthetic_ridge`` capture (its first frames' decodes resized, each moved by a known
-sub-pixel shake, re-mosaiced), then measures, in this one process, the CPU seconds per frame (medians over the frames, so
+sub-pixel shake, re-mosaiced; with ``--noise`` through the renderer's sensor model, Poisson-
+Gaussian noise at every photosite, instead of scaled as they are), then measures, in this one process, the CPU seconds per frame (medians over the frames, so
 that the per-job fixed costs and the other users' load spikes drop out):
 
 * decode-only: the direct mosaic read of a frame (:class:`shadowcam.io.mosaic_reader.MosaicReader`),
@@ -49,10 +50,12 @@ def _timed(function, *args, **kwargs):
     return out, cpu1 - cpu, wall1 - wall
 
 
-def _make_dngs(folder, size, count, source):
+def _make_dngs(folder, size, count, source, *, noise=False):
+    """The benchmark's DNGs in `folder` (made once); with `noise`, from the renderer's sensor model with its noise."""
     from shadowcam.io.decode import read_frame
     from shadowcam.io.raw_writer import write_dng
     from shadowcam.outdoor.translation import translate
+    from shadowcam.synthetic.sensor import SensorModel, electrons_per_unit_radiance, simulate_raw
 
     cols, rows = size
     frames = sorted(Path(source).glob("*.dng"))
@@ -60,6 +63,7 @@ def _make_dngs(folder, size, count, source):
         raise SystemExit(f"no DNG frames in {source}: run the workflow on synthetic_ridge first, or give --source")
     folder.mkdir(parents=True, exist_ok=True)
     rng = np.random.default_rng(1)
+    sensor, scale = SensorModel(bit_depth=14), None
     paths = []
     for k in range(count):
         path = folder / f"{k:04d}.dng"
@@ -69,6 +73,13 @@ def _make_dngs(folder, size, count, source):
         image = cv2.resize(read_frame(frames[k % len(frames)]), (cols, rows), interpolation=cv2.INTER_CUBIC)
         shift = rng.uniform(-2, 2, size=2) if k else np.zeros(2)
         image = np.stack([translate(image[..., c], shift, method="opencv_cubic") for c in range(3)], axis=-1)
+        if noise:  # Poisson-Gaussian at every photosite, frame 0's exposure as synthetic_ridge's (0.6)
+            radiance = np.clip(np.nan_to_num(image), 0, None)
+            scale = scale or electrons_per_unit_radiance(radiance, sensor=sensor, target_fraction=0.6)
+            raw = simulate_raw(radiance, sensor=sensor, scale=scale, seed=[1, 0, k], noise=True)
+            write_dng(path, raw, bit_depth=14, black_level=sensor.black_level, exposure_time=0.01,
+                      compression="ljpeg")
+            continue
         mosaic = np.empty((rows, cols), np.float32)
         mosaic[0::2, 0::2], mosaic[0::2, 1::2] = image[0::2, 0::2, 0], image[0::2, 1::2, 1]
         mosaic[1::2, 0::2], mosaic[1::2, 1::2] = image[1::2, 0::2, 1], image[1::2, 1::2, 2]
@@ -164,12 +175,15 @@ def main():
     parser.add_argument("--dir", type=Path, default=Path("/tmp/shadowcam-bench-pass1"))
     parser.add_argument("--source", type=Path, default=Path("results/synthetic_ridge/capture/frames"),
                         help="rendered DNG frames the benchmark's frames are made from")
+    parser.add_argument("--noise", action="store_true",
+                        help="make the frames with the renderer's sensor noise at every photosite")
     parser.add_argument("--codecs", action="store_true",
                         help="measure the store's codecs and the luminance kernel instead of pass 1")
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     n = args.frames
-    paths = _make_dngs(args.dir / f"dng-{args.size}", size, n, args.source)
+    paths = _make_dngs(args.dir / f"dng-{args.size}{'-noisy' if args.noise else ''}", size, n, args.source,
+                       noise=args.noise)
     if args.codecs:
         _codecs(paths, args.dir)
         return
