@@ -443,7 +443,8 @@ class _MosaicImage(BackendArray):
 
     An index reads the mosaic window of the indexed rows and cols, widened by
     :data:`_WINDOW_MARGIN` pixels and started on even rows and cols (the CFA
-    phase), demosaics it (:func:`shadowcam.io.decode.mosaic_image`) and crops it:
+    phase), frame by frame from `chunks` (a :class:`shadowcam.io.mosaic_chunks.MosaicChunks`
+    of the store; zarr reads the window where it cannot), demosaics it (:func:`shadowcam.io.decode.mosaic_image`) and crops it:
     the values of the whole frame's decode, bit for bit. With ``luminance=True``
     it is ``luminance (time, row, col)``, the mean of those channels computed
     from the mosaic directly (:func:`shadowcam.io.luminance.mosaic_luminance`, equal bit for bit).
