@@ -5,9 +5,12 @@ A sweep store reads as variable ``image (time, row, col, channel)`` float32
 float64, units ``frame``), ``time_s`` and ``exposure_s`` (seconds, NaN where
 unknown) and ``channel`` (``R``, ``G``, ``B``), chunked along time only. A
 sweep of camera RAW frames is stored as its Bayer mosaics: ``mosaic (time,
-row, col)`` uint16 DN (Blosc zstd level 1, bit-shuffled: about the size of the
-lossless-JPEG RAW files) with the per-frame levels ``black_sites`` and
-``white_sites (time, cfa_row, cfa_col)``; :func:`open_frames` presents it as
+row, col)`` uint16 DN (Blosc LZ4, bit-shuffled: a little larger than the
+lossless-JPEG RAW files, and fast to decompress) with the per-frame levels
+``black_sites`` and ``white_sites (time, cfa_row, cfa_col)``; its time chunks
+are read straight from their files into one reused buffer
+(:class:`shadowcam.io.mosaic_chunks.MosaicChunks`, any Blosc setting; zarr
+reads other layouts). :func:`open_frames` presents it as
 the lazy ``image`` above, demosaiced on indexing
 (:func:`shadowcam.io.decode.mosaic_image`: the values a float store of the
 same frames holds, bit for bit), reading only the window of the mosaic the
@@ -59,6 +62,7 @@ from shadowcam._shared.atomic import atomic_directory
 from shadowcam._shared.progress import Progress
 from shadowcam.io.decode import iter_frames, iter_mosaics, mosaic_image
 from shadowcam.io.luminance import channel_mean, mosaic_luminance
+from shadowcam.io.mosaic_chunks import MosaicChunks
 from shadowcam.io.raw_mosaic import is_raw
 
 log = logging.getLogger(__name__)
@@ -67,7 +71,7 @@ log = logging.getLogger(__name__)
 CHUNK_BYTES = 64 * 2**20
 CHANNELS = ("R", "G", "B")
 _COMPRESSORS = (ZstdCodec(level=1),)
-_MOSAIC_COMPRESSORS = (BloscCodec(cname="zstd", clevel=1, shuffle="bitshuffle", typesize=2),)
+_MOSAIC_COMPRESSORS = (BloscCodec(cname="lz4", clevel=9, shuffle="bitshuffle", typesize=2),)
 #: mosaic pixels read beyond an indexed window (bilinear demosaic: 3x3 neighbourhoods)
 _WINDOW_MARGIN = 2
 
@@ -412,12 +416,13 @@ def open_frames(path):
     if "mosaic" not in dataset:
         return dataset
     mosaic = dataset["mosaic"]
-    image = _MosaicImage(mosaic.variable, dataset["black_sites"].values, dataset["white_sites"].values,
+    reader = MosaicChunks(path / "mosaic")  # one decompressed chunk shared by the image and the luminance
+    image = _MosaicImage(mosaic.variable, reader, dataset["black_sites"].values, dataset["white_sites"].values,
                          dataset.attrs["cfa_pattern"])
     chunks = (mosaic.encoding["chunks"][0],) + image.shape[1:]
     variable = xr.Variable(("time", "row", "col", "channel"), indexing.LazilyIndexedArray(image),
                            attrs=_image_attrs(), encoding={"chunks": chunks})
-    luminance = _MosaicImage(mosaic.variable, dataset["black_sites"].values, dataset["white_sites"].values,
+    luminance = _MosaicImage(mosaic.variable, reader, dataset["black_sites"].values, dataset["white_sites"].values,
                              dataset.attrs["cfa_pattern"], luminance=True)
     luminance = xr.Variable(("time", "row", "col"), indexing.LazilyIndexedArray(luminance),
                             attrs={"long_name": "luminance (mean of R, G, B)", "units": _image_attrs()["units"]},
@@ -438,14 +443,16 @@ class _MosaicImage(BackendArray):
 
     An index reads the mosaic window of the indexed rows and cols, widened by
     :data:`_WINDOW_MARGIN` pixels and started on even rows and cols (the CFA
-    phase), demosaics it (:func:`shadowcam.io.decode.mosaic_image`) and crops it:
+    phase), frame by frame from `chunks` (a :class:`shadowcam.io.mosaic_chunks.MosaicChunks`
+    of the store; zarr reads the window where it cannot), demosaics it (:func:`shadowcam.io.decode.mosaic_image`) and crops it:
     the values of the whole frame's decode, bit for bit. With ``luminance=True``
     it is ``luminance (time, row, col)``, the mean of those channels computed
     from the mosaic directly (:func:`shadowcam.io.luminance.mosaic_luminance`, equal bit for bit).
     """
 
-    def __init__(self, mosaic, black_sites, white_sites, cfa_pattern, *, luminance=False):
+    def __init__(self, mosaic, chunks, black_sites, white_sites, cfa_pattern, *, luminance=False):
         self._mosaic, self._black, self._white, self._pattern = mosaic, black_sites, white_sites, cfa_pattern
+        self._chunks = chunks
         self._luminance = luminance
         self.shape = tuple(mosaic.shape) + (() if luminance else (len(CHANNELS),))
         self.dtype = np.dtype(np.float32)
@@ -462,8 +469,14 @@ class _MosaicImage(BackendArray):
         height, width = self.shape[1:3]
         r0, c0 = (max(0, int(p.min()) - _WINDOW_MARGIN) // 2 * 2 for p in (rows, cols))
         r1, c1 = min(height, int(rows.max()) + 1 + _WINDOW_MARGIN), min(width, int(cols.max()) + 1 + _WINDOW_MARGIN)
+        with self._chunks.lock:
+            return self._convert(times, rows, cols, channels, out_shape, (r0, r1, c0, c1))
+
+    def _convert(self, times, rows, cols, channels, out_shape, window):
+        """The frames `times` of the mosaic window ``(r0, r1, c0, c1)`` demosaiced (or their luminance), cropped."""
+        r0, r1, c0, c1 = window
         t0 = int(times.min())
-        mosaics = np.asarray(self._mosaic[t0:int(times.max()) + 1, r0:r1, c0:c1].values)
+        mosaics = None  # zarr's read of the whole window, only where the chunk files cannot be read directly
         local_rows, local_cols = _local_index(rows, r0), _local_index(cols, c0)
         whole = (isinstance(local_rows, slice) and isinstance(local_cols, slice)
                  and local_rows == slice(0, r1 - r0, 1) and local_cols == slice(0, c1 - c0, 1)
@@ -472,7 +485,14 @@ class _MosaicImage(BackendArray):
         convert = mosaic_luminance if self._luminance else mosaic_image
         out = None
         for k, t in enumerate(times):
-            image = convert(mosaics[t - t0], cfa_pattern=self._pattern, black_sites=self._black[t],
+            mosaic = self._chunks.window(int(t), int(t) + 1, r0, r1, c0, c1)
+            if mosaic is None:
+                if mosaics is None:
+                    mosaics = np.asarray(self._mosaic[t0:int(times.max()) + 1, r0:r1, c0:c1].values)
+                mosaic = mosaics[t - t0]
+            else:
+                mosaic = mosaic[0]
+            image = convert(mosaic, cfa_pattern=self._pattern, black_sites=self._black[t],
                             white_sites=self._white[t])
             if whole and times.size == 1:
                 return image.reshape(out_shape)

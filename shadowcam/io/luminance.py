@@ -92,16 +92,41 @@ def _pixel(mosaic, r, up, down, c, left, right, own, other, scale, black, span):
 
 @nb.njit(cache=True)
 def _luminance_kernel(mosaic, scale, channel_of_site, black, span, out):
-    """Mean of the normalised bilinear R, G, B of ``mosaic * scale`` (OpenCV's rounding) into `out`."""
+    """Mean of the normalised bilinear R, G, B of ``mosaic * scale`` (OpenCV's rounding) into `out`.
+
+    Each row's interior is one loop over consecutive columns: every pixel's
+    neighbour sums are formed and the site's values picked by its column
+    parity (selects, not branches), so that the loop runs on vector
+    registers; the integer sums, their rounding and the float32 operations
+    are those of :func:`_pixel`, which computes the two mirrored border columns.
+    """
     rows, cols = mosaic.shape
     scale = np.int32(scale)
+    black_r, black_g, black_b = black[0], black[1], black[2]  # scalars: `out` cannot alias them
+    span_r, span_g, span_b = span[0], span[1], span[2]
+    three = np.float32(3.0)
     for r in range(rows):
         up, down = _reflect(r - 1, rows), _reflect(r + 1, rows)
-        for parity in range(2):  # the columns of one site type: no branch on the site in the loop
-            own = channel_of_site[r & 1, parity]
-            other = channel_of_site[r & 1, 1 - parity]
-            for c in range(1 + (1 - parity), cols - 1, 2):
-                out[r, c] = _pixel(mosaic, r, up, down, c, c - 1, c + 1, own, other, scale, black, span)
+        colour_parity = 0 if channel_of_site[r & 1, 0] != 1 else 1  # the row's R or B sites; G between
+        red_row = channel_of_site[r & 1, colour_parity] == 0
+        above, here, below, row = mosaic[up], mosaic[r], mosaic[down], out[r]
+        for c in range(1, cols - 1):
+            centre = np.int32(here[c]) * scale
+            horizontal = np.int32(here[c - 1]) + np.int32(here[c + 1])
+            vertical = np.int32(above[c]) + np.int32(below[c])
+            diagonal = (np.int32(above[c - 1]) + np.int32(above[c + 1]) + np.int32(below[c - 1])
+                        + np.int32(below[c + 1]))
+            colour = (c & 1) == colour_parity
+            # the row's colour (R in an R row), G, and the other colour (from the diagonals or the column)
+            same = centre if colour else (horizontal * scale + 1) >> 1
+            green = ((horizontal + vertical) * scale + 2) >> 2 if colour else centre
+            opposite = (diagonal * scale + 2) >> 2 if colour else (vertical * scale + 1) >> 1
+            red = same if red_row else opposite
+            blue = opposite if red_row else same
+            total = (np.float32(red) - black_r) / span_r
+            total += (np.float32(green) - black_g) / span_g
+            total += (np.float32(blue) - black_b) / span_b
+            row[c] = total / three
         for c in (0, cols - 1):  # the mirrored border columns
             own, other = channel_of_site[r & 1, c & 1], channel_of_site[r & 1, (c + 1) & 1]
             out[r, c] = _pixel(mosaic, r, up, down, c, _reflect(c - 1, cols), _reflect(c + 1, cols), own, other,
