@@ -48,13 +48,15 @@ ARRAY_REASONS = {0: "ok", 1: "minima_count", 2: "uneven_gaps", 3: "minimum_flagg
 OK, MINIMA_COUNT, UNEVEN_GAPS, MINIMUM_FLAGGED = range(4)
 
 
-def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=None):
+def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=None, shape=None):
     """Times of each wire's shadow at each pixel of one experiment.
 
     Parameters
     ----------
-    frames : (T, H, W[, C]) array_like
-        The experiment's frames (light moving, wires of one family in place).
+    frames : (T, H, W[, C]) array_like, or callable
+        The experiment's frames (light moving, wires of one family in place), or a
+        callable streaming them in consecutive blocks, called twice
+        (:func:`shadowcam.io.decode.frame_blocks`).
     n_wires : int
     spacing_frames : float
         Distance between neighbouring wires in frames of the light's motion.
@@ -63,6 +65,8 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     half_window : int, optional
         Of :func:`shadowcam.lab.minima.find_minima`; default ``floor(spacing / 2)``
         (neighbouring dips are at least `spacing_frames` apart).
+    shape : (int, int), optional
+        ``(H, W)``; needed when `frames` is a callable.
 
     Returns
     -------
@@ -76,12 +80,17 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     check_positive(tolerance, "tolerance", finite=True)
     if int(n_wires) != n_wires or n_wires < 1:
         raise ValueError(f"n_wires must be an integer >= 1; got {n_wires!r}")
-    frames = np.asarray(frames)
-    check_array(frames, "frames")
-    if frames.ndim not in (3, 4):
-        raise ValueError(f"frames must be (T, H, W[, C]); got shape {frames.shape}")
+    if callable(frames):
+        if shape is None:
+            raise ValueError("shape: the (H, W) of the frames is needed when they are streamed (frames a callable)")
+    else:
+        frames = np.asarray(frames)
+        check_array(frames, "frames")
+        if frames.ndim not in (3, 4):
+            raise ValueError(f"frames must be (T, H, W[, C]); got shape {frames.shape}")
+        shape = frames.shape[1:3]
     h = max(1, int(spacing_frames // 2)) if half_window is None else int(half_window)
-    minima = _m.find_minima(frames, frames.shape[1:3], count=int(n_wires), half_window=h,
+    minima = _m.find_minima(frames, tuple(shape), count=int(n_wires), half_window=h,
                             steady_level=False)  # the light moves: its level varies
     reason = np.full(minima.count.shape, OK, np.int8)
     # identical wires cast dips of like depth: a minimum less than half as deep as the
@@ -111,7 +120,7 @@ def assign_wires(frames, n_wires, *, spacing_frames, tolerance=0.5, half_window=
     return times, reason, minima
 
 
-def estimate_spacing(frames, n_wires, *, tolerance=0.5):
+def estimate_spacing(frames, n_wires, *, tolerance=0.5, shape=None):
     """The wires' spacing in frames of the light's motion, from one experiment's dips.
 
     The dips of neighbouring wires at a point at depth ``d`` beyond the mask are
@@ -124,12 +133,14 @@ def estimate_spacing(frames, n_wires, *, tolerance=0.5):
 
     Parameters
     ----------
-    frames : (T, H, W[, C]) array_like
-        One experiment's frames.
+    frames : (T, H, W[, C]) array_like, or callable
+        One experiment's frames, or a callable streaming them (see :func:`assign_wires`).
     n_wires : int
         Wires of the family whose shadows pass (>= 2).
     tolerance : float
         Frames by which a pixel's gaps may differ from each other.
+    shape : (int, int), optional
+        ``(H, W)``; needed when `frames` is a callable.
 
     Returns
     -------
@@ -138,7 +149,8 @@ def estimate_spacing(frames, n_wires, *, tolerance=0.5):
     if int(n_wires) != n_wires or n_wires < 2:
         raise ValueError(f"n_wires: the spacing is estimated from the gaps between two or more wires' dips; "
                          f"got {n_wires!r}: give the spacing (camera_array.spacing_frames) instead")
-    times, reason, _ = assign_wires(frames, n_wires, spacing_frames=2.0, tolerance=tolerance, half_window=1)
+    times, reason, _ = assign_wires(frames, n_wires, spacing_frames=2.0, tolerance=tolerance, half_window=1,
+                                    shape=shape)
     every = (reason == OK) & np.all(np.isfinite(times), axis=0)  # all wires' dips inside the sweep
     gaps = np.diff(times, axis=0).mean(axis=0)[every]
     if not gaps.size:

@@ -3,63 +3,28 @@
 A camera-array capture (docs/contracts.md) holds two sweeps of frame files, ``horizontal``
 (the light moving along ``e_u``) and ``vertical`` (along ``e_v``), and one image lit from
 each wire crossing; its plan (:func:`shadowcam.io.capture_plan.capture_plan`) lists them.
-The frames and images are decoded one at a time by the lab sweeps' decoder
-(:func:`shadowcam.io.decode.iter_frames`: camera RAW, TIFF, PNG, EXR to linear RGB) into
-one float32 stack per experiment, whose wires :func:`shadowcam.cameras.array.assign_wires`
-times whole (every pixel's minima span the sweep) before the next is read.
+Each experiment is streamed through the lab sweeps' decoder
+(:func:`shadowcam.io.decode.frame_blocks`: camera RAW, TIFF, PNG, EXR to linear RGB), a
+block of frames at a time, into the two passes of
+:func:`shadowcam.cameras.array.assign_wires` (twice more when the spacing is estimated):
+memory follows the frame size, not the number of frames. The crossing images are
+decoded into one stack.
 
 Offers
 ------
-read_stack : decode frame files into one (N, H, W, 3) float32 stack.
 camera_array_of_plan : a camera-array capture plan -> the array dataset.
 """
 
 import numpy as np
 
 from shadowcam.cameras.array import array_views, assign_wires, estimate_spacing
-from shadowcam.io.decode import iter_frames
-
-
-def read_stack(paths, *, shape=None):
-    """Decode frame files into one stack, one file at a time.
-
-    Parameters
-    ----------
-    paths : sequence of str or Path
-        Files in order.
-    shape : (2,) tuple of int, optional
-        ``(rows, cols)`` every file must have (default: the first file's).
-
-    Returns
-    -------
-    (N, H, W, 3) float32 ndarray
-        Linear RGB (black 0, white level 1).
-
-    Raises
-    ------
-    ValueError
-        No paths, or a file of another size than `shape` or the first file (naming both).
-    """
-    paths = list(paths)
-    if not paths:
-        raise ValueError("paths: no frame files to read")
-    stack = None
-    for k, (path, image, _) in enumerate(iter_frames(paths)):
-        if stack is None:
-            if shape is not None and tuple(image.shape[:2]) != tuple(shape):
-                raise ValueError(f"frame {path} has size {image.shape[0]}x{image.shape[1]} (rows x cols) but the "
-                                 f"capture's frames are {shape[0]}x{shape[1]}; every frame and crossing image "
-                                 "must come from one camera at one size (remove or crop the odd file)")
-            stack = np.empty((len(paths), *image.shape), np.float32)
-        stack[k] = image
-    return stack
+from shadowcam.io.decode import frame_blocks, read_stack
 
 
 def camera_array_of_plan(plan, *, tolerance=0.5, method="mesh"):
     """The virtual camera array of a captured (or rendered and written) camera-array capture.
 
-    The experiments are decoded one after the other, each freed once its wires are timed,
-    then the crossing images.
+    The experiments are streamed one after the other, then the crossing images decoded.
 
     Parameters
     ----------
@@ -91,16 +56,16 @@ def camera_array_of_plan(plan, *, tolerance=0.5, method="mesh"):
     order = sorted(experiments, key=lambda name: experiments[name] < 2)  # an estimable family first
     times, spacing = {}, {}
     for name in order:
-        frames = read_stack(plan.sweep(name).files, shape=plan.frame_shape)
+        frames = frame_blocks(plan.sweep(name).files, plan.frame_shape)
         if given is not None:
             spacing[name] = float(given)
         elif experiments[name] >= 2:
-            spacing[name] = estimate_spacing(frames, experiments[name], tolerance=tolerance)
+            spacing[name] = estimate_spacing(frames, experiments[name], tolerance=tolerance, shape=plan.frame_shape)
         else:
             spacing[name] = next(iter(spacing.values()))
-        times[name] = assign_wires(frames, experiments[name], spacing_frames=spacing[name],
-                                   tolerance=tolerance)[:2] + (len(frames),)
-        del frames
+        wire_times, reason, minima = assign_wires(frames, experiments[name], spacing_frames=spacing[name],
+                                                  tolerance=tolerance, shape=plan.frame_shape)
+        times[name] = (wire_times, reason, minima.n_frames)
     crossings = read_stack(array["crossings"], shape=plan.frame_shape)
     (u, reason_u, t_u), (v, reason_v, t_v) = times["horizontal"], times["vertical"]
     out = array_views(crossings.reshape(rows, cols, *crossings.shape[1:]), u, v, reason_u=reason_u,

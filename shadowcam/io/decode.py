@@ -22,6 +22,9 @@ header_metadata : exposure and capture time from the file header only
 frame_info : size, bit depth, black/white levels, white balance, exposure and
     capture time of a frame, without decoding more than needed.
 iter_frames : decode several frames one at a time, checking they share a size.
+frame_blocks : a callable streaming decoded frames in blocks of bounded size, anew on each call.
+read_stack : decode frame files into one (N, H, W, 3) float32 stack.
+BLOCK_BYTES : the most decoded frames one block of :func:`frame_blocks` holds, in bytes.
 mosaic_image : linear float32 RGB of a Bayer mosaic and its levels (demosaic + levels).
 iter_mosaics : read several RAW frames' mosaics one at a time, checking they share a size and CFA.
 
@@ -283,6 +286,90 @@ def iter_frames(paths):
                 "must have the same size (remove or crop the odd file)"
             )
         yield Path(path), image, info
+
+
+#: the most decoded frames (float32 RGB) one block of :func:`frame_blocks` holds, in bytes
+BLOCK_BYTES = 16 * 2 ** 20
+
+
+def _check_frame_size(path, image, shape):
+    """Raise ValueError naming `path` if `image` is not ``shape`` (rows, cols)."""
+    if tuple(image.shape[:2]) != tuple(shape):
+        raise ValueError(f"frame {path} has size {image.shape[0]}x{image.shape[1]} (rows x cols) but the "
+                         f"capture's frames are {shape[0]}x{shape[1]}; every frame must come from one "
+                         "camera at one size (remove or crop the odd file)")
+
+
+def frame_blocks(paths, shape, *, block_bytes=BLOCK_BYTES):
+    """A callable streaming the files' decoded frames anew on each call, in blocks.
+
+    For passes over a sweep whose whole stack need not be held (e.g. the two passes of
+    :func:`shadowcam.lab.minima.find_minima`): memory follows the frame size, not the
+    number of frames.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        Files in order (decoded by :func:`iter_frames`).
+    shape : (2,) tuple of int
+        ``(rows, cols)`` every file must have.
+    block_bytes : int
+        The most bytes of decoded frames one block holds (at least one frame).
+
+    Returns
+    -------
+    callable
+        Each call returns an iterator of consecutive ``(t, H, W, 3)`` float32 blocks; it
+        raises (when iterated) ValueError for a frame of another size than `shape`.
+    """
+    paths = list(paths)
+    per_block = max(1, int(block_bytes) // (int(shape[0]) * int(shape[1]) * 3 * 4))
+
+    def blocks():
+        block = []
+        for path, image, _ in iter_frames(paths):
+            _check_frame_size(path, image, shape)
+            block.append(image)
+            if len(block) == per_block:
+                yield np.stack(block)
+                block = []
+        if block:
+            yield np.stack(block)
+
+    return blocks
+
+
+def read_stack(paths, *, shape=None):
+    """Decode frame files into one stack, one file at a time.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        Files in order.
+    shape : (2,) tuple of int, optional
+        ``(rows, cols)`` every file must have (default: the first file's).
+
+    Returns
+    -------
+    (N, H, W, 3) float32 ndarray
+        Linear RGB (black 0, white level 1).
+
+    Raises
+    ------
+    ValueError
+        No paths, or a file of another size than `shape` or the first file (naming both).
+    """
+    paths = list(paths)
+    if not paths:
+        raise ValueError("paths: no frame files to read")
+    stack = None
+    for k, (path, image, _) in enumerate(iter_frames(paths)):
+        if stack is None:
+            if shape is not None:
+                _check_frame_size(path, image, shape)
+            stack = np.empty((len(paths), *image.shape), np.float32)
+        stack[k] = image
+    return stack
 
 
 def iter_mosaics(paths):

@@ -5,7 +5,7 @@ A several-lights capture (docs/contracts.md) is a standard lab capture, sweeps `
 top-level ``lights`` block (``kinds``, optional ``light_along_u``, ``light_along_v``); its
 plan (:func:`shadowcam.io.capture_plan.capture_plan`) lists them. Each sweep is streamed
 twice through the lab sweeps' decoder (:func:`shadowcam.io.decode.iter_frames`: camera RAW,
-TIFF, PNG, EXR to linear RGB), a block of frames at a time (:data:`BLOCK_BYTES`), into
+TIFF, PNG, EXR to linear RGB), a block of frames at a time (:func:`shadowcam.io.decode.frame_blocks`), into
 the two passes of :func:`shadowcam.lab.minima.find_minima` (per-pixel work in row bands),
 whose minima :func:`shadowcam.lab.light_views.sweep_light_times` assigns to the lights
 (camera RAW: timed from each pixel's own mosaic site where its noise allows): memory
@@ -13,7 +13,6 @@ follows the frame size, not the sweep's length.
 
 Offers
 ------
-BLOCK_BYTES : the most decoded frames held at once, in bytes (at least one frame).
 light_set_views_of_plan : a several-lights capture plan -> the per-light views dataset.
 light_set_capture_of_plan : the capture's frames, reference and ground truth as one dataset
     (what :func:`shadowcam.lab.light_views.light_set_views` and the methods comparison read).
@@ -22,38 +21,8 @@ light_set_capture_of_plan : the capture's frames, reference and ground truth as 
 import numpy as np
 import xarray as xr
 
-from shadowcam.cameras.array_files import read_stack
-from shadowcam.io.decode import frame_info, iter_frames
+from shadowcam.io.decode import frame_blocks, frame_info, read_stack
 from shadowcam.lab.light_views import SWEEPS, light_views_dataset, pair_sweep_lights, sweep_light_times, view_attrs
-
-
-#: the most decoded frames (float32 RGB) held at once while a sweep streams, in bytes
-BLOCK_BYTES = 16 * 2 ** 20
-
-
-def _frame_blocks(paths, shape):
-    """A callable streaming the files' decoded frames anew on each call, in consecutive
-    ``(t, H, W, 3)`` float32 blocks of at most :data:`BLOCK_BYTES` (one frame at least).
-
-    Raises (when streamed) ValueError for a frame of another size than `shape`.
-    """
-    per_block = max(1, BLOCK_BYTES // (int(shape[0]) * int(shape[1]) * 3 * 4))
-
-    def blocks():
-        block = []
-        for path, image, _ in iter_frames(paths):
-            if tuple(image.shape[:2]) != tuple(shape):
-                raise ValueError(f"frame {path} has size {image.shape[0]}x{image.shape[1]} (rows x cols) but the "
-                                 f"capture's frames are {shape[0]}x{shape[1]}; every frame must come from one "
-                                 "camera at one size (remove or crop the odd file)")
-            block.append(image)
-            if len(block) == per_block:
-                yield np.stack(block)
-                block = []
-        if block:
-            yield np.stack(block)
-
-    return blocks
 
 
 def _captured(plan):
@@ -119,7 +88,7 @@ def light_set_views_of_plan(plan, *, half_window=4, method="edge_fit", radius=2,
     per_sweep, positions = {}, {}
     for name in SWEEPS:
         per_sweep[name], positions[name] = sweep_light_times(
-            _frame_blocks(plan.sweep(name).files, plan.frame_shape), block["count"], sweep=name,
+            frame_blocks(plan.sweep(name).files, plan.frame_shape), block["count"], sweep=name,
             light_along=block[f"light_along_{name}"], half_window=half_window, method=method, radius=radius,
             tolerance=tolerance, check_order=check_order, cfa_pattern=pattern, shape=plan.frame_shape)
     per_sweep, positions, pairing = pair_sweep_lights(per_sweep, positions, described=described, check=check_order)

@@ -32,6 +32,19 @@ def test_even_dips_are_the_wires_in_order():
     np.testing.assert_allclose(times[:, 0, 0], [10.3, 18.9, 27.5], atol=1 / (8 * 1.2) + 2e-3)
 
 
+def test_streamed_blocks_give_the_wires_of_the_whole_stack():
+    frames = _dips(50, [10.3, 18.9, 27.5], shape=(3, 4))
+    frames[:, 1, 2] = _dips(50, [9.1, 17.0, 25.2])[:, 0, 0]
+    whole, reason, _ = assign_wires(frames, 3, spacing_frames=SPACING)
+    streamed, reason_streamed, minima = assign_wires(lambda: (frames[i:i + 7] for i in range(0, 50, 7)), 3,
+                                                     spacing_frames=SPACING, shape=(3, 4))
+    np.testing.assert_array_equal(streamed, whole)
+    np.testing.assert_array_equal(reason_streamed, reason)
+    assert minima.n_frames == 50
+    with pytest.raises(ValueError, match="shape"):
+        assign_wires(lambda: iter([frames]), 3, spacing_frames=SPACING)
+
+
 def test_uneven_gaps_or_a_wrong_count_are_flagged():
     _, reason, _ = assign_wires(_dips(50, [10.0, 18.0, 30.0]), 3, spacing_frames=SPACING)
     assert np.all(reason == UNEVEN_GAPS)
