@@ -9,6 +9,7 @@ from shadowcam.lab.penumbra_law import (
     choose_profile, dips_are_wide, disc_share_below, fit_penumbra_law, hidden_share, law_edges, penumbra_edges,
 )
 from shadowcam.lab.dip_classification import OK
+from shadowcam.lab.penumbra_kernels import hidden_share_at
 
 
 def _numeric_share(t, centre, extent, width, profile, n=200_001):
@@ -157,3 +158,27 @@ def test_the_sweep_takes_the_profile_that_fits_its_dips(profile):
     times, samples = _dips(params, profile=profile)
     centre = np.array([p[0] for p in params]).round()
     assert choose_profile(times, samples, centre=centre, width=np.full(40, 8.5), spread=np.zeros(40)) == profile
+
+
+@settings(max_examples=60, deadline=None)
+@given(t=st.floats(-12, 12), extent=st.floats(0.3, 6), width=st.floats(0.3, 12), spread=st.floats(0, 0.6),
+       profile=st.sampled_from(["disc", "box"]))
+def test_the_compiled_share_and_its_slopes_are_the_laws(t, extent, width, spread, profile):
+    # the fit's kernel evaluates the law pixel by pixel: the same share as the numpy law
+    # (to rounding: a multiplication by 1 / extent for a division), and slopes that are its
+    # derivatives in centre, extent and width (central differences, step 1e-6)
+    share, *slopes = hidden_share_at(t, 0.5, extent, width, spread, profile == "box")
+    assert share == pytest.approx(float(hidden_share(t, 0.5, extent, width, spread=spread, profile=profile)),
+                                  abs=1e-14)
+    base = np.array([0.5, extent, width])
+    for i, slope in enumerate(slopes):
+        step = np.zeros(3)
+        step[i] = 1e-6
+        high = hidden_share(t, *(base + step), spread=spread, profile=profile)
+        low = hidden_share(t, *(base - step), spread=spread, profile=profile)
+        # near a disc's ends the slope goes as sqrt(1 - z^2), so the central difference is
+        # off by up to about sqrt(step) / extent there; a box profile's slope jumps at its
+        # ends: there the central difference is the mean of the two sides', the kernel's one
+        # side (the two sides differ by at most 0.25 / extent per edge)
+        kink = (2e-3 if profile == "disc" else 0.5) / extent + 1e-5
+        assert slope == pytest.approx(float(high - low) / 2e-6, abs=kink)
