@@ -38,15 +38,17 @@ def test_dips(n, seed=0):
                                               spread=spread[:, None], profile=profile)
             samples = 1.0 - (1.0 - full[:, None]) * share + noise * rng.standard_normal(times.shape)
             kinds.append((f"{profile}{'' if umbra else ' no umbra'} noise {noise}",
-                          (times, samples, centre.round(), width + 1.0, spread, profile)))
+                          (times, samples, centre.round(), width + 1.0, spread, profile),
+                          (centre - 0.5 * width - extent, centre + 0.5 * width + extent)))
     return kinds
 
 
-def fit_edges(module, dips):
+def fit_edges(module, dips, **options):
     """Edges of `module`'s fit of `dips`, and its process time (s)."""
     times, samples, centre, width, spread, profile = dips
     start = time.process_time()
-    fit = module.fit_penumbra_law(times, samples, centre=centre, width=width, spread=spread, profile=profile)
+    fit = module.fit_penumbra_law(times, samples, centre=centre, width=width, spread=spread, profile=profile,
+                                  **options)
     used = time.process_time() - start
     return module.law_edges(fit), used
 
@@ -55,23 +57,26 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--pixels", type=int, default=2000, help="dips per kind (6 kinds)")
     parser.add_argument("--reference", help="another version's penumbra_law.py to compare with")
+    parser.add_argument("--starts", type=int, help="this version's grid points refined (default: its own)")
     args = parser.parse_args()
     modules = {"this": penumbra_law}
     if args.reference:
         spec = importlib.util.spec_from_file_location("reference_penumbra_law", args.reference)
         modules["reference"] = importlib.util.module_from_spec(spec)
         spec.loader.exec_module(modules["reference"])
+    options = {"this": {} if args.starts is None else {"starts": args.starts}, "reference": {}}
     kinds = test_dips(args.pixels)
-    for module in modules.values():
-        fit_edges(module, (kinds[0][1][0][:8],) + tuple(a[:8] if isinstance(a, np.ndarray) else a
-                                                          for a in kinds[0][1][1:]))  # warm-up
+    for key, module in modules.items():
+        fit_edges(module, tuple(a[:8] if isinstance(a, np.ndarray) else a for a in kinds[0][1]),
+                  **options[key])  # warm-up
     total = dict.fromkeys(modules, 0.0)
-    for name, dips in kinds:
+    for name, dips, (first, last) in kinds:
         edges = {}
         for key, module in modules.items():
-            edges[key], used = fit_edges(module, dips)
+            edges[key], used = fit_edges(module, dips, **options[key])
             total[key] += used
-        line = f"{name:24s}"
+        error = np.abs(np.concatenate([edges["this"]["first"] - first, edges["this"]["last"] - last]))
+        line = f"{name:24s} first/last error p95 {np.percentile(error, 95):.3f} max {error.max():.3f}"
         if args.reference:
             for edge in ("first", "last", "entry", "exit"):
                 a, b = edges["this"][edge], edges["reference"][edge]

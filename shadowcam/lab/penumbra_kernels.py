@@ -1,23 +1,21 @@
 """Compiled per-pixel fit of the penumbra law (numba, ``prange`` over pixels).
 
-Each pixel's fit is the arithmetic of :func:`shadowcam.lab.penumbra_law.fit_penumbra_law`
-done pixel by pixel: the same grid start, the same damped Gauss-Newton steps on the
-residual with lit and full solved inside, the same forward-difference Jacobian. The sums
-run in frame order (numpy sums pairwise) and the 3 x 3 damped systems are solved by their
-inverse where it is well conditioned, so the results equal the numpy formulation's to
-rounding, not bit for bit. Samples outside a pixel's penumbrae cost no ``arcsin``.
+Each pixel's fit of :func:`shadowcam.lab.penumbra_law.fit_penumbra_law`: the grid start
+(its best points kept), damped Gauss-Newton from each of them on the residual with lit and
+full solved inside, the lowest residual kept. The Jacobian is the forward difference of
+that residual with the share moved along its exact slopes (one ``arcsin`` pass per step,
+not four), samples beyond a law's penumbrae cost none, and the steps stop once one moves
+every parameter by less than a given fraction. Sums run in frame order.
 
 Offers
 ------
-hidden_share_at : the law's hidden share of one pixel at one frame (compiled, scalar).
-fit_laws : per pixel, the law's parameters, levels, residual and covariance.
+hidden_share_at : the law's hidden share of one pixel at one frame and its slopes (scalars).
+fit_laws : per pixel, the law's parameters, levels, sum of squares and normal matrix.
 """
 
 import numba as nb
 import numpy as np
 
-#: profile codes of the kernels (keys of ``penumbra_law.PROFILES``)
-PROFILE_CODES = {"disc": 0, "box": 1}
 _STEP = 1e-6  # forward-difference step, relative to max(1, |parameter|)
 
 
@@ -86,6 +84,26 @@ def _shares(times, centre, extent, width, spread, box, share, slopes):
             slopes[j, 2] = dw
 
 
+@nb.njit(cache=True, inline="always", error_model="numpy")
+def _solve_levels(aa, ab, bb, ay, by):
+    """Least-squares lit and full (>= 0) of ``lit a + full b`` from the sums of ``a a``,
+    ``a b``, ``b b``, ``a y``, ``b y`` (a = 1 - F, b = F)."""
+    det = aa * bb - ab * ab
+    lit = (bb * ay - ab * by) / det
+    full = (aa * by - ab * ay) / det
+    # no sample in the dip's hidden part, or a negative full level: full = 0 (or lit) and
+    # lit alone by least squares
+    flat = not (abs(det) > 1e-12 * max(aa * bb, 1e-300))
+    dark = (not flat) and not (full >= 0.0)
+    if flat or dark:
+        lit = ay / max(aa, 1e-300)
+    if flat:
+        full = lit
+    elif dark:
+        full = 0.0
+    return lit, full
+
+
 @nb.njit(cache=True, error_model="numpy")
 def _levels(share, samples, residual):
     """Least-squares lit and full (>= 0) of ``lit (1 - F) + full F`` for one pixel's
@@ -104,19 +122,7 @@ def _levels(share, samples, residual):
         bb += b * b
         ay += a * y
         by += b * y
-    det = aa * bb - ab * ab
-    lit = (bb * ay - ab * by) / det
-    full = (aa * by - ab * ay) / det
-    # no sample in the dip's hidden part, or a negative full level: full = 0 (or lit) and
-    # lit alone by least squares
-    flat = not (abs(det) > 1e-12 * max(aa * bb, 1e-300))
-    dark = (not flat) and not (full >= 0.0)
-    if flat or dark:
-        lit = ay / max(aa, 1e-300)
-    if flat:
-        full = lit
-    elif dark:
-        full = 0.0
+    lit, full = _solve_levels(aa, ab, bb, ay, by)
     cost = 0.0
     for j in range(share.shape[0]):
         r = samples[j] - lit * (1.0 - share[j]) - full * share[j]
@@ -190,9 +196,44 @@ def _pseudo_inverse(matrix):
     return np.linalg.pinv(matrix)
 
 
+@nb.njit(cache=True, error_model="numpy")
+def _refine(t, y, params, cost, spread, box, iterations, floor, converged, work, jacobian, normal, gradient):
+    """Damped Gauss-Newton steps of one pixel's law from `params` (3,), in place; returns
+    the sum of squares reached (`cost`: at the start)."""
+    no_slopes = np.empty((0, 3))
+    trial = np.empty(3)
+    damping = 1e-3
+    for _ in range(iterations):
+        _normal_equations(t, y, params, spread, box, work, jacobian, normal, gradient)
+        system = normal.copy()
+        for i in range(3):
+            system[i, i] += damping * (normal[i, i] + 1e-12)
+        inverse = _pseudo_inverse(system)
+        largest = 0.0
+        for i in range(3):
+            step = -(inverse[i, 0] * gradient[0] + inverse[i, 1] * gradient[1] + inverse[i, 2] * gradient[2])
+            step = step if np.isfinite(step) else 0.0
+            trial[i] = params[i] + step
+            largest = max(largest, abs(step) / max(1.0, abs(params[i])))
+        trial[1] = max(trial[1], floor)
+        trial[2] = max(trial[2], floor)
+        _shares(t, trial[0], trial[1], trial[2], spread, box, work[1], no_slopes)
+        trial_cost = _levels(work[1], y, work[0])[2]
+        if trial_cost < cost:
+            params[:] = trial
+            cost = trial_cost
+            damping = damping / 3.0
+        else:
+            damping = damping * 4.0
+        damping = min(max(damping, 1e-9), 1e9)
+        if largest < converged:
+            break  # the steps left move the parameters by less than this, relative
+    return cost
+
+
 @nb.njit(cache=True, parallel=True, error_model="numpy")
 def fit_laws(times, samples, valid, centre0, width0, spread, box, extent_ratios, width_ratios, iterations, floor,
-             converged):
+             converged, starts):
     """Fit the law to each pixel's samples: grid start, then damped Gauss-Newton.
 
     Parameters
@@ -212,6 +253,9 @@ def fit_laws(times, samples, valid, centre0, width0, spread, box, extent_ratios,
     converged : float
         The steps stop once a step moves every parameter by less than this, relative to
         ``max(1, |parameter|)`` (0: all `iterations` steps).
+    starts : int
+        The grid's best points refined; the lowest residual reached is kept (the best
+        grid point's on ties).
 
     Returns
     -------
@@ -238,48 +282,40 @@ def fit_laws(times, samples, valid, centre0, width0, spread, box, extent_ratios,
         jacobian = np.empty((len(held), 3))
         normal = np.empty((3, 3))
         gradient = np.empty(3)
-        params = np.empty(3)
-        trial = np.empty(3)
-        params[0] = centre0[p]
-        params[1] = extent_ratios[0] * width0[p]
-        params[2] = width_ratios[0] * width0[p]
-        cost = np.inf
+        # the grid's `starts` best points, best first
+        start_cost = np.full(starts, np.inf)
+        start_extent = np.full(starts, extent_ratios[0] * width0[p])
+        start_width = np.full(starts, width_ratios[0] * width0[p])
         for er in extent_ratios:
             for wr in width_ratios:
                 extent = er * width0[p]
                 width = wr * width0[p]
                 _shares(t, centre0[p], extent, width, s, box, work[1], no_slopes)
                 c = _levels(work[1], y, work[0])[2]
-                if c < cost:
-                    params[1] = extent
-                    params[2] = width
-                    cost = c
-        damping = 1e-3
-        for _ in range(iterations):
-            _normal_equations(t, y, params, s, box, work, jacobian, normal, gradient)
-            system = normal.copy()
-            for i in range(3):
-                system[i, i] += damping * (normal[i, i] + 1e-12)
-            inverse = _pseudo_inverse(system)
-            largest = 0.0
-            for i in range(3):
-                step = -(inverse[i, 0] * gradient[0] + inverse[i, 1] * gradient[1] + inverse[i, 2] * gradient[2])
-                step = step if np.isfinite(step) else 0.0
-                trial[i] = params[i] + step
-                largest = max(largest, abs(step) / max(1.0, abs(params[i])))
-            trial[1] = max(trial[1], floor)
-            trial[2] = max(trial[2], floor)
-            _shares(t, trial[0], trial[1], trial[2], s, box, work[1], no_slopes)
-            trial_cost = _levels(work[1], y, work[0])[2]
-            if trial_cost < cost:
+                i = starts
+                while i > 0 and c < start_cost[i - 1]:
+                    i -= 1
+                if i < starts:
+                    start_cost[i + 1:] = start_cost[i:-1].copy()
+                    start_extent[i + 1:] = start_extent[i:-1].copy()
+                    start_width[i + 1:] = start_width[i:-1].copy()
+                    start_cost[i] = c
+                    start_extent[i] = extent
+                    start_width[i] = width
+        params = np.empty(3)
+        trial = np.empty(3)
+        cost = np.inf
+        for start in range(starts):
+            if start > 0 and not np.isfinite(start_cost[start]):
+                break
+            trial[0] = centre0[p]
+            trial[1] = start_extent[start]
+            trial[2] = start_width[start]
+            refined = _refine(t, y, trial, start_cost[start], s, box, iterations, floor, converged, work,
+                              jacobian, normal, gradient)
+            if start == 0 or refined < cost:
                 params[:] = trial
-                cost = trial_cost
-                damping = damping / 3.0
-            else:
-                damping = damping * 4.0
-            damping = min(max(damping, 1e-9), 1e9)
-            if largest < converged:
-                break  # the steps left move the parameters by less than this, relative
+                cost = refined
         _shares(t, params[0], params[1], params[2], s, box, work[1], no_slopes)
         lit, full, cost = _levels(work[1], y, work[0])
         _normal_equations(t, y, params, s, box, work, jacobian, normal, gradient)

@@ -14,7 +14,8 @@ points' times about the centre's by ``spread`` frames (standard deviation): the 
 F averaged over the two times ``t -+ spread`` (the symmetric two-point kernel of that
 variance; exact for two sub-samples along the sweep). The fit
 (:func:`fit_penumbra_law`) finds centre, extent and width by damped Gauss-Newton on the
-samples, with lit and full (>= 0) solved exactly (linear) at each step: first contact
+samples from the grid start's best points, with lit and full (>= 0) solved exactly (linear)
+at each step, pixel by pixel in :mod:`shadowcam.lab.penumbra_kernels`: first contact
 ``centre - width/2 - extent`` and last release ``centre + width/2 + extent`` (the
 source's extreme points seen through the wire's edges) and the half-hidden crossings
 follow from the shape, and a dip without umbra gets its full-occlusion level.
@@ -24,6 +25,7 @@ Offers
 PROFILES : source profiles -> share of the source below a normalised coordinate.
 disc_share_below : share of the unit disc below a coordinate (circular segment).
 hidden_share : F(t) of the law, with the footprint's two-point spread.
+GRID_EXTENT_RATIOS, GRID_WIDTH_RATIOS : the fit's grid start, in units of the starting width.
 fit_penumbra_law : per pixel, the law's parameters from the samples of its dip.
 law_edges : first contact, last release and the half-hidden crossings of fitted laws.
 dips_are_wide : whether a sweep's dips are wider than the tracker's window (the law applies).
@@ -128,7 +130,8 @@ GRID_EXTENT_RATIOS = np.geomspace(0.03, 1.2, 12)
 GRID_WIDTH_RATIOS = np.linspace(0.2, 1.3, 12)
 
 
-def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc", iterations=40, converged=1e-10):
+def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc", iterations=40, converged=1e-10,
+                     starts=2):
     """Fit the law of :func:`hidden_share` to each pixel's dip samples.
 
     Parameters
@@ -147,6 +150,8 @@ def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc
     converged : float, optional
         The steps stop once one moves every parameter by less than this, relative to
         ``max(1, |parameter|)`` (0: all `iterations`).
+    starts : int, optional
+        The grid's best points refined, the lowest residual reached kept.
 
     Returns
     -------
@@ -162,7 +167,7 @@ def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc
         np.ascontiguousarray(times), np.ascontiguousarray(samples), np.ascontiguousarray(valid),
         np.ascontiguousarray(centre, dtype=np.float64),
         np.maximum(np.asarray(width, dtype=np.float64), 0.5), np.ascontiguousarray(spread),
-        profile == "box", GRID_EXTENT_RATIOS, GRID_WIDTH_RATIOS, int(iterations), 1e-3, float(converged))
+        profile == "box", GRID_EXTENT_RATIOS, GRID_WIDTH_RATIOS, int(iterations), 1e-3, float(converged), int(starts))
     count = valid.sum(1)
     rms = np.sqrt(sum_squares / np.maximum(count, 1))
     # five parameters (lit and full solved inside): the residual's variance per sample

@@ -60,9 +60,10 @@ def test_the_fit_finds_the_outer_edges_of_noise_free_samples(centre, extent, wid
     # an umbra (width >= 2 extent), the samples at whole frames (an instant exposure). A
     # penumbra under about a frame is not identifiable from them: with its edge on a frame,
     # any extent below 1 gives the same samples (0, 1/2, 1 at the three frames around it).
-    # 321 random such dips (np.random seed 2): first / last exact (p95 < 1e-4) for both
-    # profiles, max 0.118 / 0.127 frame (disc) and 0.105 / 0.104 (box) where the fit ends in
-    # a near-equal minimum; bound 0.15. A box source under the box strip is symmetric in
+    # 500 random such dips per profile (scripts/benchmark_penumbra_fit.py): first / last
+    # exact (p95 < 1e-3), max 0.000 (disc) and 0.040 frame (box) from the grid's two best
+    # points; from the best alone 0.181 and 0.133, where the fit ends on the bound full = 0
+    # (e.g. c 18, a 2, w 4.75, full 0.19); bound 0.15. A box source under the box strip is symmetric in
     # extent and half width (the full level taking up the plateau): its outer edges, c -+
     # (extent + width / 2), are the same for both, its half-hidden crossings are not (p95 0.49)
     assume(width >= 2 * extent)
