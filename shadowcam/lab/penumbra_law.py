@@ -14,7 +14,8 @@ points' times about the centre's by ``spread`` frames (standard deviation): the 
 F averaged over the two times ``t -+ spread`` (the symmetric two-point kernel of that
 variance; exact for two sub-samples along the sweep). The fit
 (:func:`fit_penumbra_law`) finds centre, extent and width by damped Gauss-Newton on the
-samples, with lit and full (>= 0) solved exactly (linear) at each step: first contact
+samples from the grid start's best points, with lit and full (>= 0) solved exactly (linear)
+at each step, pixel by pixel in :mod:`shadowcam.lab.penumbra_kernels`: first contact
 ``centre - width/2 - extent`` and last release ``centre + width/2 + extent`` (the
 source's extreme points seen through the wire's edges) and the half-hidden crossings
 follow from the shape, and a dip without umbra gets its full-occlusion level.
@@ -24,6 +25,7 @@ Offers
 PROFILES : source profiles -> share of the source below a normalised coordinate.
 disc_share_below : share of the unit disc below a coordinate (circular segment).
 hidden_share : F(t) of the law, with the footprint's two-point spread.
+GRID_EXTENT_RATIOS, GRID_WIDTH_RATIOS : the fit's grid start, in units of the starting width.
 fit_penumbra_law : per pixel, the law's parameters from the samples of its dip.
 law_edges : first contact, last release and the half-hidden crossings of fitted laws.
 dips_are_wide : whether a sweep's dips are wider than the tracker's window (the law applies).
@@ -39,6 +41,7 @@ import numpy as np
 
 from shadowcam._shared.validation import check_in
 from shadowcam.lab.dip_classification import OK
+from shadowcam.lab.penumbra_kernels import fit_laws
 
 log = logging.getLogger(__name__)
 
@@ -122,35 +125,13 @@ class LawFit:
     profile: str = "disc"
 
 
-def _levels(share, samples, valid):
-    """Least-squares lit and full (>= 0) of ``lit (1 - F) + full F`` per row, and the residual."""
-    a, b = np.where(valid, 1.0 - share, 0.0), np.where(valid, share, 0.0)
-    y = np.where(valid, samples, 0.0)
-    aa, ab, bb = (a * a).sum(1), (a * b).sum(1), (b * b).sum(1)
-    ay, by = (a * y).sum(1), (b * y).sum(1)
-    det = aa * bb - ab * ab
-    with np.errstate(invalid="ignore", divide="ignore"):
-        lit = (bb * ay - ab * by) / det
-        full = (aa * by - ab * ay) / det
-    # no sample in the dip's hidden part, or a negative full level (the light left with the
-    # whole source hidden cannot be): full = 0 (or lit) and lit alone by least squares
-    flat = ~(np.abs(det) > 1e-12 * np.maximum(aa * bb, 1e-300))
-    dark = ~flat & ~(full >= 0)
-    alone = ay / np.maximum(aa, 1e-300)
-    lit = np.where(flat | dark, alone, lit)
-    full = np.where(flat, lit, np.where(dark, 0.0, full))
-    residual = np.where(valid, y - lit[:, None] * a - full[:, None] * b, 0.0)
-    return lit, full, residual
+#: the fit's grid start: extents and widths in proportion to the starting (half-depth) width
+GRID_EXTENT_RATIOS = np.geomspace(0.03, 1.2, 12)
+GRID_WIDTH_RATIOS = np.linspace(0.2, 1.3, 12)
 
 
-def _residual(params, times, samples, valid, spread, profile):
-    centre, extent, width = params.T
-    share = hidden_share(times, centre[:, None], extent[:, None], width[:, None], spread=spread[:, None],
-                         profile=profile)
-    return _levels(share, samples, valid)
-
-
-def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc", iterations=40):
+def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc", iterations=40, converged=1e-10,
+                     starts=2):
     """Fit the law of :func:`hidden_share` to each pixel's dip samples.
 
     Parameters
@@ -165,7 +146,12 @@ def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc
         Footprint spread in frames (:func:`hidden_share`).
     profile : {"disc", "box"}, optional
     iterations : int, optional
-        Damped Gauss-Newton steps after a coarse grid of extents and widths.
+        Most damped Gauss-Newton steps after a coarse grid of extents and widths.
+    converged : float, optional
+        The steps stop once one moves every parameter by less than this, relative to
+        ``max(1, |parameter|)`` (0: all `iterations`).
+    starts : int, optional
+        The grid's best points refined, the lowest residual reached kept.
 
     Returns
     -------
@@ -175,60 +161,23 @@ def fit_penumbra_law(times, samples, *, centre, width, spread=0.0, profile="disc
     times = np.asarray(times, dtype=np.float64)
     samples = np.asarray(samples, dtype=np.float64)
     valid = np.isfinite(times) & np.isfinite(samples)
-    times = np.where(valid, times, 0.0)
     n = len(times)
-    centre0 = np.asarray(centre, dtype=np.float64)
-    width0 = np.maximum(np.asarray(width, dtype=np.float64), 0.5)
-    spread = np.broadcast_to(np.asarray(spread, dtype=np.float64), (n,)).copy()
-    floor = 1e-3
-    # coarse start: extents and widths in proportion to the half-depth width
-    best, best_cost = None, np.full(n, np.inf)
-    for extent_ratio in np.geomspace(0.03, 1.2, 12):
-        for width_ratio in np.linspace(0.2, 1.3, 12):
-            params = np.column_stack([centre0, extent_ratio * width0, width_ratio * width0])
-            cost = (_residual(params, times, samples, valid, spread, profile)[2] ** 2).sum(1)
-            better = cost < best_cost
-            best = params if best is None else np.where(better[:, None], params, best)
-            best_cost = np.where(better, cost, best_cost)
-    params, cost, damping = best, best_cost, np.full(n, 1e-3)
-    for _ in range(iterations):
-        residual, normal, jacobian = _linearised(params, times, samples, valid, spread, profile)
-        gradient = np.einsum("nki,nk->ni", jacobian, residual)
-        diagonal = np.einsum("nii->ni", normal)
-        system = normal + (damping[:, None] * (diagonal + 1e-12))[:, :, None] * np.eye(3)
-        step = np.einsum("nij,nj->ni", np.linalg.pinv(system), -gradient)  # a singular pixel alone
-        trial = params + np.where(np.isfinite(step), step, 0.0)
-        trial[:, 1:] = np.maximum(trial[:, 1:], floor)
-        trial_cost = (_residual(trial, times, samples, valid, spread, profile)[2] ** 2).sum(1)
-        better = trial_cost < cost
-        params = np.where(better[:, None], trial, params)
-        cost = np.where(better, trial_cost, cost)
-        damping = np.clip(np.where(better, damping / 3.0, damping * 4.0), 1e-9, 1e9)
-    lit, full, residual = _residual(params, times, samples, valid, spread, profile)
+    spread = np.broadcast_to(np.asarray(spread, dtype=np.float64), (n,))
+    params, lit, full, sum_squares, normal = fit_laws(
+        np.ascontiguousarray(times), np.ascontiguousarray(samples), np.ascontiguousarray(valid),
+        np.ascontiguousarray(centre, dtype=np.float64),
+        np.maximum(np.asarray(width, dtype=np.float64), 0.5), np.ascontiguousarray(spread),
+        profile == "box", GRID_EXTENT_RATIOS, GRID_WIDTH_RATIOS, int(iterations), 1e-3, float(converged), int(starts))
     count = valid.sum(1)
-    rms = np.sqrt((residual ** 2).sum(1) / np.maximum(count, 1))
+    rms = np.sqrt(sum_squares / np.maximum(count, 1))
     # five parameters (lit and full solved inside): the residual's variance per sample
-    variance = (residual ** 2).sum(1) / np.maximum(count - 5, 1)
-    normal = _linearised(params, times, samples, valid, spread, profile)[1]
+    variance = sum_squares / np.maximum(count - 5, 1)
     covariance = np.linalg.pinv(normal) * variance[:, None, None]
     fitted = count >= 6
     nan = np.where(fitted, 1.0, np.nan)
     return LawFit(centre=params[:, 0] * nan, extent=params[:, 1] * nan, width=params[:, 2] * nan,
                   lit=lit * nan, full=full * nan, rms=rms * nan, covariance=covariance * nan[:, None, None],
                   profile=profile)
-
-
-def _linearised(params, times, samples, valid, spread, profile):
-    """Residual (N, K), normal matrix (N, 3, 3) and Jacobian (N, K, 3) of the projected
-    residual in (centre, extent, width), by forward differences."""
-    residual = _residual(params, times, samples, valid, spread, profile)[2]
-    jacobian = np.empty(residual.shape + (3,))
-    for j in range(3):
-        moved = params.copy()
-        moved[:, j] += 1e-6 * np.maximum(1.0, np.abs(params[:, j]))
-        jacobian[..., j] = (_residual(moved, times, samples, valid, spread, profile)[2] - residual) \
-            / (moved[:, j] - params[:, j])[:, None]
-    return residual, np.einsum("nki,nkj->nij", jacobian, jacobian), jacobian
 
 
 def law_edges(fit, *, share=0.5, iterations=50):
