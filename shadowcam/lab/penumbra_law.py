@@ -289,8 +289,9 @@ def penumbra_edges(read, results, *, n_frames, half_window, footprint_variance=N
     results : dict of (H, W) ndarray
         A sweep's shadow times with the interval (:func:`shadowcam.lab.shadow_time.shadow_times`).
     n_frames, half_window : int
-    footprint_variance : float, optional
-        Per-axis second moment of a pixel's footprint, px^2.
+    footprint_variance : float or (H, W) array_like, optional
+        Per-axis second moment of a pixel's footprint, px^2 (per pixel: a RAW sweep's
+        channel sum adds its demosaic taps').
     profile : {"disc", "box"}, optional
         Default: the one that fits the sweep best (:func:`choose_profile`).
 
@@ -314,7 +315,9 @@ def penumbra_edges(read, results, *, n_frames, half_window, footprint_variance=N
     times, samples = _dip_samples(read(), rows, cols, first_frame, (last[rows, cols] - first_frame + 1).astype(np.int64))
     gradient = np.hypot(*np.gradient(results["shadow_time"].astype(np.float64)))
     gradient = np.where(np.isfinite(gradient), gradient, np.nanmedian(gradient) if np.isfinite(gradient).any() else 0.0)
-    spread = np.sqrt(footprint_variance or 0.0) * gradient[rows, cols]
+    variance = np.broadcast_to(np.asarray(0.0 if footprint_variance is None else footprint_variance, np.float64),
+                               entry.shape)
+    spread = np.sqrt(variance[rows, cols]) * gradient[rows, cols]
     centre, width = 0.5 * (entry + exit_)[rows, cols], width[rows, cols]
     if profile is None and len(rows):
         profile = choose_profile(times, samples, centre=centre, width=width, spread=spread)

@@ -43,7 +43,7 @@ from shadowcam.lab.dip_classification import (
 from shadowcam.lab.dip_tracker import DipTracker, lit_colour, track_intervals, without_interval
 from shadowcam.lab.penumbra_law import penumbra_edges
 from shadowcam.lab.shadow_time_methods import SHADOW_TIME_METHODS
-from shadowcam.lab.site_signal import cfa_site_colours, track_site_window
+from shadowcam.lab.site_signal import blend_variance, cfa_site_colours, track_site_window
 from shadowcam.lab.timing_kernels import neighbour_median, removed_light
 
 log = logging.getLogger(__name__)
@@ -547,7 +547,8 @@ def measured_shadow_times(summary, *, read, method="edge_fit", cfa_pattern=None,
     :func:`summary_shadow_times`; where the sweep's dips are wider than the window, their
     outer edges and half-hidden crossings from the penumbra law
     (:func:`shadowcam.lab.penumbra_law.penumbra_edges`, with ``method_params``'
-    ``footprint_variance``).
+    ``footprint_variance``, for RAW plus the demosaic taps' second moment,
+    :func:`shadowcam.lab.site_signal.blend_variance`).
 
     Parameters
     ----------
@@ -575,8 +576,11 @@ def measured_shadow_times(summary, *, read, method="edge_fit", cfa_pattern=None,
     results = summary_shadow_times(summary, method=method, cfa_pattern=cfa_pattern or None, interval=interval,
                                    read=read, own_site=own_site, site_window=site_window if own_site else None,
                                    method_params=method_params, classify_params=classify_params)
+    variance = (method_params or {}).get("footprint_variance")
+    if cfa_pattern:  # the law is fitted to the demosaic's channel sum: its taps widen each footprint
+        variance = (variance or 0.0) + blend_variance(cfa_site_colours(summary.lit_level.shape, cfa_pattern))
     results.update(penumbra_edges(read, results, n_frames=summary.n_frames, half_window=summary.half_window,
-                                  footprint_variance=(method_params or {}).get("footprint_variance")))
+                                  footprint_variance=variance))
     return results
 
 
