@@ -150,6 +150,25 @@ def test_penumbra_edges_of_a_planar_sweep_of_wide_dips():
     np.testing.assert_allclose(out["interval_exit"], centre + 4.0, atol=1e-4)
 
 
+def test_a_per_pixel_footprint_is_each_pixels_spread():
+    # a RAW sweep's footprint differs by CFA site (the demosaic's taps): half the columns are
+    # rendered with a wider footprint; each fits its own spread only when given per pixel
+    rows, cols, frames = 4, 8, 48
+    centre = 18.0 + np.tile(np.arange(cols, dtype=np.float64), (rows, 1))
+    var = np.where(np.arange(cols) % 2 == 0, 1.0 / 16.0, 0.5)[None, :] * np.ones((rows, 1))
+    t = np.arange(frames, dtype=np.float64)[:, None, None]
+    signal = 2.0 - 2.0 * hidden_share(t, centre, 3.0, 8.0, spread=np.sqrt(var))
+    results = {"interval_entry": (centre - 4.3).astype(np.float32), "interval_exit": (centre + 4.2).astype(np.float32),
+               "reason": np.full((rows, cols), OK, np.uint8), "shadow_time": centre.astype(np.float32)}
+    read = lambda: [signal]  # noqa: E731
+    per_pixel = penumbra_edges(read, results, n_frames=frames, half_window=4, footprint_variance=var)
+    np.testing.assert_allclose(per_pixel["penumbra_first"], centre - 7.0, atol=1e-4)
+    np.testing.assert_allclose(per_pixel["penumbra_last"], centre + 7.0, atol=1e-4)
+    # one spread for all: the wider footprints' dips are taken for a wider source
+    common = penumbra_edges(read, results, n_frames=frames, half_window=4, footprint_variance=1.0 / 16.0)
+    assert np.all(common["penumbra_first"][:, 1::2] < centre[:, 1::2] - 7.0 - 0.05)
+
+
 @pytest.mark.parametrize("profile", ["disc", "box"])
 def test_the_sweep_takes_the_profile_that_fits_its_dips(profile):
     # every point of a sweep sees the same source: its dips choose the profile (a disc or
