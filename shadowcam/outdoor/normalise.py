@@ -43,6 +43,7 @@ the merge turns them into the cloud's shade field over the frame (``shade_field`
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.outdoor.clipping import clipped_lit_levels, clipped_samples
 from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
 from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, reference_levels,
@@ -167,6 +168,8 @@ class SequenceNormaliser:
         self._reference_levels = reference_levels(
             self._small_reference, levels=pyramid_levels(self._small_reference.shape, levels=self._registration_levels))
         self._small_lit = block_all(self.lit_at_start, self.factor)
+        # the lit pixels whose reading is their level: a clipped one's is a lower bound of its light
+        self._small_measured = block_all(self.lit_at_start & ~clipped_samples(frame), self.factor)
         self._small_valid = block_all(~self._sky, self.factor)
         self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
         self._row_edges, self._col_edges, self.shade_rows, self.shade_cols = block_grid(
@@ -194,7 +197,7 @@ class SequenceNormaliser:
         of the blocks' `levels`); see :data:`GAIN_SOURCES`."""
         ref = self._small_reference
         if not self._small_shadowed.any():
-            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_measured, prior=rough)
             return gain_lit, gain_lit, kept, 2
         gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed, prior=last_sky * rough / last_gain)
         expected = None if self._lit_to_sky is None else gain_sky * self._lit_to_sky
@@ -203,14 +206,14 @@ class SequenceNormaliser:
             # no cloud brightens a block: the brightest block's level is the unclouded one, where
             # the unclouded blocks hold a population at or above the expected level
             blocks = np.repeat(np.repeat(unclouded, np.diff(self._row_edges), axis=0), np.diff(self._col_edges), axis=1)
-            _, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit & blocks, expected=expected)
+            _, kept, found = estimate_lit_gain(small, ref, pixels=self._small_measured & blocks, expected=expected)
             if found:
                 gain_lit = float(np.nanmax(levels))
                 self._lit_to_sky = gain_lit / gain_sky
                 return gain_lit, gain_sky, kept, 0
-        gain_lit, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit, expected=expected)
+        gain_lit, kept, found = estimate_lit_gain(small, ref, pixels=self._small_measured, expected=expected)
         if not np.isfinite(gain_lit):  # too few lit pixels and no ratio yet
-            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_measured, prior=rough)
             return gain_lit, gain_sky, kept, 2
         self._lit_to_sky = gain_lit / gain_sky
         return gain_lit, gain_sky, kept, 0 if found else 1
@@ -234,8 +237,8 @@ class SequenceNormaliser:
         if k == 0:
             self._start(frame)
             shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
-            kept, source, rough = int(self._small_lit.sum()), 0, 1.0
-            levels = block_levels(self._small_reference, self._small_reference, pixels=self._small_lit,
+            kept, source, rough = int(self._small_measured.sum()), 0, 1.0
+            levels = block_levels(self._small_reference, self._small_reference, pixels=self._small_measured,
                                   row_edges=self._row_edges, col_edges=self._col_edges,
                                   reached_below=SHADOWED_CONTRAST)
         else:
@@ -245,7 +248,7 @@ class SequenceNormaliser:
             raw = luminance(frame) if frame.ndim == 3 else frame
             factor, ref = self.factor, self._small_reference
             small = block_mean(raw, factor)
-            rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
+            rough, _ = estimate_gain(small, ref, pixels=self._small_measured, prior=self._prior(last_gain, k))
             weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
                                    margin=self._registration_margin)
             shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
@@ -255,7 +258,7 @@ class SequenceNormaliser:
             spare = self._recent.pop(0) if len(self._recent) == 3 else None
             luma, small = translate_with_block_means(raw, shift, factor=factor, out=spare)
             del raw
-            levels = block_levels(small, ref, pixels=self._small_lit, row_edges=self._row_edges,
+            levels = block_levels(small, ref, pixels=self._small_measured, row_edges=self._row_edges,
                                   col_edges=self._col_edges, reached_below=SHADOWED_CONTRAST * rough,
                                   dark=self._small_valid & ~self._small_lit, reach=self._penumbra_reach(small, rough))
             gain_lit, gain_sky, kept, source = self._gains(small, rough, last_gain, last_sky, levels)
@@ -361,9 +364,13 @@ class PartMerger:
         with np.errstate(divide="ignore", invalid="ignore"):
             contrast = np.where(ref > 0, shadow_min * to_lit / ref, np.inf)
         shadowed = lit & (contrast < SHADOWED_CONTRAST)
-        ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
+        clipped = clipped_samples(self._reference) & lit  # their reading is a lower bound of their light
+        measured = shadowed & ~clipped
+        ratio = float(np.median(contrast[measured])) if measured.any() else 0.1
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref / to_lit)
         lit_level = np.where(lit, ref, shadow_min * to_lit / ratio)
+        lit_level = clipped_lit_levels(lit_level, shadow_min * to_lit, clipped=clipped & shadowed, trusted=shadowed,
+                                       fallback_ratio=1.0 / ratio)
         shade, field = cloud_shades(curves["gain_median"], curves["gain_lit"], curves["gain_source"],
                                     curves["shade_levels"], shadow_ratio=ratio)
         return {
