@@ -12,6 +12,7 @@ reached their shadow give that ratio ``R`` and its own shadow level ``S`` (never
 Offers
 ------
 WHITE_LEVEL : the decoded value of the RAW white level.
+store_white_level : the decoded white level of a frame store (None: its values carry none).
 CLIPPED_SHARE : a clipped sample's share in a registered sample that makes its reading no level.
 LIT_RATIO_RADIUS : pixels each side whose lit-to-shadow ratios give a clipped pixel's.
 clipped_samples : the samples of a frame clipped in any channel.
@@ -30,6 +31,27 @@ WHITE_LEVEL = 1.0
 CLIPPED_SHARE = 1e-6
 #: pixels each side whose unclipped lit-to-shadow ratios give a clipped pixel's
 LIT_RATIO_RADIUS = 6
+
+
+def store_white_level(frames):
+    """The decoded value of a frame store's white level.
+
+    Parameters
+    ----------
+    frames : xarray.Dataset
+        Frame store; a decode from RAW (or any file with a white level) has attrs ``white_level``
+        and ``normalisation`` ``"linear; (value - black_level) / (white_level - black_level)"``
+        (:mod:`shadowcam.io.frame_store`).
+
+    Returns
+    -------
+    float or None
+        :data:`WHITE_LEVEL`, or None when the store's values are not normalised to a white level
+        (nothing is known to clip).
+    """
+    normalisation = str(frames.attrs.get("normalisation", ""))
+    known = "white_level" in frames.attrs and normalisation.startswith("linear; (value - black_level) / (white_level")
+    return WHITE_LEVEL if known else None
 
 
 def clipped_samples(frame, *, white_level=WHITE_LEVEL):

@@ -19,6 +19,7 @@ import logging
 
 from shadowcam.io.frame_store import iter_store_frames
 from shadowcam.io.frame_times import find_gaps, median_interval
+from shadowcam.outdoor.clipping import store_white_level
 from shadowcam.outdoor.datasets import edges_dataset, photometry_arrays
 from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
 from shadowcam.outdoor.photometric import luminance
@@ -79,6 +80,7 @@ def track_edges(frames, photometry, **options):
     width_rows = _edge_width(photometry, arrays)
     log.info("edge tracking: measured edge width %.1f rows", width_rows)
     tracked = track_frames(iter_store_frames(frames, what="edge tracking"), arrays, time_s, edge_width_rows=width_rows,
+                           white_level=store_white_level(frames),
                            **{k: v for k, v in options.items() if k in TRACK_OPTIONS})
     return _edges(tracked, arrays, time_s, options)
 
@@ -145,4 +147,4 @@ def track_column_strip(frames, photometry, *, index, count, **options):
              b, halo, width_rows)
     stream = iter_store_frames(frames.isel(col=slice(a, b)), what=f"edge tracking, strip {index}/{count}")
     return track_strip(stream, arrays, frames["time_s"].values, cols=cols, halo=halo, edge_width_rows=width_rows,
-                       **options)
+                       white_level=store_white_level(frames), **options)

@@ -111,11 +111,17 @@ class SequenceNormaliser:
         Frames before this index are processed (warm-up) but not recorded,
         and the running minimum uses the 3-frame windows ending at this frame
         or later; ``record_from - first_index`` must be >= 2 when ``first_index > 0``.
+    white_level : float or None, optional
+        Decoded value of the sensor's white level (:func:`shadowcam.outdoor.clipping.store_white_level`):
+        the reference's lit pixels clipped in any channel give no gain or block level, and their lit
+        level comes from their neighbours' lit-to-shadow ratio
+        (:func:`shadowcam.outdoor.clipping.clipped_lit_levels`). None: nothing is known to clip.
     """
 
     def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
                  registration_levels=2, registration_margin=6, shade_block=96, reference=None, first_index=0,
-                 record_from=0):
+                 record_from=0, white_level=None):
+        self.white_level = None if white_level is None else float(white_level)
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
@@ -169,11 +175,16 @@ class SequenceNormaliser:
             self._small_reference, levels=pyramid_levels(self._small_reference.shape, levels=self._registration_levels))
         self._small_lit = block_all(self.lit_at_start, self.factor)
         # the lit pixels whose reading is their level: a clipped one's is a lower bound of its light
-        self._small_measured = block_all(self.lit_at_start & ~clipped_samples(frame), self.factor)
+        self._small_measured = block_all(self.lit_at_start & ~self._clipped(frame), self.factor)
         self._small_valid = block_all(~self._sky, self.factor)
         self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
         self._row_edges, self._col_edges, self.shade_rows, self.shade_cols = block_grid(
             self._small_reference.shape, block=max(1, round(self._shade_block / self.factor)), factor=self.factor)
+
+    def _clipped(self, frame):
+        if self.white_level is None:
+            return np.zeros(frame.shape[:2], dtype=bool)
+        return clipped_samples(frame, white_level=self.white_level)
 
     def _penumbra_reach(self, small, rough):
         """Reduced pixels the ridge's penumbra may reach beyond its core and beyond the ground shadowed
@@ -290,7 +301,8 @@ class SequenceNormaliser:
             ``shade_levels (T_part, By, Bx)`` with ``shade_rows (By,)``, ``shade_cols (Bx,)``,
             ``shadow_min (H, W)``
             (running minimum over the part's 3-frame windows), ``sky``, ``lit_at_start``
-            ``(H, W)`` and ``reference (H, W, C)`` (frame 0; the same in every part).
+            ``(H, W)``, ``reference (H, W, C)`` (frame 0; the same in every part) and ``white_level``
+            (NaN: none known).
         """
         if not self.shifts:
             raise ValueError("no frames were recorded (feed frames up to and past record_from)")
@@ -309,6 +321,7 @@ class SequenceNormaliser:
             "sky": self._sky,
             "lit_at_start": self.lit_at_start,
             "reference": self.reference,
+            "white_level": np.nan if self.white_level is None else self.white_level,
         }
 
     def result(self):
@@ -327,6 +340,7 @@ class PartMerger:
     def __init__(self):
         self._curves = {key: [] for key in _CURVES}
         self._shadow_min = self._sky = self._lit = self._reference = None
+        self._white_level = np.nan
         self._next = 0
 
     def add(self, part):
@@ -344,6 +358,7 @@ class PartMerger:
             np.minimum(self._shadow_min, part["shadow_min"], out=self._shadow_min)
         if self._reference is None and part.get("reference") is not None:
             self._reference = part["reference"]
+            self._white_level = float(part.get("white_level", np.nan))
         self._grid = (np.asarray(part["shade_rows"]), np.asarray(part["shade_cols"]))
 
     def result(self):
@@ -364,7 +379,8 @@ class PartMerger:
         with np.errstate(divide="ignore", invalid="ignore"):
             contrast = np.where(ref > 0, shadow_min * to_lit / ref, np.inf)
         shadowed = lit & (contrast < SHADOWED_CONTRAST)
-        clipped = clipped_samples(self._reference) & lit  # their reading is a lower bound of their light
+        clipped = lit & (clipped_samples(self._reference, white_level=self._white_level)  # a lower bound of the light
+                         if np.isfinite(self._white_level) else False)
         measured = shadowed & ~clipped
         ratio = float(np.median(contrast[measured])) if measured.any() else 0.1
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref / to_lit)

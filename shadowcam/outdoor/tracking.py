@@ -96,11 +96,17 @@ class EdgeTracker:
     max_sigma : float, optional
         Largest standard error of a fitted ramp centre, in median intervals
         (:func:`shadowcam.outdoor.descent.fit_descents`).
+    white_level : float or None, optional
+        Decoded value of the sensor's white level (:func:`shadowcam.outdoor.clipping.store_white_level`):
+        a reading a clipped sample enters does not update the lit level, and a pixel whose own
+        clipped sample reads below the level at or after its final crossing gets no time (ramp state
+        ``clipped_crossing``). None: nothing is known to clip.
     """
 
     def __init__(self, photometry, time_s, *, half_window=3, min_drop=0.2, margin=2, max_step=3.0,
                  lit_update=0.3, update_distance=4.0, count_cols=None, edge_width_rows=0.0, descent_frames=128,
-                 max_sigma=1.0):
+                 max_sigma=1.0, white_level=None):
+        self.white_level = None if white_level is None else float(white_level)
         self.shift = np.asarray(photometry["shift"], dtype=np.float64)
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
@@ -164,7 +170,8 @@ class EdgeTracker:
         luma = translate(luminance(frame), self.shift[k], method="cubic_Keys1981") / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
-        clipped = registered_clipped(frame, self.shift[k])
+        clipped = None if self.white_level is None else registered_clipped(frame, self.shift[k],
+                                                                           white_level=self.white_level)
         if self.shade_field is not None and (self.shade_field[k] < 1).any():  # a cloud's shade over the frame
             cover /= interpolate_field(self.shade_field[k], row_centres=self.shade_grid[0],
                                        col_centres=self.shade_grid[1], shape=cover.shape)

@@ -319,7 +319,8 @@ def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6, push_stops
     -------
     xarray.Dataset
         ``image (time, row, col, channel)`` float32 in [0, 1], coords ``time_s`` and
-        ``exposure_s`` (4 ms times the auto-exposure steps: the metadata carries no flicker).
+        ``exposure_s`` (4 ms times the auto-exposure steps: the metadata carries no flicker);
+        attrs ``black_level``, ``white_level`` and ``normalisation`` as a decoded frame store's.
     """
     import xarray as xr
 
@@ -334,7 +335,9 @@ def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6, push_stops
                                      sensor=sensor) for k, frame in enumerate(capture.frames)])
     return xr.Dataset({"image": (("time", "row", "col", "channel"), images)},
                       coords={"time_s": ("time", capture.times_s),
-                              "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)})
+                              "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)},
+                      attrs={"black_level": sensor.black_level, "white_level": sensor.white_level,
+                             "normalisation": "linear; (value - black_level) / (white_level - black_level)"})
 
 
 def edge_speed(arrival_frame, shadow_class):
