@@ -60,8 +60,8 @@ def test_a_sunset_exposed_past_the_white_level_gives_no_confident_wrong_arrivals
     truth = capture.ground_truth
     store = noisy_frame_store(capture, seed=3, push_stops=1.5)
     assert (store["image"].values[0] >= WHITE_LEVEL).any(axis=-1).mean() > 0.3
-    photometry = photometry_from_frames(store)
-    arrival = arrival_map(photometry, track_edges(store, photometry))
+    photometry = photometry_from_frames(store, clipping=True)
+    arrival = arrival_map(photometry, track_edges(store, photometry, clipping=True))
     estimate = map_to_truth_camera(arrival["arrival_time_s"].values, shift_row=float(truth["shake_dy_px"][0]),
                                    shift_col=float(truth["shake_dx_px"][0]))
     interval = float(np.median(np.diff(capture.times_s)))
