@@ -14,9 +14,10 @@ Offers
 WHITE_LEVEL : the decoded value of the RAW white level.
 store_white_level : the decoded white level of a frame store (None: its values carry none).
 CLIPPED_SHARE : a clipped sample's share in a registered sample that makes its reading no level.
+OWN_SHARE : a clipped sample's share in a registered sample that makes it the sample's own.
 LIT_RATIO_RADIUS : pixels each side whose lit-to-shadow ratios give a clipped pixel's.
 clipped_samples : the samples of a frame clipped in any channel.
-registered_clipped : the samples of a frame registered to the reference that a clipped sample enters.
+registered_clipped : the clipped samples' share in each sample of a frame registered to the reference.
 clipped_lit_levels : the lit level of the pixels whose lit sample clips, from their neighbours' ratio.
 """
 
@@ -29,6 +30,8 @@ from shadowcam.outdoor.translation import translate
 WHITE_LEVEL = 1.0
 #: share of a clipped sample in a registered sample (the cubic kernel's) below which it is left out
 CLIPPED_SHARE = 1e-6
+#: share at or above which the registered sample is the clipped one (the nearest of the kernel's taps)
+OWN_SHARE = 0.5
 #: pixels each side whose unclipped lit-to-shadow ratios give a clipped pixel's
 LIT_RATIO_RADIUS = 6
 

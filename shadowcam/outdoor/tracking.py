@@ -32,7 +32,7 @@ track_frames : run it over an iterable of frames.
 
 import numpy as np
 
-from shadowcam.outdoor.clipping import CLIPPED_SHARE, registered_clipped
+from shadowcam.outdoor.clipping import CLIPPED_SHARE, OWN_SHARE, registered_clipped
 from shadowcam.outdoor.descent import STATE_CODE, DescentBuffer, fit_descents
 from shadowcam.outdoor.edge_tracking import column_edges
 from shadowcam.outdoor.episodes import ShadowEpisodes
@@ -191,7 +191,7 @@ class EdgeTracker:
         self._last_edge[found] = self.edge_row[k][found]
         self.episodes.update(cover, self.time_s[k])
         if clipped is not None:  # a clipped reading is a lower bound of the light: below the level, not dark
-            self._clipped_dark_s[(clipped >= 0.5) & (cover < self.episodes.level)] = self.time_s[k]
+            self._clipped_dark_s[(clipped >= OWN_SHARE) & (cover < self.episodes.level)] = self.time_s[k]
         self.descent.update(cover, dark=self.episodes.dark & np.isfinite(self.episodes.start),
                             luminance=None if self.shadow_ratio is None else shadow + cover * (self.lit_level - shadow))
         if self.lit_update > 0:
