@@ -67,6 +67,7 @@ ARRIVAL_REASONS = {
     10: "no_lit_level",
     11: "lit_ratio_spread",
     12: "arrival_before_record",
+    13: "clipped_crossing",
 }
 REASON_CODE = {name: code for code, name in ARRIVAL_REASONS.items()}
 #: event kind code -> meaning: the ridge shadow's arrival (end = relit time, NaN if it lasts),
@@ -250,7 +251,7 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
         The ramp centre where the state is one of
         :data:`shadowcam.outdoor.descent.TIMED_STATES`; NaN where it is ``cut`` (reason
         ``ramp_cut``), ``ambiguous`` (reason ``ambiguous_ramp``), ``no_lit_level``,
-        ``lit_ratio_spread`` (reasons of the same names) or ``before_record`` (reason
+        ``lit_ratio_spread``, ``clipped_crossing`` (reasons of the same names) or ``before_record`` (reason
         ``arrival_before_record``).
     reason : (H, W) uint8 ndarray
     """
@@ -264,7 +265,8 @@ def apply_ramps(arrival_s, reason, ramp_centre_s, ramp_state):
     arrival[fitted] = np.asarray(ramp_centre_s, dtype=np.float64)[fitted]
     reason[fitted] = REASON_CODE["penumbra_fit"]
     for name, code in (("cut", "ramp_cut"), ("ambiguous", "ambiguous_ramp"), ("no_lit_level", "no_lit_level"),
-                       ("lit_ratio_spread", "lit_ratio_spread"), ("before_record", "arrival_before_record")):
+                       ("lit_ratio_spread", "lit_ratio_spread"), ("before_record", "arrival_before_record"),
+                       ("clipped_crossing", "clipped_crossing")):
         where = final & (state == STATE_CODE[name])
         arrival[where] = np.nan
         reason[where] = REASON_CODE[code]

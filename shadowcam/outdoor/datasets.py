@@ -132,7 +132,7 @@ def photometry_part_dataset(part, time_s, *, exposure_gain=None, sky_source="aut
         ``shift_col``, ``gain``; ``gain_sky``, ``kept_lit``, ``gain_source``, ``gain_median``, ``exposure_gain``; over
         ``(row, col)``: ``shadow_min`` (linear), ``sky``, ``lit_at_start``;
         ``reference (row, col, channel)`` only in the part holding frame 0.
-        Attrs ``first_frame``, ``sky_source``.
+        Attrs ``first_frame``, ``sky_source``, ``white_level`` (decoded; NaN: none known).
     """
     n_frames = len(part["gain_lit"])
     first = int(part["first_frame"])
@@ -143,7 +143,7 @@ def photometry_part_dataset(part, time_s, *, exposure_gain=None, sky_source="aut
                              {"units": "linear", "long_name": "minimum of 3-frame smoothed luminance / gain_sky over the part"})
     if first != 0:
         dataset = dataset.drop_vars(["reference", "channel"])
-    dataset.attrs.update(first_frame=first)
+    dataset.attrs.update(first_frame=first, white_level=float(part.get("white_level", np.nan)))
     del dataset.attrs["shadow_ratio"]
     return dataset
 
@@ -165,6 +165,7 @@ def photometry_part_arrays(dataset):
         "sky": dataset["sky"].values.astype(bool),
         "lit_at_start": dataset["lit_at_start"].values.astype(bool),
         "reference": dataset["reference"].values if "reference" in dataset else None,
+        "white_level": float(dataset.attrs.get("white_level", np.nan)),
     }
 
 

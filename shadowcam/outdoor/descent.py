@@ -70,7 +70,7 @@ from shadowcam.outdoor.penumbra import coherent_durations, fit_ramps, neighbour_
 #: ramp state code -> meaning
 RAMP_STATES = {0: "none", 1: "short", 2: "fitted", 3: "neighbours_duration", 4: "cut", 5: "ambiguous",
                6: "cut_centred", 7: "half_level", 8: "neighbours_lit", 9: "no_lit_level", 10: "lit_ratio_spread",
-               11: "before_record"}
+               11: "before_record", 12: "clipped_crossing"}
 STATE_CODE = {name: code for code, name in RAMP_STATES.items()}
 #: states whose ramp centre is the arrival
 TIMED_STATES = ("fitted", "neighbours_duration", "cut_centred", "half_level", "neighbours_lit")

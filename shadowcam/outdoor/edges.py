@@ -19,6 +19,7 @@ import logging
 
 from shadowcam.io.frame_store import iter_store_frames
 from shadowcam.io.frame_times import find_gaps, median_interval
+from shadowcam.outdoor.clipping import store_white_level
 from shadowcam.outdoor.datasets import edges_dataset, photometry_arrays
 from shadowcam.outdoor.keyframes import interpolate_edges, select_keyframes
 from shadowcam.outdoor.photometric import luminance
@@ -27,7 +28,7 @@ from shadowcam.outdoor.tracking import track_frames
 
 log = logging.getLogger(__name__)
 
-TRACK_OPTIONS = frozenset({"half_window", "min_drop", "margin", "max_step", "lit_update",
+TRACK_OPTIONS = frozenset({"clipping", "half_window", "min_drop", "margin", "max_step", "lit_update",
                            "update_distance", "descent_frames", "max_sigma"})
 KEYFRAME_OPTIONS = frozenset({"min_confidence", "min_found_fraction"})
 
@@ -36,6 +37,11 @@ def _check_options(options, allowed, name):
     unknown = set(options) - set(allowed)
     if unknown:
         raise ValueError(f"{name}: unknown option(s) {sorted(unknown)}; allowed {sorted(allowed)}")
+
+
+def _white_level(frames, options):
+    """The store's white level where the ``clipping`` option (popped from `options`) asks for it."""
+    return store_white_level(frames) if options.pop("clipping", False) else None
 
 
 def _edges(tracked, arrays, time_s, options):
@@ -66,7 +72,9 @@ def track_edges(frames, photometry, **options):
     photometry : xarray.Dataset
         Result of the first pass (``photometry.nc``).
     **options
-        :data:`TRACK_OPTIONS` and :data:`KEYFRAME_OPTIONS`.
+        :data:`TRACK_OPTIONS` and :data:`KEYFRAME_OPTIONS`; ``clipping`` (default False): the frame
+        store's white level (:func:`shadowcam.outdoor.clipping.store_white_level`) marks clipped
+        samples (:class:`shadowcam.outdoor.tracking.EdgeTracker` ``white_level``).
 
     Returns
     -------
@@ -78,8 +86,9 @@ def track_edges(frames, photometry, **options):
     time_s = frames["time_s"].values
     width_rows = _edge_width(photometry, arrays)
     log.info("edge tracking: measured edge width %.1f rows", width_rows)
+    track_options = {k: v for k, v in options.items() if k in TRACK_OPTIONS}
     tracked = track_frames(iter_store_frames(frames, what="edge tracking"), arrays, time_s, edge_width_rows=width_rows,
-                           **{k: v for k, v in options.items() if k in TRACK_OPTIONS})
+                           white_level=_white_level(frames, track_options), **track_options)
     return _edges(tracked, arrays, time_s, options)
 
 
@@ -143,6 +152,7 @@ def track_column_strip(frames, photometry, *, index, count, **options):
     a, b = strip_window(cols, halo, width)
     log.info("strip %d/%d: columns %d:%d, reading %d:%d (halo %d, edge width %.1f rows)", index, count, *cols, a,
              b, halo, width_rows)
+    white_level = _white_level(frames, options)
     stream = iter_store_frames(frames.isel(col=slice(a, b)), what=f"edge tracking, strip {index}/{count}")
     return track_strip(stream, arrays, frames["time_s"].values, cols=cols, halo=halo, edge_width_rows=width_rows,
-                       **options)
+                       white_level=white_level, **options)

@@ -43,6 +43,7 @@ the merge turns them into the cloud's shade field over the frame (``shade_field`
 import numpy as np
 
 from shadowcam._shared.validation import check_array, check_same_shape
+from shadowcam.outdoor.clipping import clipped_lit_levels, clipped_samples
 from shadowcam.outdoor.frame_kernels import normalise_smooth_minimum
 from shadowcam.outdoor.photometric import estimate_gain, estimate_lit_gain, lit_at_start, luminance
 from shadowcam.outdoor.registration import (block_all, block_mean, pyramid_levels, reference_levels,
@@ -110,11 +111,17 @@ class SequenceNormaliser:
         Frames before this index are processed (warm-up) but not recorded,
         and the running minimum uses the 3-frame windows ending at this frame
         or later; ``record_from - first_index`` must be >= 2 when ``first_index > 0``.
+    white_level : float or None, optional
+        Decoded value of the sensor's white level (:func:`shadowcam.outdoor.clipping.store_white_level`):
+        the reference's lit pixels clipped in any channel give no gain or block level, and their lit
+        level comes from their neighbours' lit-to-shadow ratio
+        (:func:`shadowcam.outdoor.clipping.clipped_lit_levels`). None: nothing is known to clip.
     """
 
     def __init__(self, *, sky=None, exposure_gain=None, sky_params=None, registration_size=1536,
                  registration_levels=2, registration_margin=6, shade_block=96, reference=None, first_index=0,
-                 record_from=0):
+                 record_from=0, white_level=None):
+        self.white_level = None if white_level is None else float(white_level)
         self._sky = None if sky is None else np.asarray(sky, dtype=bool)
         self._exposure = None if exposure_gain is None else np.asarray(exposure_gain, dtype=np.float64)
         self._sky_params = dict(sky_params or {})
@@ -167,10 +174,17 @@ class SequenceNormaliser:
         self._reference_levels = reference_levels(
             self._small_reference, levels=pyramid_levels(self._small_reference.shape, levels=self._registration_levels))
         self._small_lit = block_all(self.lit_at_start, self.factor)
+        # the lit pixels whose reading is their level: a clipped one's is a lower bound of its light
+        self._small_measured = block_all(self.lit_at_start & ~self._clipped(frame), self.factor)
         self._small_valid = block_all(~self._sky, self.factor)
         self._small_shadowed = block_all(self.shadowed_at_start, self.factor)
         self._row_edges, self._col_edges, self.shade_rows, self.shade_cols = block_grid(
             self._small_reference.shape, block=max(1, round(self._shade_block / self.factor)), factor=self.factor)
+
+    def _clipped(self, frame):
+        if self.white_level is None:
+            return np.zeros(frame.shape[:2], dtype=bool)
+        return clipped_samples(frame, white_level=self.white_level)
 
     def _penumbra_reach(self, small, rough):
         """Reduced pixels the ridge's penumbra may reach beyond its core and beyond the ground shadowed
@@ -194,7 +208,7 @@ class SequenceNormaliser:
         of the blocks' `levels`); see :data:`GAIN_SOURCES`."""
         ref = self._small_reference
         if not self._small_shadowed.any():
-            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_measured, prior=rough)
             return gain_lit, gain_lit, kept, 2
         gain_sky, _ = estimate_gain(small, ref, pixels=self._small_shadowed, prior=last_sky * rough / last_gain)
         expected = None if self._lit_to_sky is None else gain_sky * self._lit_to_sky
@@ -203,14 +217,14 @@ class SequenceNormaliser:
             # no cloud brightens a block: the brightest block's level is the unclouded one, where
             # the unclouded blocks hold a population at or above the expected level
             blocks = np.repeat(np.repeat(unclouded, np.diff(self._row_edges), axis=0), np.diff(self._col_edges), axis=1)
-            _, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit & blocks, expected=expected)
+            _, kept, found = estimate_lit_gain(small, ref, pixels=self._small_measured & blocks, expected=expected)
             if found:
                 gain_lit = float(np.nanmax(levels))
                 self._lit_to_sky = gain_lit / gain_sky
                 return gain_lit, gain_sky, kept, 0
-        gain_lit, kept, found = estimate_lit_gain(small, ref, pixels=self._small_lit, expected=expected)
+        gain_lit, kept, found = estimate_lit_gain(small, ref, pixels=self._small_measured, expected=expected)
         if not np.isfinite(gain_lit):  # too few lit pixels and no ratio yet
-            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_lit, prior=rough)
+            gain_lit, kept = estimate_gain(small, ref, pixels=self._small_measured, prior=rough)
             return gain_lit, gain_sky, kept, 2
         self._lit_to_sky = gain_lit / gain_sky
         return gain_lit, gain_sky, kept, 0 if found else 1
@@ -234,8 +248,8 @@ class SequenceNormaliser:
         if k == 0:
             self._start(frame)
             shift, gain_lit, gain_sky, luma = np.zeros(2), 1.0, 1.0, self.reference_luma
-            kept, source, rough = int(self._small_lit.sum()), 0, 1.0
-            levels = block_levels(self._small_reference, self._small_reference, pixels=self._small_lit,
+            kept, source, rough = int(self._small_measured.sum()), 0, 1.0
+            levels = block_levels(self._small_reference, self._small_reference, pixels=self._small_measured,
                                   row_edges=self._row_edges, col_edges=self._col_edges,
                                   reached_below=SHADOWED_CONTRAST)
         else:
@@ -245,7 +259,7 @@ class SequenceNormaliser:
             raw = luminance(frame) if frame.ndim == 3 else frame
             factor, ref = self.factor, self._small_reference
             small = block_mean(raw, factor)
-            rough, _ = estimate_gain(small, ref, pixels=self._small_lit, prior=self._prior(last_gain, k))
+            rough, _ = estimate_gain(small, ref, pixels=self._small_measured, prior=self._prior(last_gain, k))
             weight = static_weight(small, ref, lit_reference=self._small_lit, gain=rough, valid=self._small_valid,
                                    margin=self._registration_margin)
             shift, _ = shift_coarse_to_fine(small, ref, weight=weight, initial=last_shift / factor,
@@ -255,7 +269,7 @@ class SequenceNormaliser:
             spare = self._recent.pop(0) if len(self._recent) == 3 else None
             luma, small = translate_with_block_means(raw, shift, factor=factor, out=spare)
             del raw
-            levels = block_levels(small, ref, pixels=self._small_lit, row_edges=self._row_edges,
+            levels = block_levels(small, ref, pixels=self._small_measured, row_edges=self._row_edges,
                                   col_edges=self._col_edges, reached_below=SHADOWED_CONTRAST * rough,
                                   dark=self._small_valid & ~self._small_lit, reach=self._penumbra_reach(small, rough))
             gain_lit, gain_sky, kept, source = self._gains(small, rough, last_gain, last_sky, levels)
@@ -287,7 +301,8 @@ class SequenceNormaliser:
             ``shade_levels (T_part, By, Bx)`` with ``shade_rows (By,)``, ``shade_cols (Bx,)``,
             ``shadow_min (H, W)``
             (running minimum over the part's 3-frame windows), ``sky``, ``lit_at_start``
-            ``(H, W)`` and ``reference (H, W, C)`` (frame 0; the same in every part).
+            ``(H, W)``, ``reference (H, W, C)`` (frame 0; the same in every part) and ``white_level``
+            (NaN: none known).
         """
         if not self.shifts:
             raise ValueError("no frames were recorded (feed frames up to and past record_from)")
@@ -306,6 +321,7 @@ class SequenceNormaliser:
             "sky": self._sky,
             "lit_at_start": self.lit_at_start,
             "reference": self.reference,
+            "white_level": np.nan if self.white_level is None else self.white_level,
         }
 
     def result(self):
@@ -324,6 +340,7 @@ class PartMerger:
     def __init__(self):
         self._curves = {key: [] for key in _CURVES}
         self._shadow_min = self._sky = self._lit = self._reference = None
+        self._white_level = np.nan
         self._next = 0
 
     def add(self, part):
@@ -341,6 +358,7 @@ class PartMerger:
             np.minimum(self._shadow_min, part["shadow_min"], out=self._shadow_min)
         if self._reference is None and part.get("reference") is not None:
             self._reference = part["reference"]
+            self._white_level = float(part.get("white_level", np.nan))
         self._grid = (np.asarray(part["shade_rows"]), np.asarray(part["shade_cols"]))
 
     def result(self):
@@ -361,9 +379,14 @@ class PartMerger:
         with np.errstate(divide="ignore", invalid="ignore"):
             contrast = np.where(ref > 0, shadow_min * to_lit / ref, np.inf)
         shadowed = lit & (contrast < SHADOWED_CONTRAST)
-        ratio = float(np.median(contrast[shadowed])) if shadowed.any() else 0.1
+        clipped = lit & (clipped_samples(self._reference, white_level=self._white_level)  # a lower bound of the light
+                         if np.isfinite(self._white_level) else False)
+        measured = shadowed & ~clipped
+        ratio = float(np.median(contrast[measured])) if measured.any() else 0.1
         shadow_level = np.where(shadowed | (~sky & ~lit), shadow_min, ratio * ref / to_lit)
         lit_level = np.where(lit, ref, shadow_min * to_lit / ratio)
+        lit_level = clipped_lit_levels(lit_level, shadow_min * to_lit, clipped=clipped & shadowed, trusted=shadowed,
+                                       fallback_ratio=1.0 / ratio)
         shade, field = cloud_shades(curves["gain_median"], curves["gain_lit"], curves["gain_source"],
                                     curves["shade_levels"], shadow_ratio=ratio)
         return {

@@ -22,12 +22,13 @@ from shadowcam.io.manifest import verify_checksums
 from shadowcam.outdoor.datasets import (
     photometry_dataset, photometry_part_arrays, photometry_part_dataset,
 )
+from shadowcam.outdoor.clipping import store_white_level
 from shadowcam.outdoor.normalise import PartMerger, normalise_frames, normalise_part, part_frames
 from shadowcam.outdoor.photometric import exposure_gains
 from shadowcam.outdoor.sky_mask import auto_sky_mask, mask_from_image, polygon_mask
 
 PHOTOMETRY_OPTIONS = frozenset({"sky_params", "registration_size", "registration_levels",
-                                "registration_margin", "overlap"})
+                                "registration_margin", "overlap", "clipping"})
 
 
 def sky_mask_from_manifest(manifest, shape):
@@ -107,7 +108,9 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
         ``(start, stop)``: only this time part (read with its warm-up frames), to be merged by
         :func:`merge_photometry_parts`.
     **options
-        :data:`PHOTOMETRY_OPTIONS`.
+        :data:`PHOTOMETRY_OPTIONS`; ``clipping`` (default False): the frame store's white level
+        (:func:`shadowcam.outdoor.clipping.store_white_level`) marks clipped samples
+        (:class:`shadowcam.outdoor.normalise.SequenceNormaliser` ``white_level``).
 
     Returns
     -------
@@ -125,7 +128,8 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
     pass_options = dict(sky=sky, exposure_gain=exposure, sky_params=options.get("sky_params"),
                         registration_size=options.get("registration_size", 1536),
                         registration_levels=options.get("registration_levels", 2),
-                        registration_margin=options.get("registration_margin", 6))
+                        registration_margin=options.get("registration_margin", 6),
+                        white_level=store_white_level(frames) if options.get("clipping", False) else None)
     time_s = frames["time_s"].values
     if part is None:
         result = normalise_frames(_pass_frames(frames, 0, frames.sizes["time"], what="registration and gains"),

@@ -32,7 +32,8 @@ track_frames : run it over an iterable of frames.
 
 import numpy as np
 
-from shadowcam.outdoor.descent import DescentBuffer, fit_descents
+from shadowcam.outdoor.clipping import CLIPPED_SHARE, OWN_SHARE, registered_clipped
+from shadowcam.outdoor.descent import STATE_CODE, DescentBuffer, fit_descents
 from shadowcam.outdoor.edge_tracking import column_edges
 from shadowcam.outdoor.episodes import ShadowEpisodes
 from shadowcam.outdoor.frame_difference import difference_band
@@ -95,11 +96,17 @@ class EdgeTracker:
     max_sigma : float, optional
         Largest standard error of a fitted ramp centre, in median intervals
         (:func:`shadowcam.outdoor.descent.fit_descents`).
+    white_level : float or None, optional
+        Decoded value of the sensor's white level (:func:`shadowcam.outdoor.clipping.store_white_level`):
+        a reading a clipped sample enters does not update the lit level, and a pixel whose own
+        clipped sample reads below the level at or after its final crossing gets no time (ramp state
+        ``clipped_crossing``). None: nothing is known to clip.
     """
 
     def __init__(self, photometry, time_s, *, half_window=3, min_drop=0.2, margin=2, max_step=3.0,
                  lit_update=0.3, update_distance=4.0, count_cols=None, edge_width_rows=0.0, descent_frames=128,
-                 max_sigma=1.0):
+                 max_sigma=1.0, white_level=None):
+        self.white_level = None if white_level is None else float(white_level)
         self.shift = np.asarray(photometry["shift"], dtype=np.float64)
         self.gain_lit = np.asarray(photometry["gain_lit"], dtype=np.float64)
         self.gain_sky = np.asarray(photometry["gain_sky"], dtype=np.float64)
@@ -149,6 +156,7 @@ class EdgeTracker:
         self.shadow_ratio = float(ratio) if ratio is not None and np.isfinite(ratio) else None
         self.descent = DescentBuffer((height, width), frames=descent_frames, luminance=self.shadow_ratio is not None)
         self.max_sigma = float(max_sigma)
+        self._clipped_dark_s = np.full((height, width), -np.inf)  # last clipped sample below the level
         self._previous = None
         self._last_edge = np.full(width, np.nan, dtype=np.float32)  # most recent edge found per column
         self._k = 0
@@ -162,6 +170,8 @@ class EdgeTracker:
         luma = translate(luminance(frame), self.shift[k], method="cubic_Keys1981") / np.float32(self.gain_lit[k])
         shadow = self.shadow_level * np.float32(self.gain_sky[k] / self.gain_lit[k])
         cover = coverage(luma, lit_level=self.lit_level, shadow_level=shadow)
+        clipped = None if self.white_level is None else registered_clipped(frame, self.shift[k],
+                                                                           white_level=self.white_level)
         if self.shade_field is not None and (self.shade_field[k] < 1).any():  # a cloud's shade over the frame
             cover /= interpolate_field(self.shade_field[k], row_centres=self.shade_grid[0],
                                        col_centres=self.shade_grid[1], shape=cover.shape)
@@ -180,12 +190,16 @@ class EdgeTracker:
         found = np.isfinite(self.edge_row[k])
         self._last_edge[found] = self.edge_row[k][found]
         self.episodes.update(cover, self.time_s[k])
+        if clipped is not None:  # a clipped reading is a lower bound of the light: below the level, not dark
+            self._clipped_dark_s[(clipped >= OWN_SHARE) & (cover < self.episodes.level)] = self.time_s[k]
         self.descent.update(cover, dark=self.episodes.dark & np.isfinite(self.episodes.start),
                             luminance=None if self.shadow_ratio is None else shadow + cover * (self.lit_level - shadow))
         if self.lit_update > 0:
             with np.errstate(invalid="ignore"):
                 far = ~(self._centre > self.edge_row[k][None, :] - self.update_distance)
             update = self.lit_at_start & (cover > 0.9) & far
+            if clipped is not None:  # a reading a clipped sample enters is no level
+                update &= np.abs(clipped) < CLIPPED_SHARE
             blended = (1 - self.lit_update) * self.lit_level + self.lit_update * luma
             np.copyto(self.lit_level, blended, where=update)
         self._previous = cover
@@ -197,14 +211,21 @@ class EdgeTracker:
             raise ValueError(f"got {self._k} frames but {self.time_s.size} frame times")
         episodes = {"coverage_arrival_s" if key == "final_start_s" else key: value
                     for key, value in self.episodes.result().items()}
+        ramps = fit_descents(self.descent, episodes["coverage_arrival_s"], self.time_s, max_sigma=self.max_sigma,
+                             cut_rows=self._edge_width, shadow_ratio=self.shadow_ratio)
+        # a sample read below the level on the clip at or after the final crossing: the light may
+        # have been above it, the crossing later; neither the crossing nor the ramp's time stands
+        with np.errstate(invalid="ignore"):
+            hidden = self._clipped_dark_s >= episodes["coverage_arrival_s"]
+        ramps["ramp_state"][hidden] = STATE_CODE["clipped_crossing"]
+        ramps["ramp_centre_s"][hidden] = np.nan
         return {
             "edge_row": self.edge_row,
             "confidence": self.confidence,
             "n_transitions": self.n_transitions,
             "band_fraction": self.band_fraction,
             **episodes,
-            **fit_descents(self.descent, episodes["coverage_arrival_s"], self.time_s, max_sigma=self.max_sigma,
-                           cut_rows=self._edge_width, shadow_ratio=self.shadow_ratio),
+            **ramps,
         }
 
 

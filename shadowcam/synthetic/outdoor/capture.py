@@ -296,7 +296,7 @@ def render_outdoor_capture(scene, *, frames, supersample=3, seed=0, sun_diameter
     return OutdoorCapture(frames=sensor_frames, ground_truth=ds)
 
 
-def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6):
+def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6, push_stops=0.0):
     """A capture's frames with Poisson-Gaussian sensor noise on linear RGB (no mosaic), as a frame store.
 
     Parameters
@@ -309,12 +309,18 @@ def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6):
     exposure : float, keyword-only
         The reference radiance's share of the sensor's range
         (:func:`shadowcam.synthetic.sensor.electrons_per_unit_radiance`).
+    push_stops : float, keyword-only
+        Stops the photographer pushes the exposure beyond `exposure` (the signal times
+        ``2 ** push_stops``): the brightest lit ground then reaches the sensor's white level,
+        where its samples read 1 (the RAW white level after black subtraction, as a decoded
+        frame store's). 0 (default): today's frames, bit for bit.
 
     Returns
     -------
     xarray.Dataset
         ``image (time, row, col, channel)`` float32 in [0, 1], coords ``time_s`` and
-        ``exposure_s`` (4 ms times the auto-exposure steps: the metadata carries no flicker).
+        ``exposure_s`` (4 ms times the auto-exposure steps: the metadata carries no flicker);
+        attrs ``black_level``, ``white_level`` and ``normalisation`` as a decoded frame store's.
     """
     import xarray as xr
 
@@ -323,11 +329,15 @@ def noisy_frame_store(capture, *, bit_depth=14, seed=3, exposure=0.6):
     truth = capture.ground_truth
     sensor = SensorModel(bit_depth=int(bit_depth))
     scale = electrons_per_unit_radiance(truth["reference_radiance"].values, sensor=sensor, target_fraction=exposure)
+    if push_stops:
+        scale = scale * 2.0 ** float(push_stops)
     images = np.stack([raw_to_linear(simulate_raw(frame, sensor=sensor, scale=scale, seed=[seed, k], mosaic=False),
                                      sensor=sensor) for k, frame in enumerate(capture.frames)])
     return xr.Dataset({"image": (("time", "row", "col", "channel"), images)},
                       coords={"time_s": ("time", capture.times_s),
-                              "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)})
+                              "exposure_s": ("time", 0.004 * 2.0 ** truth["ae_ev"].values)},
+                      attrs={"black_level": sensor.black_level, "white_level": sensor.white_level,
+                             "normalisation": "linear; (value - black_level) / (white_level - black_level)"})
 
 
 def edge_speed(arrival_frame, shadow_class):
