@@ -41,7 +41,7 @@ def _check_options(options, allowed, name):
 
 def _white_level(frames, options):
     """The store's white level where the ``clipping`` option (popped from `options`) asks for it."""
-    return store_white_level(frames) if options.pop("clipping", False) else None
+    return store_white_level(frames) if options.pop("clipping", True) else None
 
 
 def _edges(tracked, arrays, time_s, options):
@@ -72,7 +72,7 @@ def track_edges(frames, photometry, **options):
     photometry : xarray.Dataset
         Result of the first pass (``photometry.nc``).
     **options
-        :data:`TRACK_OPTIONS` and :data:`KEYFRAME_OPTIONS`; ``clipping`` (default False): the frame
+        :data:`TRACK_OPTIONS` and :data:`KEYFRAME_OPTIONS`; ``clipping`` (default True): the frame
         store's white level (:func:`shadowcam.outdoor.clipping.store_white_level`) marks clipped
         samples (:class:`shadowcam.outdoor.tracking.EdgeTracker` ``white_level``).
 

@@ -108,7 +108,7 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
         ``(start, stop)``: only this time part (read with its warm-up frames), to be merged by
         :func:`merge_photometry_parts`.
     **options
-        :data:`PHOTOMETRY_OPTIONS`; ``clipping`` (default False): the frame store's white level
+        :data:`PHOTOMETRY_OPTIONS`; ``clipping`` (default True): the frame store's white level
         (:func:`shadowcam.outdoor.clipping.store_white_level`) marks clipped samples
         (:class:`shadowcam.outdoor.normalise.SequenceNormaliser` ``white_level``).
 
@@ -129,7 +129,7 @@ def photometry_from_frames(frames, *, sky=None, sky_source="auto", exposure_meta
                         registration_size=options.get("registration_size", 1536),
                         registration_levels=options.get("registration_levels", 2),
                         registration_margin=options.get("registration_margin", 6),
-                        white_level=store_white_level(frames) if options.get("clipping", False) else None)
+                        white_level=store_white_level(frames) if options.get("clipping", True) else None)
     time_s = frames["time_s"].values
     if part is None:
         result = normalise_frames(_pass_frames(frames, 0, frames.sizes["time"], what="registration and gains"),
